@@ -1,0 +1,164 @@
+# occmap - one entry point.
+#   make          build/libocc.a and build/occmap (release, -O2)
+#   make test     install what is missing, then every test under ASan+UBSan, cross, symbol check
+#   make demo     the main job (see README)
+#   make bench    benchmarks against OctoMap in the same run
+#   make cross    the core for Cortex-M4F and Cortex-M0+, size table and worst stack frame
+#   make fuzz     the fuzz harnesses (bounded time)
+#   make clean    remove build products (keeps build/venv and build/cache: slow to remake)
+#
+# Fragments: src/sources.mk lists the core files (firmware Makefiles include it); every
+# tests/*.mk, tools/*.mk, bench/*.mk and port/*.mk adds its own rules and variables.
+
+.DEFAULT_GOAL := all
+SHELL := /bin/bash
+BUILD := build
+CC := gcc
+CXX := g++
+AR := ar
+
+WARN := -std=c99 -pedantic-errors -Wall -Wextra -Werror -Wconversion -Wsign-conversion \
+        -Wdouble-promotion -Wshadow -Wcast-qual -Wstrict-prototypes -Wmissing-prototypes \
+        -Wvla -Wundef -Wswitch-enum -Wfloat-equal -fno-common
+# Host programs (tools, tests, ports) are C99 with the same warnings but may use POSIX.
+HOST_WARN := $(WARN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
+CXXWARN := -std=c++14 -Wall -Wextra -Werror -Wno-deprecated-copy -Wno-class-memaccess
+SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+INC := -Iinclude -Isrc
+
+# Package lists: fragments append. apt is only called when something is missing.
+APT_PKGS := build-essential libcmocka-dev liboctomap-dev octomap-tools libccd-dev libeigen3-dev \
+            libpng-dev gcc-arm-none-eabi libnewlib-arm-none-eabi bzip2 python3-venv \
+            qemu-system-arm valgrind clang
+PIP_PKGS := pymavlink==2.4.50 dronecan==1.0.27 python-can==4.3.1
+VENV := $(BUILD)/venv
+PY := $(VENV)/bin/python
+
+include src/sources.mk
+
+# Extra libraries every host test and tool links with (fragments may append).
+HOST_LIBS := -loctomap -loctomath -lccd -lpng -lcmocka -lm -lpthread
+
+# Objects every fragment may add to: TEST_SUPPORT_SRC (tests/support), PORT_SRC (port/posix),
+# TOOL_SRC (tools/*.c), TEST_STEPS (phony targets run by `make test`, each a counted test),
+# DEMO_STEPS, BENCH_STEPS, FUZZ_STEPS.
+PORT_SRC := $(wildcard port/posix/*.c)
+TOOL_SRC := $(wildcard tools/*.c)
+TEST_SUPPORT_SRC := $(wildcard tests/support/*.c tests/support/*.cpp)
+TEST_C := $(wildcard tests/test_*.c)
+TEST_STEPS :=
+DEMO_STEPS :=
+BENCH_STEPS :=
+FUZZ_STEPS :=
+
+-include $(wildcard port/*.mk tests/*.mk tools/*.mk bench/*.mk)
+
+# ---- deps ------------------------------------------------------------------------------------
+DEPS_STAMP := $(BUILD)/.deps-ok
+deps: $(DEPS_STAMP)
+$(DEPS_STAMP): Makefile $(wildcard port/*.mk tests/*.mk tools/*.mk bench/*.mk)
+	@mkdir -p $(BUILD)
+	@missing=""; for p in $(APT_PKGS); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "deps: installing$$missing"; \
+	  export DEBIAN_FRONTEND=noninteractive; \
+	  apt-get update -q && apt-get install -y -q --no-install-recommends $$missing; \
+	fi
+	@if [ ! -x $(PY) ] || ! $(PY) -c "import pymavlink, dronecan" 2>/dev/null \
+	    || [ "$$(cat $(VENV)/.pins 2>/dev/null)" != "$(PIP_PKGS)" ]; then \
+	  echo "deps: creating $(VENV) with $(PIP_PKGS)"; \
+	  (python3 -m venv $(VENV) || /usr/bin/python3 -m venv $(VENV)) && \
+	  $(PY) -m pip install -q $(PIP_PKGS) && echo "$(PIP_PKGS)" > $(VENV)/.pins; \
+	fi
+	@touch $@
+
+# ---- the library (release and sanitizer builds) ------------------------------------------------
+REL_CFLAGS := $(WARN) -O2 -g $(INC)
+ASAN_CFLAGS := $(WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1
+
+$(BUILD)/rel/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(REL_CFLAGS) $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
+$(BUILD)/asan/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(ASAN_CFLAGS) $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
+$(BUILD)/relhost/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_WARN) -O2 -g $(INC) $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
+$(BUILD)/asanhost/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
+$(BUILD)/asanhost/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXWARN) -O1 -g $(SAN) $(INC) -I/usr/include/eigen3 -MMD -MP -c $< -o $@
+$(BUILD)/relhost/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXWARN) -O2 -g $(INC) -I/usr/include/eigen3 -MMD -MP -c $< -o $@
+
+LIB_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC) $(OCC_CCD_SRC)
+$(BUILD)/libocc.a: $(LIB_SRC:%.c=$(BUILD)/rel/%.o)
+	@rm -f $@
+	$(AR) rcs $@ $^
+$(BUILD)/asan/libocc.a: $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+# The command-line tool: tools/*.c + port/posix, release build.
+$(BUILD)/occmap: $(TOOL_SRC:%.c=$(BUILD)/relhost/%.o) $(PORT_SRC:%.c=$(BUILD)/relhost/%.o) $(BUILD)/libocc.a
+	$(CXX) -o $@ $^ $(HOST_LIBS)
+
+all: $(DEPS_STAMP) $(BUILD)/libocc.a $(BUILD)/occmap
+
+# ---- tests -------------------------------------------------------------------------------------
+TEST_BINS := $(TEST_C:tests/%.c=$(BUILD)/asan/tests/bin/%)
+TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/asanhost/%.o,$(patsubst %.cpp,$(BUILD)/asanhost/%.o,$(TEST_SUPPORT_SRC)))
+TEST_PORT_OBJ := $(PORT_SRC:%.c=$(BUILD)/asanhost/%.o)
+
+$(BUILD)/asan/tests/bin/%: $(BUILD)/asanhost/tests/%.o $(TEST_SUPPORT_OBJ) $(TEST_PORT_OBJ) $(BUILD)/asan/libocc.a
+	@mkdir -p $(dir $@)
+	$(CXX) $(SAN) -o $@ $^ $(HOST_LIBS)
+
+test-build: $(DEPS_STAMP) $(TEST_BINS) $(BUILD)/occmap $(TEST_BUILD_EXTRA)
+
+# Each step prints PASS/FAIL lines the runner counts; the runner prints "N passed, N failed".
+test: $(DEPS_STAMP)
+	@$(MAKE) --no-print-directory test-build
+	@bash tests/run_all.sh $(BUILD) "$(TEST_BINS)" "$(TEST_STEPS)"
+
+# ---- cross (Cortex-M) ---------------------------------------------------------------------------
+CROSS_CC := arm-none-eabi-gcc
+CROSS_COMMON := $(WARN) -Os -ffunction-sections -fdata-sections -ffreestanding -fstack-usage $(INC)
+CROSS_M4 := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
+CROSS_M0 := -mcpu=cortex-m0plus -mthumb -mfloat-abi=soft
+CROSS_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC)
+
+$(BUILD)/cross/m4/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M4) $(EXTRA_CFLAGS) -c $< -o $@
+$(BUILD)/cross/m0/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M0) $(EXTRA_CFLAGS) -c $< -o $@
+
+cross-objs: $(DEPS_STAMP) $(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o) $(CROSS_EXTRA)
+cross: cross-objs
+	@bash tests/cross_report.sh $(BUILD)/cross
+
+# The core must not reach for the heap, stdio or process exit.
+symcheck: $(BUILD)/libocc.a cross-objs
+	@bash tests/symcheck.sh $(BUILD)/rel/src $(BUILD)/cross/m4/src
+
+# ---- other entry points (fragments add steps) -----------------------------------------------------
+demo: all $(DEMO_STEPS)
+bench: all $(BENCH_STEPS)
+fuzz: $(DEPS_STAMP) $(FUZZ_STEPS)
+
+clean:
+	rm -rf $(filter-out $(BUILD)/venv $(BUILD)/cache,$(wildcard $(BUILD)/*)) $(BUILD)/.deps-ok
+distclean:
+	rm -rf $(BUILD)
+
+.PHONY: all deps test test-build cross cross-objs symcheck demo bench fuzz clean distclean
+.SECONDARY:
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -1,0 +1,109 @@
+/*
+ * occ_feed.h - what the vehicle is told: the nearest obstacle per horizontal sector (src/feed/sectors.c).
+ * Pure C99, no OS, no heap; uses the public map API only.
+ *
+ * Frames
+ *  - The map frame is ENU: x east, y north, z up (OctoMap's data). Maps built in NED are handled
+ *    by the caller (occmap feed --map-frame ned) before poses reach this module.
+ *  - An autopilot's NED pose converts as map x = NED y (east), map y = NED x (north),
+ *    map z = -NED z, yaw_map = pi/2 - yaw_ned (occ_pose_from_ned).
+ *  - Sectors are in the vehicle's heading frame, MAV_FRAME_BODY_FRD seen from above: body angle 0
+ *    is forward, angles grow clockwise. Sector i is centred on body angle
+ *    angle_offset_deg + i * increment_deg and covers [centre - inc/2, centre + inc/2).
+ *    Roll and pitch are accepted but not used: sectors are horizontal slices (ArduPilot files
+ *    OBSTACLE_DISTANCE in its 0-degree pitch layer, PX4 in its horizontal bins).
+ *
+ * What a sector reports (the exact geometric definition the tests check by brute force)
+ *  - The vertical band is [z - band_below_m, z + band_above_m); a voxel takes part when its z
+ *    extent overlaps the band. Space outside the map volume counts as UNKNOWN.
+ *  - For each sector: d_occ = the smallest horizontal distance from the vehicle to a point of an
+ *    OCCUPIED voxel's footprint that lies inside the sector's wedge; d_unk the same for UNKNOWN
+ *    voxels (never observed, or in the band between free_max and occupied_min).
+ *    R = max_distance_cm / 100 m is the search radius.
+ *  - d_occ <= d_unk and d_occ < R : obstacle: distance in cm (floor), clamped to
+ *    [min_distance_cm, max_distance_cm].
+ *  - d_unk < d_occ and d_unk < R  : the view is blocked by unknown space. Unknown space is never
+ *    reported as free: unknown_as_distance = false reports UINT16_MAX ("no data" for ArduPilot
+ *    and PX4), true reports d_unk clamped like an obstacle (conservative, for vehicles that
+ *    must not fly into unexplored space).
+ *  - otherwise (everything within R observed free): max_distance_cm.
+ *  A value is never 0 (min_distance_cm >= 1). A vehicle standing in unknown space gets
+ *  d_unk = 0 in every sector.
+ */
+#ifndef OCC_FEED_H_INCLUDED
+#define OCC_FEED_H_INCLUDED
+
+#include "occmap/occmap.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define OCC_SECTORS_MAX 72u
+#define OCC_SECTORS_UNKNOWN UINT16_MAX
+
+typedef struct {
+    float x, y, z;                 /* metres, map frame (ENU) */
+    float yaw_rad;                 /* map frame: 0 = +x (east), counter-clockwise positive */
+    float roll_rad, pitch_rad;     /* optional, 0 when unknown; not used by the sectors */
+} occ_pose_t;
+
+/* Convert an autopilot pose (NED metres, yaw from north clockwise, radians) to the ENU map
+ * frame; yaw_map is wrapped to (-pi, pi]. Roll and pitch are set to 0. O(1). */
+occ_pose_t occ_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad);
+
+typedef struct {
+    uint8_t n_sectors;             /* 1..72 */
+    float increment_deg;           /* (0, 90], n_sectors * increment_deg <= 360 */
+    float angle_offset_deg;        /* body angle of sector 0's centre, clockwise positive */
+    float band_below_m, band_above_m; /* vertical band around the vehicle, metres >= 0, sum > 0 */
+    uint16_t min_distance_cm, max_distance_cm; /* 1 <= min < max <= 65534 */
+    bool unknown_as_distance;      /* see the header comment: false -> UINT16_MAX */
+} occ_sectors_config_t;
+
+/* Work space of one computation (internal): a depth-first stack of nodes and per-sector state.
+ * Lives in occ_sectors_t so the call needs only a small C stack frame. */
+#define OCC_SECTORS_STACK (8u * (OCC_MAX_DEPTH + 2u))
+typedef struct {
+    uint32_t k[3];
+    uint8_t level;
+    float dmin;
+} occ_sectors_item_t;
+
+typedef struct {
+    uint8_t n;                              /* sectors filled */
+    uint16_t distance_cm[OCC_SECTORS_MAX];  /* obstacle clamped to [min,max]; max = observed
+                                             * free; UINT16_MAX = unknown; never 0 */
+    /* Diagnostics of the last call. */
+    uint32_t nodes_read;                    /* occ_map_read_key calls */
+    uint32_t leaves_used;                   /* uniform nodes folded into the sectors */
+    /* Metres, per sector, of the last call (OCC_SECTORS_FAR when nothing within R). */
+    float d_occ_m[OCC_SECTORS_MAX];
+    float d_unk_m[OCC_SECTORS_MAX];
+    /* Internal scratch. */
+    float ray_c[OCC_SECTORS_MAX + 1], ray_s[OCC_SECTORS_MAX + 1];
+    occ_sectors_item_t stack[OCC_SECTORS_STACK];
+} occ_sectors_t;
+
+#define OCC_SECTORS_FAR 1.0e30f
+
+/* Defaults: 72 sectors of 5 degrees, offset 0, band +-0.5 m, 20..2000 cm, unknown -> UINT16_MAX. */
+occ_sectors_config_t occ_sectors_config_default(void);
+
+/* OCC_OK if `cfg` is usable, else OCC_ERR_ARG (ranges as documented on the fields). O(1). */
+occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg);
+
+/* Fill out->distance_cm[0..n_sectors-1] (and out->n, d_occ_m, d_unk_m) for the vehicle at `pose`.
+ * Walks the octree top-down with occ_map_read_key(), nearest node first, and skips a node when
+ * it lies outside the search cylinder, holds only free space, or is farther than what every
+ * sector it spans already found. Cost grows with the number of non-free nodes near the vehicle,
+ * not with R^2. Never writes the map; reads no memory other than map, pose, cfg and out.
+ * Errors: OCC_ERR_ARG (NULL, non-finite pose, bad cfg), OCC_ERR_RANGE (the vehicle outside the
+ * map volume). On error `out` holds n = 0. */
+occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
+                              const occ_sectors_config_t *cfg, occ_sectors_t *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,179 @@
+/*
+ * check.c - occ_map_check(): an O(n) audit of pools and tree that never writes.
+ *
+ * Block ownership is verified without extra memory: every block index below the pool's
+ * high-water mark must be owned exactly once, by the tree or by the free list. The count,
+ * the sum and the sum of squares of all owned indices must equal those of 0..hwm-1; a leak,
+ * a block owned twice or a free block still in the tree changes at least one of them
+ * (barring adversarial coincidences of both sums).
+ */
+#include <string.h>
+
+#include "tree_internal.h"
+
+typedef struct {
+    uint64_t count, sum, sum_sq;
+} tally_t;
+
+static void tally_add(tally_t *const t, const uint32_t idx)
+{
+    t->count++;
+    t->sum += idx;
+    t->sum_sq += (uint64_t)idx * idx;
+}
+
+static bool tally_complete(const tally_t *const t, const uint32_t hwm)
+{
+    const uint64_t n = hwm;
+    const uint64_t sum = n == 0u ? 0u : n * (n - 1u) / 2u;
+    /* sum of squares 0..n-1 = (n-1) n (2n-1) / 6, computed without overflow for n < 2^32 */
+    uint64_t a = n == 0u ? 0u : n - 1u, b = n, c = n == 0u ? 0u : 2u * n - 1u;
+    if (a % 2u == 0u) a /= 2u; else b /= 2u;
+    if (a % 3u == 0u) a /= 3u; else if (b % 3u == 0u) b /= 3u; else c /= 3u;
+    return t->count == n && t->sum == sum && t->sum_sq == a * b * c;
+}
+
+static bool check_free_lists(const occ_map_t *const m, tally_t *const inner, tally_t *const leaf)
+{
+    uint32_t n = 0u;
+    for (uint32_t i = m->inner.free_head; i != OCC_NONE; i = occ_inner_at(m, i)->child[0]) {
+        if (i >= m->inner.hwm || n++ > m->inner.hwm ||
+            occ_inner_at(m, i)->flags[7] != OCC_INNER_FREE_MARK) {
+            return false; /* foreign index, cycle, or a used block on the list */
+        }
+        tally_add(inner, i);
+    }
+    if (n != m->inner.free_count) {
+        return false;
+    }
+    n = 0u;
+    uint32_t i = m->leaf.free_head;
+    while (i != OCC_NONE) {
+        if (i >= m->leaf.hwm || n++ > m->leaf.hwm) {
+            return false;
+        }
+        tally_add(leaf, i);
+        memcpy(&i, occ_leaf_at(m, i)->value, sizeof i);
+    }
+    return n == m->leaf.free_count;
+}
+
+/* Expected value and flags of a node from its child block, and whether the block is prunable. */
+static bool check_block(const occ_map_t *const m, const uint32_t child, const unsigned level,
+                        const occ_value_t value, const uint8_t flags)
+{
+    occ_value_t mx = OCC_VALUE_UNOBSERVED;
+    uint8_t f = 0u;
+    bool prunable = true;
+    if (level == 1u) {
+        const occ_leaf_block_t *const b = occ_leaf_at(m, child);
+        for (unsigned s = 0; s < 8u; s++) {
+            mx = b->value[s] > mx ? b->value[s] : mx;
+            f = (uint8_t)(f | occ_value_flags(m, b->value[s]));
+            prunable = prunable && occ_value_eq(b->value[s], b->value[0]);
+        }
+    } else {
+        const occ_inner_block_t *const b = occ_inner_at(m, child);
+        if (b->flags[7] == OCC_INNER_FREE_MARK) {
+            return false;
+        }
+        for (unsigned s = 0; s < 8u; s++) {
+            mx = b->value[s] > mx ? b->value[s] : mx;
+            f = (uint8_t)(f | b->flags[s]);
+            prunable = prunable && b->child[s] == OCC_NONE && occ_value_eq(b->value[s], b->value[0]);
+            if (b->child[s] == OCC_NONE && b->flags[s] != occ_value_flags(m, b->value[s])) {
+                return false;
+            }
+        }
+    }
+    return !prunable && occ_value_eq(mx, value) && f == flags;
+}
+
+occ_err_t occ_map_check(const occ_map_t *const m)
+{
+    if (m == NULL) {
+        return OCC_ERR_ARG;
+    }
+    const occ_pool_t *const pools[2] = {&m->inner, &m->leaf};
+    for (unsigned k = 0; k < 2u; k++) {
+        const occ_pool_t *const p = pools[k];
+        if ((uint64_t)p->used + p->free_count != p->hwm || p->used > p->peak) {
+            return OCC_ERR_CORRUPT;
+        }
+    }
+    if ((uint64_t)m->inner.hwm * sizeof(occ_inner_block_t) +
+            (uint64_t)m->leaf.hwm * sizeof(occ_leaf_block_t) > m->arena_bytes) {
+        return OCC_ERR_CORRUPT;
+    }
+    tally_t inner = {0u, 0u, 0u}, leaf = {0u, 0u, 0u};
+    if (!check_free_lists(m, &inner, &leaf)) {
+        return OCC_ERR_CORRUPT;
+    }
+    /* Root. */
+    const unsigned depth = m->cfg.depth_levels;
+    if (m->root_child == OCC_NONE) {
+        return m->root_flags == occ_value_flags(m, m->root_value) &&
+                       tally_complete(&inner, m->inner.hwm) && tally_complete(&leaf, m->leaf.hwm)
+                   ? OCC_OK
+                   : OCC_ERR_CORRUPT;
+    }
+    const uint32_t root_hwm = depth == 1u ? m->leaf.hwm : m->inner.hwm;
+    if (m->root_child >= root_hwm ||
+        !check_block(m, m->root_child, depth, m->root_value, m->root_flags)) {
+        return OCC_ERR_CORRUPT;
+    }
+    if (depth == 1u) {
+        tally_add(&leaf, m->root_child);
+    } else {
+        tally_add(&inner, m->root_child);
+        /* Iterative DFS over inner blocks: frame = block whose nodes sit at lvl, next slot. */
+        uint32_t blk[OCC_MAX_DEPTH + 1];
+        uint8_t lvl[OCC_MAX_DEPTH + 1], next[OCC_MAX_DEPTH + 1];
+        unsigned sp = 0;
+        blk[0] = m->root_child;
+        lvl[0] = (uint8_t)(depth - 1u);
+        next[0] = 0u;
+        for (;;) {
+            if (next[sp] >= 8u) {
+                if (sp == 0u) {
+                    break;
+                }
+                sp--;
+                continue;
+            }
+            const occ_inner_block_t *const b = occ_inner_at(m, blk[sp]);
+            const unsigned s = next[sp]++;
+            const uint32_t c = b->child[s];
+            if (c == OCC_NONE) {
+                continue;
+            }
+            const unsigned l = lvl[sp];
+            if (c >= (l == 1u ? m->leaf.hwm : m->inner.hwm) ||
+                !check_block(m, c, l, b->value[s], b->flags[s])) {
+                return OCC_ERR_CORRUPT;
+            }
+            if (l == 1u) {
+                tally_add(&leaf, c);
+                if (leaf.count > m->leaf.hwm) {
+                    return OCC_ERR_CORRUPT; /* a cycle or shared blocks */
+                }
+            } else {
+                tally_add(&inner, c);
+                if (inner.count > m->inner.hwm || sp + 1u > OCC_MAX_DEPTH) {
+                    return OCC_ERR_CORRUPT;
+                }
+                sp++;
+                blk[sp] = c;
+                lvl[sp] = (uint8_t)(l - 1u);
+                next[sp] = 0u;
+            }
+        }
+    }
+    if (inner.count - m->inner.free_count != m->inner.used ||
+        leaf.count - m->leaf.free_count != m->leaf.used) {
+        return OCC_ERR_CORRUPT;
+    }
+    return tally_complete(&inner, m->inner.hwm) && tally_complete(&leaf, m->leaf.hwm)
+               ? OCC_OK
+               : OCC_ERR_CORRUPT;
+}

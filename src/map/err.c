@@ -1,0 +1,18 @@
+/* err.c - error code texts. */
+#include "occmap/occmap.h"
+
+const char *occ_err_str(const occ_err_t err)
+{
+    switch (err) {
+    case OCC_OK: return "ok";
+    case OCC_ERR_ARG: return "invalid argument";
+    case OCC_ERR_RANGE: return "outside the map volume";
+    case OCC_ERR_NOMEM: return "out of memory (pool or scratch)";
+    case OCC_ERR_FORMAT: return "malformed input";
+    case OCC_ERR_IO: return "i/o error";
+    case OCC_ERR_STATE: return "invalid state";
+    case OCC_ERR_UNSUPPORTED: return "unsupported";
+    case OCC_ERR_CORRUPT: return "map invariants broken";
+    default: return "unknown error";
+    }
+}

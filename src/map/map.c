@@ -1,0 +1,160 @@
+/* map.c - configuration, init/clear, and coordinate <-> key arithmetic. */
+#include "tree_internal.h"
+
+occ_map_config_t occ_map_config_default(void)
+{
+    occ_map_config_t c;
+    c.resolution_m = 0.1f;
+    c.depth_levels = 16u;
+    c.hit = 0.85f;        /* OctoMap's AbstractOccupancyOcTree defaults (log-odds) */
+    c.miss = -0.4f;
+    c.clamp_min = -2.0f;
+    c.clamp_max = 3.5f;
+    c.free_max = 0.0f;
+    c.occupied_min = 0.0f;
+    return c;
+}
+
+static bool finite_f(const float x)
+{
+    return x - x < 1.0f;  /* false for NaN and +-Inf */
+}
+
+/* Log-odds a fixed-point value can hold exactly enough (|x| < 31). */
+static bool in_value_range(const float x)
+{
+    return finite_f(x) && x > -31.0f && x < 31.0f;
+}
+
+occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, void *const arena,
+                       const size_t arena_bytes)
+{
+    if (map == NULL || cfg == NULL || (arena == NULL && arena_bytes != 0u)) {
+        return OCC_ERR_ARG;
+    }
+    if (!finite_f(cfg->resolution_m) || !(cfg->resolution_m > 0.0f) ||
+        cfg->depth_levels < 1u || cfg->depth_levels > OCC_MAX_DEPTH ||
+        !in_value_range(cfg->hit) || !(cfg->hit > 0.0f) || !in_value_range(cfg->miss) ||
+        !(cfg->miss < 0.0f) || !in_value_range(cfg->clamp_min) ||
+        !in_value_range(cfg->clamp_max) || !(cfg->clamp_min < cfg->clamp_max) ||
+        !in_value_range(cfg->free_max) || !in_value_range(cfg->occupied_min) ||
+        cfg->free_max > cfg->occupied_min) {
+        return OCC_ERR_ARG;
+    }
+    map->cfg = *cfg;
+    map->q_hit = occ_value_from_logodds(cfg->hit);
+    map->q_miss = occ_value_from_logodds(cfg->miss);
+    map->q_clamp_min = occ_value_from_logodds(cfg->clamp_min);
+    map->q_clamp_max = occ_value_from_logodds(cfg->clamp_max);
+    map->q_free_max = occ_value_from_logodds(cfg->free_max);
+    map->q_occ_min = occ_value_from_logodds(cfg->occupied_min);
+    map->inv_res = 1.0f / cfg->resolution_m;
+#if OCC_RAY_DOUBLE
+    map->inv_res_d = 1.0 / (double)cfg->resolution_m;
+#else
+    map->inv_res_d = 0;
+#endif
+    /* Align the start and the size to 8 so both block kinds stay aligned from either end. */
+    uintptr_t start = (uintptr_t)arena;
+    size_t bytes = arena_bytes;
+    const uintptr_t misalign = start % OCC_ARENA_ALIGN;
+    if (misalign != 0u) {
+        const size_t adj = OCC_ARENA_ALIGN - (size_t)misalign;
+        bytes = bytes > adj ? bytes - adj : 0u;
+        start += adj;
+    }
+    map->arena = (uint8_t *)start;
+    map->arena_bytes = bytes - bytes % OCC_ARENA_ALIGN;
+    map->block_budget = (uint32_t)(map->arena_bytes / OCC_LEAF_BLOCK_BYTES);
+    occ_map_clear(map);
+    return OCC_OK;
+}
+
+void occ_map_clear(occ_map_t *const map)
+{
+    if (map == NULL) {
+        return;
+    }
+    const occ_pool_t empty = {0u, 0u, 0u, OCC_NONE, 0u};
+    map->inner = empty;
+    map->leaf = empty;
+    map->oom_count = 0u;
+    map->root_child = OCC_NONE;
+    map->root_value = OCC_VALUE_UNOBSERVED;
+    map->root_flags = (uint8_t)OCC_NODE_HAS_UNKNOWN;
+}
+
+static bool finite_v(const occ_vec3_t p)
+{
+    return finite_f(p.x) && finite_f(p.y) && finite_f(p.z);
+}
+
+/* OctoMap's coordToKeyChecked: floor(coordinate / res) + 2^(D-1), in OctoMap's arithmetic. */
+static bool coord_to_key(const occ_map_t *const m, const float c, uint32_t *const key)
+{
+    const int32_t half = (int32_t)1 << (m->cfg.depth_levels - 1u);
+#if OCC_RAY_DOUBLE
+    const double scaled = (double)c * m->inv_res_d;
+    const double lo = -(double)half, hi = (double)half;
+    if (!(scaled >= lo) || !(scaled < hi)) {
+        return false;
+    }
+    double fl = (double)(int32_t)scaled;
+    if (fl > scaled) {
+        fl -= 1.0;
+    }
+#else
+    const float scaled = c * m->inv_res;
+    const float lo = -(float)half, hi = (float)half;
+    if (!(scaled >= lo) || !(scaled < hi)) {
+        return false;
+    }
+    float fl = (float)(int32_t)scaled;
+    if (fl > scaled) {
+        fl -= 1.0f;
+    }
+#endif
+    *key = (uint32_t)((int32_t)fl + half);
+    return true;
+}
+
+occ_err_t occ_map_key(const occ_map_t *const map, const occ_vec3_t p, occ_key_t *const key)
+{
+    if (map == NULL || key == NULL || !finite_v(p)) {
+        return OCC_ERR_ARG;
+    }
+    occ_key_t k;
+    if (!coord_to_key(map, p.x, &k.k[0]) || !coord_to_key(map, p.y, &k.k[1]) ||
+        !coord_to_key(map, p.z, &k.k[2])) {
+        return OCC_ERR_RANGE;
+    }
+    *key = k;
+    return OCC_OK;
+}
+
+occ_key_t occ_key_at_level(occ_key_t key, const unsigned level)
+{
+    const uint32_t mask = level >= 32u ? 0u : ~(((uint32_t)1 << level) - 1u);
+    for (unsigned i = 0; i < 3u; i++) {
+        key.k[i] &= mask;
+    }
+    return key;
+}
+
+float occ_map_node_size(const occ_map_t *const map, const unsigned level)
+{
+    return map->cfg.resolution_m * (float)((uint32_t)1 << level);
+}
+
+occ_vec3_t occ_map_key_center(const occ_map_t *const map, const occ_key_t key, const unsigned level)
+{
+    const occ_key_t base = occ_key_at_level(key, level);
+    const int32_t half = (int32_t)1 << (map->cfg.depth_levels - 1u);
+    const float res = map->cfg.resolution_m;
+    const float offset = 0.5f * occ_map_node_size(map, level);
+    occ_vec3_t c;
+    c.x = (float)((int32_t)base.k[0] - half) * res + offset;
+    c.y = (float)((int32_t)base.k[1] - half) * res + offset;
+    c.z = (float)((int32_t)base.k[2] - half) * res + offset;
+    return c;
+}

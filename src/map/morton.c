@@ -1,0 +1,60 @@
+/* morton.c - 3 x 21-bit key <-> 63-bit Morton code (x in bit 0, y in bit 1, z in bit 2). */
+#include "occmap/occmap.h"
+
+#if OCC_USE_BMI2
+#include <immintrin.h>
+
+static const uint64_t mask_x = 0x1249249249249249ull;
+
+occ_code_t occ_morton_encode(const occ_key_t key)
+{
+    return _pdep_u64(key.k[0], mask_x) | _pdep_u64(key.k[1], mask_x << 1) |
+           _pdep_u64(key.k[2], mask_x << 2);
+}
+
+occ_key_t occ_morton_decode(const occ_code_t code)
+{
+    occ_key_t key;
+    key.k[0] = (uint32_t)_pext_u64(code, mask_x);
+    key.k[1] = (uint32_t)_pext_u64(code, mask_x << 1);
+    key.k[2] = (uint32_t)_pext_u64(code, mask_x << 2);
+    return key;
+}
+#else
+/* Spread the low 21 bits of v to every third bit (magic-bits method). */
+static uint64_t spread3(const uint32_t v)
+{
+    uint64_t x = v & 0x1FFFFFu;
+    x = (x | (x << 32)) & 0x001F00000000FFFFull;
+    x = (x | (x << 16)) & 0x001F0000FF0000FFull;
+    x = (x | (x << 8)) & 0x100F00F00F00F00Full;
+    x = (x | (x << 4)) & 0x10C30C30C30C30C3ull;
+    x = (x | (x << 2)) & 0x1249249249249249ull;
+    return x;
+}
+
+static uint32_t compact3(const uint64_t code)
+{
+    uint64_t x = code & 0x1249249249249249ull;
+    x = (x | (x >> 2)) & 0x10C30C30C30C30C3ull;
+    x = (x | (x >> 4)) & 0x100F00F00F00F00Full;
+    x = (x | (x >> 8)) & 0x001F0000FF0000FFull;
+    x = (x | (x >> 16)) & 0x001F00000000FFFFull;
+    x = (x | (x >> 32)) & 0x1FFFFFull;
+    return (uint32_t)x;
+}
+
+occ_code_t occ_morton_encode(const occ_key_t key)
+{
+    return spread3(key.k[0]) | (spread3(key.k[1]) << 1) | (spread3(key.k[2]) << 2);
+}
+
+occ_key_t occ_morton_decode(const occ_code_t code)
+{
+    occ_key_t key;
+    key.k[0] = compact3(code);
+    key.k[1] = compact3(code >> 1);
+    key.k[2] = compact3(code >> 2);
+    return key;
+}
+#endif

@@ -1,0 +1,121 @@
+/*
+ * pool.c - the two block pools in one arena. Leaf blocks are carved upwards from the bottom,
+ * inner blocks downwards from the top, so the split between them follows the map's content
+ * instead of a guess made at init. Each pool has an intrusive free list. All O(1).
+ */
+#include <string.h>
+
+#include "tree_internal.h"
+
+#ifndef OCC_POOL_PARANOID
+#ifdef OCC_TESTING
+#define OCC_POOL_PARANOID 1
+#else
+#define OCC_POOL_PARANOID 0
+#endif
+#endif
+
+static size_t gap_bytes(const occ_map_t *const m)
+{
+    return m->arena_bytes - (size_t)m->inner.hwm * sizeof(occ_inner_block_t) -
+           (size_t)m->leaf.hwm * sizeof(occ_leaf_block_t);
+}
+
+static void note_alloc(occ_pool_t *const p)
+{
+    p->used++;
+    if (p->used > p->peak) {
+        p->peak = p->used;
+    }
+}
+
+bool occ_pool_can_supply(const occ_map_t *const m, const uint32_t n_inner, const uint32_t n_leaf)
+{
+    const uint64_t new_inner = n_inner > m->inner.free_count ? n_inner - m->inner.free_count : 0u;
+    const uint64_t new_leaf = n_leaf > m->leaf.free_count ? n_leaf - m->leaf.free_count : 0u;
+    const uint64_t need = new_inner * sizeof(occ_inner_block_t) + new_leaf * sizeof(occ_leaf_block_t);
+    return need <= (uint64_t)gap_bytes(m);
+}
+
+uint32_t occ_pool_alloc_inner(occ_map_t *const m)
+{
+    uint32_t idx = m->inner.free_head;
+    if (idx != OCC_NONE) {
+        m->inner.free_head = occ_inner_at(m, idx)->child[0];
+        m->inner.free_count--;
+    } else if (gap_bytes(m) >= sizeof(occ_inner_block_t)) {
+        idx = m->inner.hwm++;
+    } else {
+        return OCC_NONE;
+    }
+    occ_inner_at(m, idx)->flags[7] = 0u;
+    note_alloc(&m->inner);
+    return idx;
+}
+
+uint32_t occ_pool_alloc_leaf(occ_map_t *const m)
+{
+    uint32_t idx = m->leaf.free_head;
+    if (idx != OCC_NONE) {
+        memcpy(&m->leaf.free_head, occ_leaf_at(m, idx)->value, sizeof(uint32_t));
+        m->leaf.free_count--;
+    } else if (gap_bytes(m) >= sizeof(occ_leaf_block_t)) {
+        idx = m->leaf.hwm++;
+    } else {
+        return OCC_NONE;
+    }
+    note_alloc(&m->leaf);
+    return idx;
+}
+
+bool occ_pool_free_inner(occ_map_t *const m, const uint32_t idx)
+{
+    if (idx >= m->inner.hwm || m->inner.used == 0u) {
+        return false;
+    }
+    occ_inner_block_t *const b = occ_inner_at(m, idx);
+    if (b->flags[7] == OCC_INNER_FREE_MARK) {
+        return false;  /* already free */
+    }
+    b->flags[7] = OCC_INNER_FREE_MARK;
+    b->child[0] = m->inner.free_head;
+    m->inner.free_head = idx;
+    m->inner.free_count++;
+    m->inner.used--;
+    return true;
+}
+
+bool occ_pool_free_leaf(occ_map_t *const m, const uint32_t idx)
+{
+    if (idx >= m->leaf.hwm || m->leaf.used == 0u) {
+        return false;
+    }
+#if OCC_POOL_PARANOID
+    uint32_t it = m->leaf.free_head;
+    for (uint32_t n = 0; it != OCC_NONE && n <= m->leaf.free_count; n++) {
+        if (it == idx) {
+            return false;  /* already free */
+        }
+        memcpy(&it, occ_leaf_at(m, it)->value, sizeof it);
+    }
+#endif
+    memcpy(occ_leaf_at(m, idx)->value, &m->leaf.free_head, sizeof(uint32_t));
+    m->leaf.free_head = idx;
+    m->leaf.free_count++;
+    m->leaf.used--;
+    return true;
+}
+
+uint32_t occ_arena_blocks_for_bytes(const size_t arena_bytes, const uint32_t n_inner)
+{
+    if (arena_bytes < OCC_ARENA_ALIGN) {
+        return 0u;
+    }
+    const size_t usable = arena_bytes - OCC_ARENA_ALIGN;
+    const size_t inner_bytes = (size_t)n_inner * sizeof(occ_inner_block_t);
+    if (inner_bytes > usable) {
+        return 0u;
+    }
+    const size_t n = (usable - inner_bytes) / sizeof(occ_leaf_block_t);
+    return n > (size_t)(OCC_NONE - 1u) ? OCC_NONE - 1u : (uint32_t)n;
+}

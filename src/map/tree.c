@@ -1,0 +1,524 @@
+/*
+ * tree.c - reading and writing the octree: descent, expansion, refresh/prune, batch updates.
+ *
+ * Writes are all-or-nothing: each write first counts the blocks it will allocate (with no frees
+ * assumed) and refuses with OCC_ERR_NOMEM before touching anything when the pools cannot supply
+ * them. Pruning only ever frees, so the count is an upper bound.
+ */
+#include "tree_internal.h"
+
+/* ---- node helpers --------------------------------------------------------------------------- */
+
+static bool key_in_range(const occ_map_t *const m, const occ_key_t key)
+{
+    const uint32_t limit = (uint32_t)1 << m->cfg.depth_levels;
+    return key.k[0] < limit && key.k[1] < limit && key.k[2] < limit;
+}
+
+static occ_value_t max_of8(const occ_value_t *const v)
+{
+    occ_value_t mx = v[0];
+    for (unsigned i = 1; i < 8u; i++) {
+        if (v[i] > mx) {
+            mx = v[i];
+        }
+    }
+    return mx;
+}
+
+void occ_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
+{
+    OCC_ASSERT(level >= 1u && *node.child == OCC_NONE);
+    const occ_value_t v = *node.value;
+    if (level == 1u) {
+        const uint32_t idx = occ_pool_alloc_leaf(m);
+        OCC_ASSERT(idx != OCC_NONE);
+        occ_leaf_block_t *const b = occ_leaf_at(m, idx);
+        for (unsigned i = 0; i < 8u; i++) {
+            b->value[i] = v;
+        }
+        *node.child = idx;
+    } else {
+        const uint32_t idx = occ_pool_alloc_inner(m);
+        OCC_ASSERT(idx != OCC_NONE);
+        occ_inner_block_t *const b = occ_inner_at(m, idx);
+        const uint8_t f = occ_value_flags(m, v);
+        for (unsigned i = 0; i < 8u; i++) {
+            b->child[i] = OCC_NONE;
+            b->value[i] = v;
+            b->flags[i] = f;
+        }
+        *node.child = idx;
+    }
+}
+
+bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
+{
+    const uint32_t child = *node.child;
+    if (child == OCC_NONE) {
+        return false;
+    }
+    occ_value_t nv;
+    uint8_t nf = 0u;
+    bool prunable;
+    if (level == 1u) {
+        const occ_leaf_block_t *const b = occ_leaf_at(m, child);
+        nv = max_of8(b->value);
+        prunable = true;
+        for (unsigned i = 0; i < 8u; i++) {
+            nf = (uint8_t)(nf | occ_value_flags(m, b->value[i]));
+            prunable = prunable && occ_value_eq(b->value[i], b->value[0]);
+        }
+        if (prunable) {
+            (void)occ_pool_free_leaf(m, child);
+        }
+    } else {
+        const occ_inner_block_t *const b = occ_inner_at(m, child);
+        nv = max_of8(b->value);
+        prunable = true;
+        for (unsigned i = 0; i < 8u; i++) {
+            nf = (uint8_t)(nf | b->flags[i]);
+            prunable = prunable && b->child[i] == OCC_NONE && occ_value_eq(b->value[i], b->value[0]);
+        }
+        if (prunable) {
+            (void)occ_pool_free_inner(m, child);
+        }
+    }
+    if (prunable) {
+        *node.child = OCC_NONE;
+    }
+    const bool changed = prunable || !occ_value_eq(nv, *node.value) || nf != *node.flags;
+    *node.value = nv;
+    *node.flags = nf;
+    return changed;
+}
+
+void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
+{
+    if (*node.child == OCC_NONE) {
+        return;
+    }
+    if (level == 1u) {
+        (void)occ_pool_free_leaf(m, *node.child);
+        *node.child = OCC_NONE;
+        return;
+    }
+    /* Iterative post-order over inner blocks; frame i holds the block whose children sit at
+     * level lvl[i] - 1 and the next slot to visit. */
+    uint32_t blk[OCC_MAX_DEPTH + 1];
+    uint8_t lvl[OCC_MAX_DEPTH + 1];
+    uint8_t next[OCC_MAX_DEPTH + 1];
+    unsigned sp = 0;
+    blk[0] = *node.child;
+    lvl[0] = (uint8_t)(level - 1u); /* level of the nodes inside blk[0] */
+    next[0] = 0u;
+    *node.child = OCC_NONE;
+    for (;;) {
+        occ_inner_block_t *const b = occ_inner_at(m, blk[sp]);
+        if (next[sp] < 8u) {
+            const unsigned slot = next[sp]++;
+            const uint32_t c = b->child[slot];
+            if (c == OCC_NONE) {
+                continue;
+            }
+            if (lvl[sp] == 1u) {
+                (void)occ_pool_free_leaf(m, c);
+            } else {
+                sp++;
+                blk[sp] = c;
+                lvl[sp] = (uint8_t)(lvl[sp - 1u] - 1u);
+                next[sp] = 0u;
+            }
+            continue;
+        }
+        (void)occ_pool_free_inner(m, blk[sp]);
+        if (sp == 0u) {
+            break;
+        }
+        sp--;
+    }
+}
+
+/* ---- reading ---------------------------------------------------------------------------------- */
+
+occ_err_t occ_map_read_key(const occ_map_t *const map, const occ_key_t key, const unsigned level,
+                           occ_node_info_t *const out)
+{
+    if (map == NULL || out == NULL || level > map->cfg.depth_levels) {
+        return OCC_ERR_ARG;
+    }
+    if (!key_in_range(map, key)) {
+        return OCC_ERR_RANGE;
+    }
+    const occ_code_t code = occ_morton_encode(key);
+    unsigned l = map->cfg.depth_levels;
+    uint32_t child = map->root_child;
+    occ_value_t v = map->root_value;
+    uint8_t f = map->root_flags;
+    while (l > level && child != OCC_NONE) {
+        const unsigned slot = occ_code_slot(code, l);
+        l--;
+        if (l == 0u) {
+            v = occ_leaf_at(map, child)->value[slot];
+            f = occ_value_flags(map, v);
+            child = OCC_NONE;
+        } else {
+            const occ_inner_block_t *const b = occ_inner_at(map, child);
+            v = b->value[slot];
+            f = b->flags[slot];
+            child = b->child[slot];
+        }
+    }
+    out->observed = occ_is_observed(v);
+    out->logodds = occ_value_to_logodds(v);
+    out->state = occ_value_state(map, v);
+    out->flags = (uint8_t)(f | (child == OCC_NONE ? OCC_NODE_UNIFORM : 0u));
+    out->level = (uint8_t)l;
+    return OCC_OK;
+}
+
+occ_err_t occ_map_read(const occ_map_t *const map, const occ_vec3_t p, const unsigned level,
+                       occ_node_info_t *const out)
+{
+    occ_key_t key;
+    const occ_err_t e = occ_map_key(map, p, &key);
+    return e != OCC_OK ? e : occ_map_read_key(map, key, level, out);
+}
+
+occ_state_t occ_map_state_at(const occ_map_t *const map, const occ_vec3_t p)
+{
+    occ_node_info_t info;
+    return occ_map_read(map, p, 0u, &info) == OCC_OK ? info.state : OCC_STATE_UNKNOWN;
+}
+
+/* ---- batch updates ---------------------------------------------------------------------------- */
+
+/* The path of the current code: node[l] for l in [low, D]; node[D] is the root. */
+typedef struct {
+    occ_nodep_t node[OCC_MAX_DEPTH + 1];
+    bool dirty[OCC_MAX_DEPTH + 2];
+    unsigned low;
+} path_t;
+
+/* Lowest level whose node contains both codes. */
+static unsigned split_level(const occ_code_t a, const occ_code_t b)
+{
+    occ_code_t x = (a ^ b) & ~OCC_CODE_HIT_BIT;
+    if (x == 0u) {
+        return 1u;
+    }
+#if defined(__GNUC__)
+    const unsigned h = 63u - (unsigned)__builtin_clzll((unsigned long long)x);
+#else
+    unsigned h = 0;
+    while (x > 1u) {
+        x >>= 1;
+        h++;
+    }
+#endif
+    return h / 3u + 1u;
+}
+
+/* Descend from node[start] along `code` while nodes have inner children; stops at level 1 or at
+ * a uniform node. Returns the voxel's value and sets *stop: 0 when it lies in a leaf block,
+ * else the level of the uniform node holding it. */
+static occ_value_t descend(const occ_map_t *const m, path_t *const p, const occ_code_t code,
+                           unsigned start, unsigned *const stop)
+{
+    unsigned l = start;
+    while (l > 1u && *p->node[l].child != OCC_NONE) {
+        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
+        l--;
+    }
+    p->low = l;
+    if (*p->node[l].child != OCC_NONE) { /* l == 1 with a leaf block */
+        *stop = 0u;
+        return occ_leaf_at(m, *p->node[1].child)->value[occ_code_slot(code, 1u)];
+    }
+    *stop = l;
+    return *p->node[l].value;
+}
+
+/* Refresh dirty nodes from p->low up to level `top` (inclusive), marking parents dirty. */
+static void refresh_up_to(occ_map_t *const m, path_t *const p, const unsigned top)
+{
+    for (unsigned l = p->low; l <= top; l++) {
+        if (p->dirty[l]) {
+            p->dirty[l] = false;
+            if (occ_tree_refresh(m, p->node[l], l)) {
+                p->dirty[l + 1u] = true;
+            }
+        }
+    }
+}
+
+typedef enum { DELTA_TAGGED, DELTA_FIXED } delta_mode_t;
+
+static occ_value_t delta_of(const occ_map_t *const m, const occ_code_t code, const delta_mode_t mode,
+                            const occ_value_t fixed)
+{
+    if (mode == DELTA_FIXED) {
+        return fixed;
+    }
+    return (code & OCC_CODE_HIT_BIT) != 0u ? m->q_hit : m->q_miss;
+}
+
+static bool codes_valid(const occ_map_t *const m, const occ_code_t *const codes, const size_t n)
+{
+    const occ_code_t limit = (occ_code_t)1 << (3u * m->cfg.depth_levels);
+    for (size_t i = 0; i < n; i++) {
+        const occ_code_t c = codes[i] & ~OCC_CODE_HIT_BIT;
+        if (c >= limit || (i > 0u && c <= (codes[i - 1u] & ~OCC_CODE_HIT_BIT))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* Read-only pass: blocks the batch will allocate if nothing is freed on the way. */
+static void count_blocks(occ_map_t *const m, const occ_code_t *const codes, const size_t n,
+                         const delta_mode_t mode, const occ_value_t fixed, uint64_t *const n_inner,
+                         uint64_t *const n_leaf)
+{
+    path_t p;
+    const unsigned depth = m->cfg.depth_levels;
+    p.node[depth] = occ_root(m);
+    occ_code_t prev = 0, last_changing = 0;
+    bool have_changing = false;
+    *n_inner = 0u;
+    *n_leaf = 0u;
+    for (size_t i = 0; i < n; i++) {
+        const occ_code_t c = codes[i] & ~OCC_CODE_HIT_BIT;
+        unsigned start = depth;
+        if (i > 0u) {
+            const unsigned s = split_level(c, prev);
+            start = s > p.low ? s : p.low;
+        }
+        unsigned stop;
+        const occ_value_t v = descend(m, &p, c, start, &stop);
+        prev = c;
+        const occ_value_t nv = occ_value_apply_delta(m, v, delta_of(m, codes[i], mode, fixed));
+        if (occ_value_eq(nv, v) || stop == 0u) {
+            if (!occ_value_eq(nv, v)) {
+                have_changing = true;
+                last_changing = c;
+            }
+            continue;
+        }
+        /* The uniform node at `stop` needs blocks at levels stop..1, except where an earlier
+         * changing code in this batch expanded the same nodes already. */
+        unsigned fresh = stop;
+        if (have_changing) {
+            const unsigned s = split_level(c, last_changing);
+            if (s - 1u < fresh) {
+                fresh = s - 1u;
+            }
+        }
+        if (fresh > 0u) {
+            *n_leaf += 1u;
+            *n_inner += fresh - 1u;
+        }
+        have_changing = true;
+        last_changing = c;
+    }
+}
+
+static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, const size_t n,
+                             const delta_mode_t mode, const occ_value_t fixed,
+                             size_t *const n_changed)
+{
+    if (n_changed != NULL) {
+        *n_changed = 0u;
+    }
+    if (n == 0u) {
+        return OCC_OK;
+    }
+    uint64_t need_inner, need_leaf;
+    count_blocks(m, codes, n, mode, fixed, &need_inner, &need_leaf);
+    if (need_inner > OCC_NONE || need_leaf > OCC_NONE ||
+        !occ_pool_can_supply(m, (uint32_t)need_inner, (uint32_t)need_leaf)) {
+        m->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    path_t p;
+    const unsigned depth = m->cfg.depth_levels;
+    for (unsigned l = 0; l <= depth + 1u; l++) {
+        p.dirty[l] = false;
+    }
+    p.node[depth] = occ_root(m);
+    p.low = depth;
+    occ_code_t prev = 0;
+    size_t changed = 0;
+    for (size_t i = 0; i < n; i++) {
+        const occ_code_t c = codes[i] & ~OCC_CODE_HIT_BIT;
+        unsigned start = depth;
+        if (i > 0u) {
+            /* Nodes below the split are finished: no later code enters them (sorted order),
+             * so they can be refreshed and pruned now without ever being re-expanded. */
+            const unsigned s = split_level(c, prev);
+            if (s > p.low) {
+                refresh_up_to(m, &p, s - 1u);
+                start = s;
+            } else {
+                start = p.low;
+            }
+        }
+        prev = c;
+        unsigned stop;
+        const occ_value_t v = descend(m, &p, c, start, &stop);
+        const occ_value_t nv = occ_value_apply_delta(m, v, delta_of(m, codes[i], mode, fixed));
+        if (occ_value_eq(nv, v)) {
+            continue;
+        }
+        for (unsigned l = stop; l >= 1u; l--) {
+            occ_tree_expand(m, p.node[l], l);
+            if (l > 1u) {
+                p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(c, l));
+            }
+        }
+        p.low = 1u;
+        occ_leaf_at(m, *p.node[1].child)->value[occ_code_slot(c, 1u)] = nv;
+        p.dirty[1] = true;
+        changed++;
+    }
+    refresh_up_to(m, &p, depth);
+    if (n_changed != NULL) {
+        *n_changed = changed;
+    }
+    return OCC_OK;
+}
+
+occ_err_t occ_map_observe_codes(occ_map_t *const map, const occ_code_t *const codes, const size_t n,
+                                size_t *const n_changed)
+{
+    if (n_changed != NULL) {
+        *n_changed = 0u;
+    }
+    if (map == NULL || (codes == NULL && n != 0u)) {
+        return OCC_ERR_ARG;
+    }
+    if (!codes_valid(map, codes, n)) {
+        return OCC_ERR_ARG;
+    }
+    return apply_batch(map, codes, n, DELTA_TAGGED, 0, n_changed);
+}
+
+static bool finite_f(const float x)
+{
+    return x - x < 1.0f;
+}
+
+occ_err_t occ_map_update_key(occ_map_t *const map, const occ_key_t key, const float delta_logodds)
+{
+    if (map == NULL || !finite_f(delta_logodds)) {
+        return OCC_ERR_ARG;
+    }
+    if (!key_in_range(map, key)) {
+        return OCC_ERR_RANGE;
+    }
+    const occ_code_t code = occ_morton_encode(key);
+    return apply_batch(map, &code, 1u, DELTA_FIXED, occ_value_from_logodds(delta_logodds), NULL);
+}
+
+occ_err_t occ_map_update(occ_map_t *const map, const occ_vec3_t p, const float delta_logodds)
+{
+    occ_key_t key;
+    const occ_err_t e = occ_map_key(map, p, &key);
+    return e != OCC_OK ? e : occ_map_update_key(map, key, delta_logodds);
+}
+
+occ_err_t occ_map_observe_key(occ_map_t *const map, const occ_key_t key, const bool occupied)
+{
+    if (map == NULL) {
+        return OCC_ERR_ARG;
+    }
+    if (!key_in_range(map, key)) {
+        return OCC_ERR_RANGE;
+    }
+    const occ_code_t code = occ_morton_encode(key) | (occupied ? OCC_CODE_HIT_BIT : 0u);
+    return apply_batch(map, &code, 1u, DELTA_TAGGED, 0, NULL);
+}
+
+/* ---- setting whole nodes ---------------------------------------------------------------------- */
+
+static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned level,
+                         const occ_value_t v)
+{
+    if (level > m->cfg.depth_levels) {
+        return OCC_ERR_ARG;
+    }
+    if (!key_in_range(m, key)) {
+        return OCC_ERR_RANGE;
+    }
+    const unsigned depth = m->cfg.depth_levels;
+    const occ_code_t code = occ_morton_encode(key);
+    path_t p;
+    p.node[depth] = occ_root(m);
+    /* Descend to the target level or to a uniform node above it. */
+    unsigned l = depth;
+    while (l > level && l > 1u && *p.node[l].child != OCC_NONE) {
+        p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(code, l));
+        l--;
+    }
+    occ_leaf_block_t *leaf = NULL;
+    if (level == 0u && l == 1u && *p.node[1].child != OCC_NONE) {
+        leaf = occ_leaf_at(m, *p.node[1].child);
+        if (occ_value_eq(leaf->value[occ_code_slot(code, 1u)], v)) {
+            return OCC_OK;
+        }
+    } else if (*p.node[l].child == OCC_NONE && occ_value_eq(*p.node[l].value, v)) {
+        return OCC_OK; /* the uniform node already holds v everywhere */
+    }
+    if (leaf == NULL && l > level) {
+        /* Expand the uniform node at l down to the target level: blocks for levels l..level+1. */
+        const unsigned n_blocks = l - level;
+        const uint32_t n_leaf = level == 0u ? 1u : 0u;
+        if (!occ_pool_can_supply(m, n_blocks - n_leaf, n_leaf)) {
+            m->oom_count++;
+            return OCC_ERR_NOMEM;
+        }
+        while (l > level) {
+            occ_tree_expand(m, p.node[l], l);
+            if (l - 1u >= 1u) {
+                p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(code, l));
+            }
+            l--;
+        }
+        if (level == 0u) {
+            leaf = occ_leaf_at(m, *p.node[1].child);
+        }
+    }
+    unsigned first_dirty;
+    if (level == 0u) {
+        leaf->value[occ_code_slot(code, 1u)] = v;
+        first_dirty = 1u;
+    } else {
+        occ_tree_release_children(m, p.node[level], level);
+        *p.node[level].value = v;
+        *p.node[level].flags = occ_value_flags(m, v);
+        first_dirty = level + 1u;
+    }
+    for (unsigned k = first_dirty; k <= depth; k++) {
+        if (!occ_tree_refresh(m, p.node[k], k)) {
+            break;
+        }
+    }
+    return OCC_OK;
+}
+
+occ_err_t occ_map_set_key(occ_map_t *const map, const occ_key_t key, const unsigned level,
+                          const float logodds)
+{
+    if (map == NULL || !finite_f(logodds)) {
+        return OCC_ERR_ARG;
+    }
+    return set_raw(map, key, level, occ_value_from_logodds(logodds));
+}
+
+occ_err_t occ_map_forget_key(occ_map_t *const map, const occ_key_t key, const unsigned level)
+{
+    if (map == NULL) {
+        return OCC_ERR_ARG;
+    }
+    return set_raw(map, key, level, OCC_VALUE_UNOBSERVED);
+}

@@ -1,0 +1,120 @@
+/*
+ * tree_internal.h - the octree's storage, shared by the modules in src/map/ only
+ * (integrate, query, io, evict). Feeds and tools use the public header.
+ *
+ * A node at level >= 1 lives in an inner block (8 siblings: child block index, value, indicator
+ * flags) or is the root (fields of occ_map_t). A node at level 0 (a voxel) lives in a leaf block
+ * (8 sibling values). A level-1 node's child index names a leaf block, a deeper node's an inner
+ * block; OCC_NONE means no children: the node is uniform (all voxels below share its value).
+ * Invariants (occ_map_check): value = max of children; flags = OR of children's flags (a uniform
+ * node's flags follow from its value); no child block whose 8 entries are uniform and equal.
+ */
+#ifndef OCC_TREE_INTERNAL_H_INCLUDED
+#define OCC_TREE_INTERNAL_H_INCLUDED
+
+#include "occmap/occmap.h"
+
+typedef struct {
+    uint32_t child[8];
+    occ_value_t value[8];
+    uint8_t flags[8];
+} occ_inner_block_t;
+
+typedef struct {
+    occ_value_t value[8];
+} occ_leaf_block_t;
+
+/* The unobserved value: below every value a voxel can hold. */
+#if OCC_VALUE_FLOAT
+#define OCC_VALUE_UNOBSERVED (-3.0e38f)
+#define OCC_VALUE_MIN (-1.0e30f)
+#define OCC_VALUE_MAX (1.0e30f)
+#else
+#define OCC_VALUE_UNOBSERVED INT16_MIN
+#define OCC_VALUE_MIN (INT16_MIN + 1)
+#define OCC_VALUE_MAX INT16_MAX
+#endif
+
+/* Pointers to one node's fields, wherever it lives. */
+typedef struct {
+    uint32_t *child;
+    occ_value_t *value;
+    uint8_t *flags;
+} occ_nodep_t;
+
+static inline occ_inner_block_t *occ_inner_at(const occ_map_t *m, uint32_t idx)
+{
+    return (occ_inner_block_t *)(void *)(m->arena + m->arena_bytes -
+                                         ((size_t)idx + 1u) * sizeof(occ_inner_block_t));
+}
+
+static inline occ_leaf_block_t *occ_leaf_at(const occ_map_t *m, uint32_t idx)
+{
+    return (occ_leaf_block_t *)(void *)(m->arena + (size_t)idx * sizeof(occ_leaf_block_t));
+}
+
+static inline occ_nodep_t occ_root(occ_map_t *m)
+{
+    occ_nodep_t n;
+    n.child = &m->root_child;
+    n.value = &m->root_value;
+    n.flags = &m->root_flags;
+    return n;
+}
+
+static inline occ_nodep_t occ_inner_node(const occ_map_t *m, uint32_t block, unsigned slot)
+{
+    occ_inner_block_t *const b = occ_inner_at(m, block);
+    occ_nodep_t n;
+    n.child = &b->child[slot];
+    n.value = &b->value[slot];
+    n.flags = &b->flags[slot];
+    return n;
+}
+
+static inline bool occ_is_observed(occ_value_t v)
+{
+    return v > OCC_VALUE_UNOBSERVED;
+}
+
+/* Child slot (0..7) of voxel `code` inside its ancestor at `level` (>= 1). */
+static inline unsigned occ_code_slot(occ_code_t code, unsigned level)
+{
+    return (unsigned)((code >> (3u * (level - 1u))) & 7u);
+}
+
+/* State and indicator flags of a single (uniform) value. */
+occ_state_t occ_value_state(const occ_map_t *m, occ_value_t v);
+uint8_t occ_value_flags(const occ_map_t *m, occ_value_t v);
+/* OctoMap's update of one voxel value: an unobserved voxel starts at 0; a value at a clamp
+ * bound is kept when the delta pushes outward; the result is clamped to [clamp_min, clamp_max]. */
+occ_value_t occ_value_apply_delta(const occ_map_t *m, occ_value_t v, occ_value_t delta);
+/* Equality of raw values (also for the float build, where -Wfloat-equal forbids ==). */
+static inline bool occ_value_eq(occ_value_t a, occ_value_t b)
+{
+    return !(a < b) && !(b < a);
+}
+
+/* Pools (pool.c). Alloc returns OCC_NONE when empty (and does not count an OOM: the caller
+ * checked capacity first with occ_pool_can_supply). Free returns false and changes nothing for
+ * an index never handed out (>= hwm) or a block already free (inner: O(1) marker; leaf: a walk
+ * of the free list when OCC_POOL_PARANOID, which defaults to OCC_TESTING). */
+uint32_t occ_pool_alloc_inner(occ_map_t *m);
+uint32_t occ_pool_alloc_leaf(occ_map_t *m);
+bool occ_pool_free_inner(occ_map_t *m, uint32_t idx);
+bool occ_pool_free_leaf(occ_map_t *m, uint32_t idx);
+/* Marker in flags[7] of an inner block on the free list (used blocks only use bits 0..2). */
+#define OCC_INNER_FREE_MARK 0xA5u
+/* True when n_inner inner and n_leaf leaf blocks can be allocated now. */
+bool occ_pool_can_supply(const occ_map_t *m, uint32_t n_inner, uint32_t n_leaf);
+/* Release a node's whole subtree to the pools (iterative). The node's child becomes OCC_NONE. */
+void occ_tree_release_children(occ_map_t *m, occ_nodep_t node, unsigned level);
+
+/* Give a uniform node at `level` >= 1 a child block filled with its value (OctoMap's
+ * expandNode). The caller made sure the pool can supply one block. */
+void occ_tree_expand(occ_map_t *m, occ_nodep_t node, unsigned level);
+/* Recompute a node's value and flags from its child block and prune the block when its
+ * 8 entries are uniform and equal. Returns true when the node's value or flags changed. */
+bool occ_tree_refresh(occ_map_t *m, occ_nodep_t node, unsigned level);
+
+#endif /* OCC_TREE_INTERNAL_H_INCLUDED */

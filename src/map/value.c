@@ -1,0 +1,91 @@
+/* value.c - log-odds <-> node values, states, and OctoMap's clamped update rule. */
+#include "tree_internal.h"
+
+#if OCC_VALUE_FLOAT
+float occ_value_to_logodds(const occ_value_t v)
+{
+    return occ_is_observed(v) ? v : 0.0f;
+}
+
+occ_value_t occ_value_from_logodds(const float logodds)
+{
+    if (!(logodds > OCC_VALUE_MIN)) {  /* also NaN */
+        return OCC_VALUE_MIN;
+    }
+    return logodds < OCC_VALUE_MAX ? logodds : OCC_VALUE_MAX;
+}
+#else
+float occ_value_to_logodds(const occ_value_t v)
+{
+    return occ_is_observed(v) ? (float)v / (float)OCC_FIXED_ONE : 0.0f;
+}
+
+/* Round to nearest and saturate to the observed range (never yields the unobserved value). */
+occ_value_t occ_value_from_logodds(const float logodds)
+{
+    const float scaled = logodds * (float)OCC_FIXED_ONE;
+    if (!(scaled > (float)OCC_VALUE_MIN)) {  /* also NaN */
+        return (occ_value_t)OCC_VALUE_MIN;
+    }
+    if (scaled >= (float)OCC_VALUE_MAX) {
+        return (occ_value_t)OCC_VALUE_MAX;
+    }
+    const float r = scaled >= 0.0f ? scaled + 0.5f : scaled - 0.5f;
+    return (occ_value_t)(int32_t)r;
+}
+#endif
+
+bool occ_value_observed(const occ_value_t v)
+{
+    return occ_is_observed(v);
+}
+
+occ_state_t occ_value_state(const occ_map_t *const m, const occ_value_t v)
+{
+    if (!occ_is_observed(v)) {
+        return OCC_STATE_UNKNOWN;
+    }
+    if (v >= m->q_occ_min) {
+        return OCC_STATE_OCCUPIED;
+    }
+    return v < m->q_free_max ? OCC_STATE_FREE : OCC_STATE_UNKNOWN;
+}
+
+uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_t v)
+{
+    switch (occ_value_state(m, v)) {
+    case OCC_STATE_OCCUPIED: return (uint8_t)OCC_NODE_HAS_OCCUPIED;
+    case OCC_STATE_FREE: return (uint8_t)OCC_NODE_HAS_FREE;
+    case OCC_STATE_UNKNOWN: return (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    default: return (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    }
+}
+
+occ_value_t occ_value_apply_delta(const occ_map_t *const m, const occ_value_t v,
+                                  const occ_value_t delta)
+{
+    const bool observed = occ_is_observed(v);
+    /* OctoMap's updateNode returns early when the voxel sits at a clamp bound already. */
+    if (observed && ((delta >= 0 && v >= m->q_clamp_max) || (delta <= 0 && v <= m->q_clamp_min))) {
+        return v;
+    }
+#if OCC_VALUE_FLOAT
+    float nv = (observed ? v : 0.0f) + delta;
+#else
+    int32_t nv = (int32_t)(observed ? v : 0) + (int32_t)delta;
+#endif
+    if (nv < m->q_clamp_min) {
+        nv = m->q_clamp_min;
+    } else if (nv > m->q_clamp_max) {
+        nv = m->q_clamp_max;
+    }
+    return (occ_value_t)nv;
+}
+
+occ_state_t occ_map_state_of(const occ_map_t *const map, const float logodds)
+{
+    if (map == NULL) {
+        return OCC_STATE_UNKNOWN;
+    }
+    return occ_value_state(map, occ_value_from_logodds(logodds));
+}

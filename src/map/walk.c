@@ -1,0 +1,95 @@
+/* walk.c - depth-first walk over observed nodes in Morton preorder, with a fixed stack. */
+#include "tree_internal.h"
+
+void occ_walk_begin(occ_walk_t *const w, const occ_map_t *const map)
+{
+    w->map = map;
+    w->sp = 0u;
+    w->started = false;
+    w->pushed = false;
+}
+
+static occ_key_t child_key(occ_key_t base, const unsigned slot, const unsigned level)
+{
+    base.k[0] |= (uint32_t)(slot & 1u) << level;
+    base.k[1] |= (uint32_t)((slot >> 1) & 1u) << level;
+    base.k[2] |= (uint32_t)((slot >> 2) & 1u) << level;
+    return base;
+}
+
+static void push(occ_walk_t *const w, const uint32_t block, const unsigned level, const occ_key_t base)
+{
+    w->stack[w->sp].block = block;
+    w->stack[w->sp].level = (uint8_t)level;
+    w->stack[w->sp].next = 0u;
+    w->stack[w->sp].base = base;
+    w->sp++;
+    w->pushed = true;
+}
+
+bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
+{
+    const occ_map_t *const m = w->map;
+    w->pushed = false;
+    if (!w->started) {
+        w->started = true;
+        if (!occ_is_observed(m->root_value)) {
+            return false;
+        }
+        const occ_key_t zero = {{0u, 0u, 0u}};
+        node->key = zero;
+        node->level = m->cfg.depth_levels;
+        node->has_children = m->root_child != OCC_NONE;
+        node->value = m->root_value;
+        node->observed = true;
+        node->flags = (uint8_t)(m->root_flags | (node->has_children ? 0u : OCC_NODE_UNIFORM));
+        if (node->has_children) {
+            push(w, m->root_child, (unsigned)m->cfg.depth_levels - 1u, zero);
+        }
+        return true;
+    }
+    while (w->sp > 0u) {
+        const unsigned top = w->sp - 1u;
+        if (w->stack[top].next >= 8u) {
+            w->sp--;
+            continue;
+        }
+        const unsigned slot = w->stack[top].next++;
+        const unsigned level = w->stack[top].level;
+        const occ_key_t key = child_key(w->stack[top].base, slot, level);
+        occ_value_t v;
+        uint32_t child = OCC_NONE;
+        uint8_t flags;
+        if (level == 0u) {
+            v = occ_leaf_at(m, w->stack[top].block)->value[slot];
+            flags = occ_value_flags(m, v);
+        } else {
+            const occ_inner_block_t *const b = occ_inner_at(m, w->stack[top].block);
+            v = b->value[slot];
+            flags = b->flags[slot];
+            child = b->child[slot];
+        }
+        if (!occ_is_observed(v)) {
+            continue; /* nothing observed below */
+        }
+        node->key = key;
+        node->level = (uint8_t)level;
+        node->has_children = child != OCC_NONE;
+        node->value = v;
+        node->observed = true;
+        node->flags = (uint8_t)(flags | (child == OCC_NONE ? OCC_NODE_UNIFORM : 0u));
+        if (child != OCC_NONE) {
+            push(w, child, level - 1u, key);
+        }
+        return true;
+    }
+    return false;
+}
+
+void occ_walk_skip_children(occ_walk_t *const w)
+{
+    if (w->pushed) {
+        w->sp--;
+        w->pushed = false;
+    }
+}

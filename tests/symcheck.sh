@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# The core must not call the heap, stdio or process exit: nm -u of every core object.
+set -u
+bad='^(malloc|calloc|realloc|free|printf|fprintf|sprintf|puts|putchar|abort|exit|_exit|fopen)$'
+status=0; n=0
+for dir in "$@"; do
+  for o in $(find "$dir" -name '*.o' | sort); do
+    n=$((n + 1))
+    hits=$(nm -u "$o" 2>/dev/null | awk '{print $NF}' | grep -E "$bad")
+    if [ -n "$hits" ]; then echo "symcheck: $o uses: $hits"; status=1; fi
+  done
+done
+[ $n -gt 0 ] || { echo "symcheck: no objects found in $*"; exit 1; }
+[ $status -eq 0 ] && echo "symcheck: $n core objects, none uses malloc/calloc/realloc/free/printf/puts/abort/exit"
+exit $status

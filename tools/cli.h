@@ -1,0 +1,33 @@
+/* cli.h - what the occmap subcommands share: the command table, argument helpers, JSON output. */
+#ifndef OCC_TOOLS_CLI_H_INCLUDED
+#define OCC_TOOLS_CLI_H_INCLUDED
+
+#include <stdio.h>
+#include "occmap/occmap.h"
+
+/* One subcommand: returns the process exit status (0 ok, 1 runtime error, 2 usage error). */
+typedef int (*cli_cmd_fn)(int argc, char **argv);
+
+int cmd_stats(int argc, char **argv);     /* cmd_stats.c    foundation */
+int cmd_build(int argc, char **argv);     /* cmd_build.c    integration */
+int cmd_query(int argc, char **argv);     /* cmd_query.c    queries */
+int cmd_info(int argc, char **argv);      /* cmd_info.c     files */
+int cmd_convert(int argc, char **argv);   /* cmd_convert.c  files */
+int cmd_feed(int argc, char **argv);      /* cmd_feed.c     MAVLink */
+int cmd_can_feed(int argc, char **argv);  /* cmd_can_feed.c DroneCAN */
+
+/* Parse "a,b,c,..." into exactly n floats; false on any malformed or non-finite entry. */
+int cli_parse_floats(const char *s, float *out, int n);
+/* Parse a positive size with optional K/M/G suffix (powers of 1024). */
+int cli_parse_size(const char *s, size_t *out);
+/* Print an error "occmap <cmd>: <msg>" to stderr. */
+void cli_error(const char *cmd, const char *fmt, ...);
+
+/* Print the map statistics keys (without braces) as JSON members:
+ * "resolution_m", "depth_levels", "inner_nodes", "leaf_nodes", "occupied_leaves", "free_leaves",
+ * "occupied_volume_m3", "free_volume_m3", "memory_bytes", "bbox_min", "bbox_max". */
+void cli_print_stats_json(FILE *f, const occ_map_t *map, const occ_map_stats_t *st);
+/* The same as human-readable lines. */
+void cli_print_stats_text(FILE *f, const occ_map_t *map, const occ_map_stats_t *st);
+
+#endif
