@@ -295,7 +295,8 @@ typedef struct {
 typedef struct {
     const occ_map_t *map;
     uint8_t sp;
-    struct { uint32_t block; uint8_t level; uint8_t next; occ_key_t base; } stack[OCC_MAX_DEPTH + 1];
+    occ_code_t code;  /* Morton code of the node last returned (internal) */
+    struct { uint32_t block; uint8_t level; uint8_t next; } stack[OCC_MAX_DEPTH + 1];
     bool started;
     bool pushed;  /* the node last returned pushed its children's frame */
 } occ_walk_t;

@@ -9,20 +9,19 @@ void occ_walk_begin(occ_walk_t *const w, const occ_map_t *const map)
     w->pushed = false;
 }
 
-static occ_key_t child_key(occ_key_t base, const unsigned slot, const unsigned level)
+/* The code of child `slot` at `level` under the node whose code is `code`: the bits of the
+ * levels above stay, the slot goes in at 3 * level, everything below is cleared. */
+static occ_code_t child_code(const occ_code_t code, const unsigned slot, const unsigned level)
 {
-    base.k[0] |= (uint32_t)(slot & 1u) << level;
-    base.k[1] |= (uint32_t)((slot >> 1) & 1u) << level;
-    base.k[2] |= (uint32_t)((slot >> 2) & 1u) << level;
-    return base;
+    const occ_code_t above = code & ~(((occ_code_t)1 << (3u * (level + 1u))) - 1u);
+    return above | ((occ_code_t)slot << (3u * level));
 }
 
-static void push(occ_walk_t *const w, const uint32_t block, const unsigned level, const occ_key_t base)
+static void push(occ_walk_t *const w, const uint32_t block, const unsigned level)
 {
     w->stack[w->sp].block = block;
     w->stack[w->sp].level = (uint8_t)level;
     w->stack[w->sp].next = 0u;
-    w->stack[w->sp].base = base;
     w->sp++;
     w->pushed = true;
 }
@@ -43,8 +42,9 @@ bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
         node->value = m->root_value;
         node->observed = true;
         node->flags = (uint8_t)(m->root_flags | (node->has_children ? 0u : OCC_NODE_UNIFORM));
+        w->code = 0u;
         if (node->has_children) {
-            push(w, m->root_child, (unsigned)m->cfg.depth_levels - 1u, zero);
+            push(w, m->root_child, (unsigned)m->cfg.depth_levels - 1u);
         }
         return true;
     }
@@ -56,7 +56,7 @@ bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
         }
         const unsigned slot = w->stack[top].next++;
         const unsigned level = w->stack[top].level;
-        const occ_key_t key = child_key(w->stack[top].base, slot, level);
+        const occ_code_t code = child_code(w->code, slot, level);
         occ_value_t v;
         uint32_t child = OCC_NONE;
         uint8_t flags;
@@ -72,14 +72,15 @@ bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
         if (!occ_is_observed(v)) {
             continue; /* nothing observed below */
         }
-        node->key = key;
+        w->code = code;
+        node->key = occ_morton_decode(code);
         node->level = (uint8_t)level;
         node->has_children = child != OCC_NONE;
         node->value = v;
         node->observed = true;
         node->flags = (uint8_t)(flags | (child == OCC_NONE ? OCC_NODE_UNIFORM : 0u));
         if (child != OCC_NONE) {
-            push(w, child, level - 1u, key);
+            push(w, child, level - 1u);
         }
         return true;
     }

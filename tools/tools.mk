@@ -1,0 +1,14 @@
+# The command-line tool's data and the first demo step.
+# $(BUILD)/data/scan.dat (OctoMap's real scan, decompressed) is made by tests/integrate.mk.
+SCAN_DAT := $(BUILD)/data/scan.dat
+
+DEMO_STEPS += demo-stats
+demo-stats: $(BUILD)/occmap $(SCAN_DAT)
+	@echo "== occmap stats on OctoMap's real laser scan (88,206 points), endpoints only"
+	$(BUILD)/occmap stats --scan $(SCAN_DAT) --res 0.1
+
+# The tool's statistics against values worked out independently (tests/cli_stats_check.py).
+TEST_STEPS += test-cli-stats
+test-cli-stats: $(BUILD)/occmap $(SCAN_DAT)
+	$(PY) tests/cli_stats_check.py $(BUILD)/occmap $(SCAN_DAT)
+.PHONY: demo-stats test-cli-stats
