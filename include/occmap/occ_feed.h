@@ -3,8 +3,10 @@
  * Pure C99, no OS, no heap; uses the public map API only.
  *
  * Frames
- *  - The map frame is ENU: x east, y north, z up (OctoMap's data). Maps built in NED are handled
- *    by the caller (occmap feed --map-frame ned) before poses reach this module.
+ *  - The map frame is ENU: x east, y north, z up (OctoMap's data), unless cfg.map_ned is set:
+ *    then the map is NED (x north, y east, z down; occmap feed --map-frame ned), the pose is
+ *    given in it (x north, y east, z down, yaw_rad = NED heading, clockwise from +x), and the
+ *    band's "above" side is -z.
  *  - An autopilot's NED pose converts as map x = NED y (east), map y = NED x (north),
  *    map z = -NED z, yaw_map = pi/2 - yaw_ned (occ_pose_from_ned).
  *  - Sectors are in the vehicle's heading frame, MAV_FRAME_BODY_FRD seen from above: body angle 0
@@ -44,7 +46,8 @@ extern "C" {
 
 typedef struct {
     float x, y, z;                 /* metres, map frame (ENU) */
-    float yaw_rad;                 /* map frame: 0 = +x (east), counter-clockwise positive */
+    float yaw_rad;                 /* ENU map: 0 = +x (east), counter-clockwise positive;
+                                    * NED map (cfg.map_ned): 0 = +x (north), clockwise */
     float roll_rad, pitch_rad;     /* optional, 0 when unknown; not used by the sectors */
 } occ_pose_t;
 
@@ -59,6 +62,7 @@ typedef struct {
     float band_below_m, band_above_m; /* vertical band around the vehicle, metres >= 0, sum > 0 */
     uint16_t min_distance_cm, max_distance_cm; /* 1 <= min < max <= 65534 */
     bool unknown_as_distance;      /* see the header comment: false -> UINT16_MAX */
+    bool map_ned;                  /* false: ENU map (default); true: NED map and pose */
 } occ_sectors_config_t;
 
 /* Work space of one computation (internal): a depth-first stack of nodes and per-sector state.

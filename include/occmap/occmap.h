@@ -175,8 +175,9 @@ typedef struct {
  * The arena is owned by the map until the caller stops using `map`; no deinit is needed.
  * Returns OCC_ERR_ARG for NULL, non-finite or inconsistent config (resolution <= 0,
  * depth 0 or > 21, hit <= 0, miss >= 0, clamp_min >= clamp_max, free_max > occupied_min,
- * a value outside the fixed-point range), OCC_ERR_NOMEM if the arena cannot hold one inner
- * and one leaf block. O(1). On error `map` is not usable. */
+ * a value outside the fixed-point range). Any arena size is accepted, even 0 (then NULL is
+ * allowed): a map whose arena holds no block can only hold a uniform root, and every write that
+ * needs a block returns OCC_ERR_NOMEM. O(1). On error `map` is not usable. */
 occ_err_t occ_map_init(occ_map_t *map, const occ_map_config_t *cfg, void *arena,
                        size_t arena_bytes);
 
