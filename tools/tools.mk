@@ -12,3 +12,9 @@ TEST_STEPS += test-cli-stats
 test-cli-stats: $(BUILD)/occmap $(SCAN_DAT)
 	$(PY) tests/cli_stats_check.py $(BUILD)/occmap $(SCAN_DAT)
 .PHONY: demo-stats test-cli-stats
+
+# The README's embedding example compiles and does what it says.
+TEST_STEPS += test-readme-example
+test-readme-example: $(BUILD)/libocc.a
+	bash tests/readme_example.sh $(BUILD)
+.PHONY: test-readme-example
