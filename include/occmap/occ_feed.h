@@ -65,8 +65,9 @@ typedef struct {
     bool map_ned;                  /* false: ENU map (default); true: NED map and pose */
 } occ_sectors_config_t;
 
-/* Work space of one computation (internal): a depth-first stack of nodes and per-sector state.
- * Lives in occ_sectors_t so the call needs only a small C stack frame. */
+/* Work space of one computation (internal): the depth-first stack of pending nodes (at most 7
+ * per level plus the root) and per-sector state. Lives in occ_sectors_t so the call needs only
+ * a small C stack frame. */
 #define OCC_SECTORS_STACK (8u * (OCC_MAX_DEPTH + 2u))
 typedef struct {
     uint32_t k[3];

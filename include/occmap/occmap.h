@@ -121,13 +121,14 @@ typedef struct {
     float hit;             /* log-odds added on a hit, > 0 (OctoMap: logit(0.7) = 0.847) */
     float miss;            /* log-odds added on a miss, < 0 (OctoMap: logit(0.4) = -0.405) */
     float clamp_min;       /* log-odds clamp, < clamp_max (OctoMap: logit(0.1192) = -2.0) */
-    float clamp_max;       /* (OctoMap: logit(0.971) = 3.5) */
+    float clamp_max;       /* (OctoMap: logit(0.971) = 3.511) */
     float free_max;        /* observed and < free_max: FREE (default 0, OctoMap) */
     float occupied_min;    /* observed and >= occupied_min: OCCUPIED (default 0); needs
                             * free_max <= occupied_min; values between read UNKNOWN */
 } occ_map_config_t;
 
-/* OctoMap's defaults: res 0.1 m, depth 16, hit 0.7, miss 0.4, clamp 0.1192/0.971, thr 0.5. */
+/* octomap::OcTree's defaults: res 0.1 m, depth 16, hit logit(0.7) = 0.847, miss logit(0.4) =
+ * -0.405, clamp logit(0.1192) = -2.0 / logit(0.971) = 3.511, occupancy threshold 0.5 (0). */
 occ_map_config_t occ_map_config_default(void);
 
 /* ---- Pools and the map ------------------------------------------------------------------------ */

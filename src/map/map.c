@@ -6,10 +6,11 @@ occ_map_config_t occ_map_config_default(void)
     occ_map_config_t c;
     c.resolution_m = 0.1f;
     c.depth_levels = 16u;
-    c.hit = 0.85f;        /* OctoMap's AbstractOccupancyOcTree defaults (log-odds) */
-    c.miss = -0.4f;
-    c.clamp_min = -2.0f;
-    c.clamp_max = 3.5f;
+    /* What octomap::OcTree 1.9.7 sets: logit(0.7), logit(0.4), logit(0.1192), logit(0.971). */
+    c.hit = 0.8472979f;
+    c.miss = -0.4054651f;
+    c.clamp_min = -2.0000279f;
+    c.clamp_max = 3.5110307f;
     c.free_max = 0.0f;
     c.occupied_min = 0.0f;
     return c;

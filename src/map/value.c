@@ -84,8 +84,8 @@ occ_value_t occ_value_apply_delta(const occ_map_t *const m, const occ_value_t v,
 
 occ_state_t occ_map_state_of(const occ_map_t *const map, const float logodds)
 {
-    if (map == NULL) {
-        return OCC_STATE_UNKNOWN;
+    if (map == NULL || !(logodds - logodds < 1.0f)) {
+        return OCC_STATE_UNKNOWN; /* NaN / Inf evidence is never FREE */
     }
     return occ_value_state(map, occ_value_from_logodds(logodds));
 }
