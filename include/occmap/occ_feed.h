@@ -70,8 +70,7 @@ typedef struct {
  * a small C stack frame. */
 #define OCC_SECTORS_STACK (8u * (OCC_MAX_DEPTH + 2u))
 typedef struct {
-    uint32_t k[3];
-    uint8_t level;
+    occ_node_t node;   /* read when pushed: popping costs no tree descent */
     float dmin;
 } occ_sectors_item_t;
 
@@ -80,7 +79,7 @@ typedef struct {
     uint16_t distance_cm[OCC_SECTORS_MAX];  /* obstacle clamped to [min,max]; max = observed
                                              * free; UINT16_MAX = unknown; never 0 */
     /* Diagnostics of the last call. */
-    uint32_t nodes_read;                    /* occ_map_read_key calls */
+    uint32_t nodes_read;                    /* nodes visited (popped from the stack) */
     uint32_t leaves_used;                   /* uniform nodes folded into the sectors */
     /* Metres, per sector, of the last call (OCC_SECTORS_FAR when nothing within R). */
     float d_occ_m[OCC_SECTORS_MAX];
@@ -101,8 +100,12 @@ occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg);
 /* Fill out->distance_cm[0..n_sectors-1] (and out->n, d_occ_m, d_unk_m) for the vehicle at `pose`.
  * Walks the octree top-down with occ_map_read_key(), nearest node first, and skips a node when
  * it lies outside the search cylinder, holds only free space, or is farther than what every
- * sector it spans already found. Cost grows with the number of non-free nodes near the vehicle,
- * not with R^2. Never writes the map; reads no memory other than map, pose, cfg and out.
+ * sector it spans already found (d_occ_m / d_unk_m are exact where they decide the result).
+ * Cost grows with the nodes between the vehicle and the nearest non-free space per sector, not
+ * with R^2: on OctoMap's geb079.bt (0.08 m) about 860 node reads and 1.26 M instructions per
+ * call with the defaults (make bench); each read is an O(depth) descent from the root.
+ * Stack: < 512 bytes (the work space is in `out`). Never writes the map; reads no memory other
+ * than map, pose, cfg and out.
  * Errors: OCC_ERR_ARG (NULL, non-finite pose, bad cfg), OCC_ERR_RANGE (the vehicle outside the
  * map volume). On error `out` holds n = 0. */
 occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,

@@ -46,9 +46,10 @@ occ_err_t occ_file_load_alloc(const char *path, const occ_map_config_t *base_cfg
 
 /* Save atomically in the format of the extension: write "<path>.tmp.<pid>", fsync it, rename
  * it over `path`, fsync the directory. A crash at any point leaves either the old file or the
- * new one, never a torn one. OCC_ERR_ARG (unknown extension), OCC_ERR_UNSUPPORTED (OctoMap
- * format and depth != 16), OCC_ERR_IO. `bytes` (may be NULL) gets the file size. */
+ * new one, never a torn one; on error the temporary file is removed. OCC_ERR_ARG (unknown
+ * extension), OCC_ERR_UNSUPPORTED (OctoMap format and depth != 16), OCC_ERR_IO. */
 occ_err_t occ_file_save(const char *path, const occ_map_t *map, char *msg, size_t msg_len);
+/* The same in an explicit format; `bytes` (may be NULL) gets the file size. */
 occ_err_t occ_file_save_as(const char *path, const occ_map_t *map, occ_format_t format,
                            size_t *bytes, char *msg, size_t msg_len);
 

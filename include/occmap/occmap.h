@@ -310,6 +310,27 @@ bool occ_walk_next(occ_walk_t *w, occ_walk_node_t *node);
 /* Do not descend into the children of the node last returned. */
 void occ_walk_skip_children(occ_walk_t *w);
 
+/* ---- Top-down node access (for walkers that pick their own order: sector scans, custom queries) --
+ * A node handle holds what a reader needs and where its children are; it stays valid until the
+ * next write to the map. Each call reads one block: O(1). */
+typedef struct {
+    occ_key_t key;      /* first voxel of the node (lowest `level` bits clear) */
+    uint8_t level;      /* 0 = voxel */
+    bool observed;      /* false: nothing below was ever observed */
+    uint8_t flags;      /* OCC_NODE_* (incl. OCC_NODE_UNIFORM when it has no children) */
+    occ_state_t state;  /* state of the node's value (the max below) */
+    float logodds;      /* max of observed voxels below (0 when unobserved) */
+    uint32_t children;  /* internal: the child block, OCC_NONE when uniform */
+} occ_node_t;
+
+/* The root (level depth_levels). */
+void occ_map_node_root(const occ_map_t *map, occ_node_t *out);
+/* Child `slot` (0..7: bit 0 = +x half, bit 1 = +y, bit 2 = +z) of `parent`. A uniform parent's
+ * children are reported with the parent's value (as if expanded). OCC_ERR_ARG for level 0 or a
+ * slot > 7. */
+occ_err_t occ_map_node_child(const occ_map_t *map, const occ_node_t *parent, unsigned slot,
+                             occ_node_t *out);
+
 /* Log-odds <-> node value. */
 float occ_value_to_logodds(occ_value_t v);
 occ_value_t occ_value_from_logodds(float logodds);

@@ -1,0 +1,351 @@
+/*
+ * occ_can.h - the CAN front end: a minimal DroneCAN (UAVCAN v0) node that tells an autopilot
+ * where the obstacles are. This header is the manual.
+ *
+ * Layers (all portable C99, no heap, no OS; time is always passed in, microseconds):
+ *  - occ_can_frame_t + occ_can_iface_t: one CAN frame and the transmit hook a port provides
+ *    (port/posix/socketcan.c, port/posix/can_mcast.c, port/baremetal/can_hooks.c).
+ *  - Transfer layer (can_transfer.c): 29-bit ids, tail bytes, multi-frame split with the
+ *    transfer CRC seeded by the data type signature, bit-stream packing, IEEE half floats.
+ *  - Messages (dronecan.c): ardupilot.equipment.proximity_sensor.Proximity (21910),
+ *    uavcan.protocol.NodeStatus (341), the uavcan.protocol.GetNodeInfo (service 1) response.
+ *  - The node (dronecan.c): static node id, per-type transfer ids, Proximity at 10 Hz (one
+ *    transfer per sector with an obstacle; one NO_DATA reading when the data is stale; one
+ *    NOT_CONNECTED reading when there is no map), NodeStatus at 1 Hz, GetNodeInfo answered.
+ *  - occ_dronecan_poll_map() (dronecan_map.c): the same fed straight from a map and a pose through
+ *    the sector module (occ_feed.h).
+ *
+ * Only classic CAN (8-byte) frames are emitted by the node; the frame type carries FD frames for
+ * the ports. Bit-exact with pydronecan 1.0.27 (tests/can_golden.py checks it byte for byte).
+ * Not thread-safe: one node per thread, or serialize the calls.
+ */
+#ifndef OCC_CAN_H_INCLUDED
+#define OCC_CAN_H_INCLUDED
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdbool.h>
+
+#include "occmap/occmap.h"
+#include "occmap/occ_feed.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- Frames and the port hook ----------------------------------------------------------------- */
+#define OCC_CAN_FLAG_EXT 0x01u /* 29-bit identifier (every DroneCAN frame) */
+#define OCC_CAN_FLAG_FD 0x02u  /* CAN FD frame (len up to 64) */
+#define OCC_CAN_FLAG_BRS 0x04u /* FD bit rate switch */
+#define OCC_CAN_FLAG_RTR 0x08u /* remote request (classic only) */
+#define OCC_CAN_FLAG_ERR 0x10u /* error report from the port (rx only): see occ_can_err_* below */
+#define OCC_CAN_MAX_DATA 64u
+#define OCC_CAN_EXT_ID_MASK 0x1FFFFFFFu
+
+typedef struct {
+    uint32_t id;      /* identifier without flag bits: 29 bits with EXT, else 11 bits */
+    uint8_t len;      /* data bytes: 0..8 classic, 0..64 FD (a valid FD length) */
+    uint8_t flags;    /* OCC_CAN_FLAG_* */
+    uint8_t data[OCC_CAN_MAX_DATA];
+} occ_can_frame_t;
+
+/* With OCC_CAN_FLAG_ERR the port reports a bus condition; `id` holds OCC_CAN_ERR_* bits. */
+#define OCC_CAN_ERR_BUS_OFF 0x01u   /* controller went bus-off */
+#define OCC_CAN_ERR_PASSIVE 0x02u   /* error passive (warning limits passed) */
+#define OCC_CAN_ERR_TX_TIMEOUT 0x04u
+#define OCC_CAN_ERR_LOST_ARB 0x08u
+#define OCC_CAN_ERR_PROTOCOL 0x10u  /* bit/stuff/form/ack errors */
+#define OCC_CAN_ERR_OTHER 0x80u
+
+/* Transmit one frame without blocking. Return OCC_OK when queued, OCC_ERR_NOMEM when the transmit
+ * queue is full (the frame is dropped), OCC_ERR_IO for a driver error. `frame` is only borrowed
+ * for the call. */
+typedef occ_err_t (*occ_can_tx_fn)(void *user, const occ_can_frame_t *frame);
+/* Free transmit slots now (optional: NULL means unknown; the node then sends frame by frame and
+ * stops a transfer at the first full queue). */
+typedef uint32_t (*occ_can_tx_space_fn)(void *user);
+
+typedef struct {
+    occ_can_tx_fn tx;
+    occ_can_tx_space_fn tx_space; /* may be NULL */
+    void *user;                   /* passed back to the hooks */
+} occ_can_iface_t;
+
+/* ---- DroneCAN transfer layer (can_transfer.c) ------------------------------------------------- */
+#define OCC_DRONECAN_PRIO_HIGHEST 0u
+#define OCC_DRONECAN_PRIO_MEDIUM 16u
+#define OCC_DRONECAN_PRIO_LOWEST 31u
+
+#define OCC_DRONECAN_TAIL_START 0x80u
+#define OCC_DRONECAN_TAIL_END 0x40u
+#define OCC_DRONECAN_TAIL_TOGGLE 0x20u
+#define OCC_DRONECAN_TAIL_TID 0x1Fu
+
+/* Largest transfer payload the node builds (GetNodeInfo response with an 80-byte name). */
+#define OCC_DRONECAN_MAX_PAYLOAD 128u
+
+/* Message frame id: priority (0..31) << 24 | data type id << 8 | source node (1..127). */
+uint32_t occ_dronecan_msg_id(uint8_t priority, uint16_t data_type_id, uint8_t src_node);
+/* Service frame id: priority << 24 | service id << 16 | request << 15 | dst << 8 | 0x80 | src. */
+uint32_t occ_dronecan_svc_id(uint8_t priority, uint8_t service_id, bool request, uint8_t dst_node,
+                             uint8_t src_node);
+
+/* CRC-16-CCITT-FALSE (poly 0x1021, no reflection, no final xor) of `n` bytes continuing `crc`
+ * (start with 0xFFFF). O(n). */
+uint16_t occ_dronecan_crc16(uint16_t crc, const uint8_t *data, size_t n);
+/* The transfer CRC's seed: 0xFFFF continued over the 8 signature bytes, little endian. */
+uint16_t occ_dronecan_crc_seed(uint64_t signature);
+
+/* Write the low `bit_len` (1..64) bits of `value` at bit `bit_off` of `buf` the way DSDL v0 does
+ * (little-endian bytes, MSB-first bit stream; a partial last byte keeps its low bits). Bits
+ * outside the field are left as they are; the caller zeroes the buffer first. */
+void occ_dronecan_put_bits(uint8_t *buf, size_t bit_off, unsigned bit_len, uint64_t value);
+/* Read back what occ_dronecan_put_bits() wrote. */
+uint64_t occ_dronecan_get_bits(const uint8_t *buf, size_t bit_off, unsigned bit_len);
+
+/* IEEE 754 half from float, as DSDL saturated float16 and pydronecan do it: +-Inf and values
+ * beyond +-65504 saturate to +-65504 (0x7BFF), NaN gives 0x7FFF (with the sign), the mantissa
+ * rounds half away from zero, subnormals are kept. O(1), float math only. */
+uint16_t occ_float16_from_float(float f);
+/* Half to float, exact (Inf and NaN survive). */
+float occ_float16_to_float(uint16_t h);
+
+/* Frames a transfer of `payload_len` bytes takes on classic CAN: 1 up to 7 bytes, else
+ * ceil((payload_len + 2) / 7). */
+size_t occ_dronecan_frame_count(size_t payload_len);
+
+/* Split one transfer into classic CAN frames and hand them to `iface`, in order.
+ * `can_id` from occ_dronecan_msg_id()/occ_dronecan_svc_id(); `signature` seeds the CRC of
+ * multi-frame transfers; `tid` 0..31. If iface->tx_space says there is room for fewer frames than
+ * needed, nothing is sent and OCC_ERR_NOMEM is returned. If the hook reports a full queue midway,
+ * the rest is dropped and OCC_ERR_NOMEM is returned. `frames_sent` (may be NULL) gets the frames
+ * the hook accepted. OCC_ERR_ARG for NULL, an empty hook, tid > 31 or payload_len >
+ * OCC_DRONECAN_MAX_PAYLOAD; OCC_ERR_IO when the hook reported a driver error. O(payload_len). */
+occ_err_t occ_dronecan_send_transfer(const occ_can_iface_t *iface, uint32_t can_id,
+                                     uint64_t signature, uint8_t tid, const uint8_t *payload,
+                                     size_t payload_len, size_t *frames_sent);
+
+/* ---- Messages (dronecan.c) -------------------------------------------------------------------- */
+#define OCC_DRONECAN_PROXIMITY_ID 21910u
+#define OCC_DRONECAN_PROXIMITY_SIG 0x99DD3985FB3222CEull
+#define OCC_DRONECAN_NODESTATUS_ID 341u
+#define OCC_DRONECAN_NODESTATUS_SIG 0x0F0868D0C1A7C6F1ull
+#define OCC_DRONECAN_GETNODEINFO_ID 1u
+#define OCC_DRONECAN_GETNODEINFO_SIG 0xEE468A8121C46A9Eull
+
+typedef enum {
+    OCC_PROX_NO_DATA = 0,       /* distance unknown (stale map or pose) */
+    OCC_PROX_NOT_CONNECTED = 1, /* no map */
+    OCC_PROX_GOOD = 2
+} occ_prox_reading_t;
+
+typedef struct {
+    uint8_t sensor_id;
+    occ_prox_reading_t reading_type;
+    uint8_t flags;      /* 5 bits, reserved: 0 */
+    float yaw_deg;      /* body frame, 0 = forward, clockwise positive */
+    float pitch_deg;    /* body frame, up positive */
+    float distance_m;
+} occ_dronecan_proximity_t;
+
+/* Payload of a Proximity message: always 8 bytes written to `out`. Returns 8. */
+size_t occ_dronecan_encode_proximity(const occ_dronecan_proximity_t *msg, uint8_t out[8]);
+
+#define OCC_NODE_HEALTH_OK 0u
+#define OCC_NODE_HEALTH_WARNING 1u
+#define OCC_NODE_HEALTH_ERROR 2u
+#define OCC_NODE_HEALTH_CRITICAL 3u
+#define OCC_NODE_MODE_OPERATIONAL 0u
+#define OCC_NODE_MODE_INITIALIZATION 1u
+#define OCC_NODE_MODE_MAINTENANCE 2u
+
+typedef struct {
+    uint32_t uptime_sec;
+    uint8_t health;     /* 2 bits: OCC_NODE_HEALTH_* */
+    uint8_t mode;       /* 3 bits: OCC_NODE_MODE_* */
+    uint8_t sub_mode;   /* 3 bits */
+    uint16_t vendor_status;
+} occ_dronecan_node_status_t;
+
+/* Payload of a NodeStatus message: always 7 bytes written. Returns 7. */
+size_t occ_dronecan_encode_node_status(const occ_dronecan_node_status_t *msg, uint8_t out[7]);
+
+typedef struct {
+    occ_dronecan_node_status_t status;
+    uint8_t sw_major, sw_minor;
+    uint8_t sw_optional_flags;   /* 1: vcs_commit valid, 2: image_crc valid */
+    uint32_t vcs_commit;
+    uint64_t image_crc;
+    uint8_t hw_major, hw_minor;
+    uint8_t unique_id[16];
+    const char *name;            /* NUL-terminated, at most 80 bytes are sent; NULL = empty */
+} occ_dronecan_node_info_t;
+
+/* Payload of a GetNodeInfo response (status, software and hardware version with an empty
+ * certificate, name as the tail array). Writes at most OCC_DRONECAN_MAX_PAYLOAD bytes (cap must
+ * be >= that) and returns the length, or 0 on a NULL argument or a small buffer. */
+size_t occ_dronecan_encode_node_info(const occ_dronecan_node_info_t *info, uint8_t *out,
+                                     size_t cap);
+
+/* ---- The node (dronecan.c) -------------------------------------------------------------------- */
+typedef struct {
+    uint8_t node_id;               /* static node id 1..127 */
+    uint8_t sensor_id;             /* Proximity sensor_id (ArduPilot PRXn_ADDR) */
+    uint8_t priority;              /* Proximity and NodeStatus priority, 0..31 */
+    uint32_t proximity_period_us;  /* > 0; default 100000 (10 Hz) */
+    uint32_t status_period_us;     /* > 0, <= 1000000; default 1000000 (1 Hz) */
+    uint32_t stale_after_us;       /* data older than this is stale; default 500000 */
+    float pitch_deg;               /* pitch reported with every reading, default 0 */
+    const char *name;              /* GetNodeInfo name; default "org.occmap.obstacles" */
+    uint8_t sw_major, sw_minor, hw_major, hw_minor;
+    uint32_t vcs_commit;           /* sent with optional flag 1 when non-zero */
+    uint8_t unique_id[16];
+} occ_dronecan_config_t;
+
+typedef struct {
+    uint32_t tx_frames;       /* frames the hook accepted */
+    uint32_t tx_transfers;    /* transfers sent completely */
+    uint32_t tx_full;         /* transfers (partly) dropped because the queue was full */
+    uint32_t tx_errors;       /* transfers stopped by a driver error */
+    uint32_t rx_frames;       /* frames ingested */
+    uint32_t rx_ignored;      /* frames not for us / not understood */
+    uint32_t rx_bus_errors;   /* error reports from the port */
+    uint32_t bus_off;         /* bus-off reports */
+    uint32_t node_info_answered;
+    uint32_t proximity_sent;  /* Proximity transfers sent completely */
+} occ_dronecan_stats_t;
+
+typedef struct {
+    occ_dronecan_config_t cfg;
+    occ_can_iface_t iface;
+    occ_dronecan_stats_t stats;
+    uint8_t tid_proximity, tid_status;
+    bool started;
+    uint64_t start_us, next_proximity_us, next_status_us;
+    uint8_t health, mode;     /* from the last poll */
+    uint16_t last_obstacles;  /* sectors with an obstacle in the last publication (NodeStatus
+                               * vendor_specific_status_code) */
+    occ_sectors_t sectors;    /* scratch for occ_dronecan_poll_map() */
+} occ_dronecan_node_t;
+
+/* Node id 0 (must be set), sensor 0, priority 24, 10 Hz, 1 Hz, 500 ms, version 0.1. */
+occ_dronecan_config_t occ_dronecan_config_default(void);
+
+/* Initialize `node` (caller-owned, no deinit). OCC_ERR_ARG for NULL, node id outside 1..127,
+ * priority > 31, zero periods, a status period over 1 s, iface->tx NULL. O(1). */
+occ_err_t occ_dronecan_init(occ_dronecan_node_t *node, const occ_dronecan_config_t *cfg,
+                            const occ_can_iface_t *iface);
+
+/* What the node knows at one instant. */
+typedef struct {
+    bool have_map;                       /* false: NOT_CONNECTED, health ERROR */
+    bool fresh;                          /* false: NO_DATA, health WARNING */
+    const occ_sectors_t *sectors;        /* needed when have_map && fresh */
+    const occ_sectors_config_t *sectors_cfg; /* angles and max distance of `sectors` */
+} occ_dronecan_view_t;
+
+/* Publish what is due at `now_us` (monotonic microseconds; the first call starts the clock and
+ * publishes both at once): NodeStatus every status period, Proximity every proximity period -
+ * GOOD, one transfer per sector whose distance is below sectors_cfg->max_distance_cm (yaw = sector
+ * centre in (-180, 180], distance in metres), nothing else when no sector has an obstacle; one
+ * NO_DATA or NOT_CONNECTED reading otherwise. A call between due times does nothing.
+ * Returns OCC_OK, OCC_ERR_NOMEM when a transfer was dropped on a full queue (counted, the rest is
+ * still tried), OCC_ERR_IO on a driver error, OCC_ERR_ARG for NULL or a fresh view without
+ * sectors. Never blocks. O(sectors). */
+occ_err_t occ_dronecan_poll(occ_dronecan_node_t *node, uint64_t now_us,
+                            const occ_dronecan_view_t *view);
+
+/* Publish every sector with an obstacle right now (what poll does when due): returns the number of
+ * transfers sent completely through *sent (may be NULL). Errors as occ_dronecan_poll. */
+occ_err_t occ_dronecan_publish_sectors(occ_dronecan_node_t *node, const occ_sectors_t *sectors,
+                                       const occ_sectors_config_t *cfg, size_t *sent);
+/* Publish one Proximity reading (any type) now. */
+occ_err_t occ_dronecan_publish_proximity(occ_dronecan_node_t *node,
+                                         const occ_dronecan_proximity_t *msg);
+/* Publish one NodeStatus now with uptime from now_us. */
+occ_err_t occ_dronecan_publish_status(occ_dronecan_node_t *node, uint64_t now_us);
+
+/* Hand one received frame to the node. Answers a GetNodeInfo request addressed to this node
+ * (single-frame request, empty payload) with the response, same priority and transfer id; counts
+ * bus-off / error reports; ignores everything else (counted in rx_ignored). Returns OCC_OK, or
+ * the send error of the response. O(1) plus the response. */
+occ_err_t occ_dronecan_ingest(occ_dronecan_node_t *node, const occ_can_frame_t *frame,
+                              uint64_t now_us);
+
+/* Poll straight from a map (dronecan_map.c): `map` NULL = no map; the data is fresh when both
+ * stamps are within cfg.stale_after_us of now_us (a stamp ahead of now_us counts as fresh).
+ * When a Proximity publication is due and the data is fresh, sectors are computed with
+ * occ_sectors_compute() into node->sectors (only then; node->sectors is ~5 KB of scratch, so
+ * keep the node static on a small stack). If that fails (e.g. OCC_ERR_RANGE: the vehicle is
+ * outside the map), the node still publishes - a NO_DATA reading and NodeStatus - and the
+ * sector error is returned. Otherwise errors as occ_dronecan_poll. */
+occ_err_t occ_dronecan_poll_map(occ_dronecan_node_t *node, uint64_t now_us, const occ_map_t *map,
+                                uint64_t map_stamp_us, const occ_pose_t *pose,
+                                uint64_t pose_stamp_us, const occ_sectors_config_t *sectors_cfg);
+
+/* ---- Ports (host side: port/posix; not part of the firmware build) ---------------------------- */
+/* Receive filter: a frame passes when (frame id & mask) == (id & mask) and its EXT flag equals
+ * `ext` (classic 11-bit vs 29-bit ids). */
+typedef struct {
+    uint32_t id, mask;
+    bool ext;
+} occ_can_filter_t;
+
+#define OCC_CAN_MAX_FILTERS 16u
+
+/* SocketCAN (port/posix/socketcan.c): one non-blocking CAN_RAW socket bound to one interface. */
+typedef struct {
+    int fd;                /* -1 when closed */
+    bool fd_frames;        /* CAN FD frames enabled on this socket */
+    uint32_t tx_full;      /* sends refused with EAGAIN / ENOBUFS */
+    uint32_t rx_errors;    /* error frames received */
+} occ_socketcan_t;
+
+/* Open `ifname` (e.g. "vcan0", "can0"), non-blocking, error frames enabled (bus-off, controller,
+ * protocol, tx timeout, lost arbitration come back from occ_socketcan_recv() as
+ * OCC_CAN_FLAG_ERR frames). `fd_frames` asks for CAN FD (fails with OCC_ERR_UNSUPPORTED when the
+ * interface cannot). OCC_ERR_IO when the kernel has no CAN (errno in `msg`). */
+occ_err_t occ_socketcan_open(occ_socketcan_t *s, const char *ifname, bool fd_frames, char *msg,
+                             size_t msg_len);
+/* Replace the receive filters (n = 0: receive nothing but error reports; filters NULL with
+ * n = 0 as well). n <= OCC_CAN_MAX_FILTERS. */
+occ_err_t occ_socketcan_set_filters(occ_socketcan_t *s, const occ_can_filter_t *filters, size_t n);
+/* Send without blocking: OCC_OK, OCC_ERR_NOMEM when the queue is full (counted in tx_full),
+ * OCC_ERR_ARG for an FD frame on a classic socket or a bad length, OCC_ERR_IO otherwise. */
+occ_err_t occ_socketcan_send(occ_socketcan_t *s, const occ_can_frame_t *frame);
+/* Wait up to `timeout_ms` (0: poll, < 0: forever) for one frame. *got = false on timeout. */
+occ_err_t occ_socketcan_recv(occ_socketcan_t *s, occ_can_frame_t *frame, int timeout_ms,
+                             bool *got);
+void occ_socketcan_close(occ_socketcan_t *s);
+/* The transmit hook for the DroneCAN node (tx_space unknown). */
+occ_can_iface_t occ_socketcan_iface(occ_socketcan_t *s);
+
+/* CAN over UDP multicast (port/posix/can_mcast.c), the format of pydronecan's `mcast:` driver and
+ * ArduPilot SITL: group 239.65.82.<bus>, port 57732, packet = u16 magic 0x2934, u16 CRC-16-CCITT
+ * of the rest, u16 flags (1 = FD), u32 id (bit 31 = extended), data; little endian. */
+typedef struct {
+    int rx_fd, tx_fd;
+    uint16_t tx_port;          /* our sender's port: our own packets are dropped on receive */
+    uint32_t tx_full, rx_bad;  /* sends refused (EAGAIN), packets dropped (magic, CRC, size) */
+} occ_can_mcast_t;
+
+#define OCC_CAN_MCAST_PORT 57732u
+#define OCC_CAN_MCAST_MAGIC 0x2934u
+
+/* Join bus 0..255 on the loopback interface when `loopback_only`, else on the default one. */
+occ_err_t occ_can_mcast_open(occ_can_mcast_t *m, unsigned bus, bool loopback_only, char *msg,
+                             size_t msg_len);
+/* Encode / decode one packet (pure functions, used by the tests). encode returns the length
+ * (10 + len) or 0 when `cap` is too small; decode returns OCC_ERR_FORMAT for a bad packet. */
+size_t occ_can_mcast_encode(const occ_can_frame_t *frame, uint8_t *out, size_t cap);
+occ_err_t occ_can_mcast_decode(const uint8_t *pkt, size_t len, occ_can_frame_t *frame);
+occ_err_t occ_can_mcast_send(occ_can_mcast_t *m, const occ_can_frame_t *frame);
+occ_err_t occ_can_mcast_recv(occ_can_mcast_t *m, occ_can_frame_t *frame, int timeout_ms,
+                             bool *got);
+void occ_can_mcast_close(occ_can_mcast_t *m);
+occ_can_iface_t occ_can_mcast_iface(occ_can_mcast_t *m);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

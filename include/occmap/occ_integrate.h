@@ -1,0 +1,146 @@
+/*
+ * occ_integrate.h - integrating point clouds (ray casting) into the map. Part of the manual.
+ *
+ * Semantics are OctoMap's insertPointCloud() exactly: within one call every voxel is updated at
+ * most once; a voxel that is both traversed by some ray and contains some end point is updated
+ * as occupied (cfg.hit), every other traversed voxel as free (cfg.miss). A ray longer than the
+ * max range clears up to max range along its direction and marks no hit. Traversal is the 3D-DDA
+ * of Amanatides & Woo with OctoMap's computeRayKeys arithmetic (float direction, double tMax
+ * when OCC_RAY_DOUBLE=1), so the keys are bit-for-bit OctoMap's for an octomap::OcTree built with
+ * resolution (double)cfg.resolution_m.
+ *
+ * Memory: no heap. The per-scan key sets live in the caller's scratch buffer. They are sorted
+ * Morton codes (radix sort), de-duplicated and applied with one occ_map_observe_codes() call,
+ * which touches the tree in Morton order. If the scratch cannot hold them, or the pools cannot
+ * hold the result, the call returns OCC_ERR_NOMEM and the map is exactly as before.
+ *
+ * Work: O(sum over rays of the voxels each ray crosses) for traversal, bounded per ray by
+ * 3 * (max_range / resolution + 2) + 2 voxels (the whole map's edge with unlimited range), plus
+ * O(unique voxels * depth) for the tree update. Firmware budgets rays x voxels per ray.
+ */
+#ifndef OCC_INTEGRATE_H_INCLUDED
+#define OCC_INTEGRATE_H_INCLUDED
+
+#include "occmap/occmap.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Radix digit width (bits) of the key-set sort: its histogram takes 2^bits * 4 bytes of scratch
+ * per pass. Filter: a direct-mapped table of 2^bits recently emitted codes (8 bytes each) that
+ * drops repeated visits before the sort; exact (a code is dropped only if it was emitted before
+ * in this call). */
+#ifndef OCC_INSERT_RADIX_BITS
+#if defined(__arm__) || defined(__thumb__)
+#define OCC_INSERT_RADIX_BITS 8
+#else
+#define OCC_INSERT_RADIX_BITS 11
+#endif
+#endif
+#ifndef OCC_INSERT_FILTER_BITS
+#if defined(__arm__) || defined(__thumb__)
+#define OCC_INSERT_FILTER_BITS 8
+#else
+#define OCC_INSERT_FILTER_BITS 15
+#endif
+#endif
+
+typedef enum {
+    /* One exact ray per point (OctoMap insertPointCloud, discretize = false). */
+    OCC_INSERT_SIMPLE = 0,
+    /* Points first reduced to one per voxel, rays to voxel centres (discretize = true). */
+    OCC_INSERT_DISCRETE = 1,
+    /* UFOMap's fast discrete integrator (approximate): DISCRETE's end voxels; free space is
+     * sampled from the origin in steps of a level-`fast_d` node's edge (res * 2^d) until
+     * `fast_n` such steps before the end, from where the exact voxel DDA runs to the end voxel
+     * (n = 0: no voxel DDA; the end's level-d node is cleared too). Every voxel below each
+     * sampled level-d node gets cfg.miss / (2d+1) once per scan; then the voxel updates (hits,
+     * fine free voxels) are applied on top, as UFOMap does (an end voxel's node is both
+     * cleared coarsely and hit). fast_d = 0 is DISCRETE exactly. The all-or-nothing pool check
+     * is conservative here: it may refuse (OCC_ERR_NOMEM) when fewer free blocks remain than
+     * the distinct nodes on the updated paths, even if existing blocks would have sufficed. */
+    OCC_INSERT_FAST_DISCRETE = 2,
+    /* Super rays (Kim et al. 2017): points whose rays cross the same voxels (decided per end
+     * voxel by the grid edges inside the bundle in the three axis-plane projections, the
+     * paper's mapping lines) share one traversal. Same map as SIMPLE, voxel for voxel: rays
+     * within 1e-9 (relative) of a decision or ending within 1e-4 voxel of a face are cast
+     * singly, and so are end voxels with fewer than super_k points and bundles split into more
+     * than a third as many super rays as rays. Pays off when a voxel holds many points of a
+     * dense sensor (depth cameras at coarse resolution); needs the dense per-scan set (the
+     * scan's box fits the scratch), else it runs as SIMPLE. */
+    OCC_INSERT_SUPER_RAYS = 3
+} occ_insert_method_t;
+
+typedef struct {
+    occ_insert_method_t method;
+    float max_range_m;  /* <= 0: unlimited. Compared like OctoMap: |p - origin| <= max range */
+    uint8_t fast_n;     /* FAST_DISCRETE: coarse nodes before the end where fine marching starts */
+    uint8_t fast_d;     /* FAST_DISCRETE: level of the coarse nodes, 0..depth_levels-1 */
+    uint16_t super_k;   /* SUPER_RAYS: end voxels with fewer points are cast singly (paper: 20) */
+} occ_insert_params_t;
+
+/* SIMPLE, unlimited range, n = 0, d = 2, k = 4. */
+occ_insert_params_t occ_insert_params_default(void);
+
+typedef struct {
+    size_t points_integrated; /* points that produced a ray or a hit */
+    size_t points_skipped;    /* bad points: NaN / Inf, or (within max range) outside the map */
+    size_t rays_clipped;      /* rays longer than max range: cleared up to max range, no hit */
+    size_t rays_cast;         /* traversals run (DISCRETE: distinct end voxels; super rays) */
+    size_t voxel_visits;      /* keys produced by traversals, before de-duplication */
+    size_t voxels_updated;    /* distinct voxels updated (= voxels_free + voxels_occupied) */
+    size_t voxels_free;       /* ... of which as free */
+    size_t voxels_occupied;   /* ... of which as occupied */
+    size_t voxels_changed;    /* voxels whose stored value changed */
+    size_t coarse_updated;    /* FAST_DISCRETE: coarse nodes updated as free */
+    size_t scratch_used;      /* scratch bytes this call used at most */
+} occ_insert_result_t;
+
+/* Scratch bytes that make occ_map_insert_cloud() never fail for lack of scratch, for up to
+ * `n_points` points whose rays are at most `max_ray_m` long (pass max(max_range, farthest point
+ * distance); <= 0 or non-finite means "the whole map": a huge number). Formula:
+ *   fixed + 16 * n_points * (3 * (ceil(max_ray_m / res) + 2) + 2) + 16 * n_points
+ * where fixed = 2^OCC_INSERT_FILTER_BITS * 8 + 6 * 2^OCC_INSERT_RADIX_BITS * 4 + 64.
+ * FAST_DISCRETE and SUPER_RAYS need no more than SIMPLE. Saturates at SIZE_MAX. O(1). */
+size_t occ_insert_scratch_bytes(const occ_map_t *map, size_t n_points, float max_ray_m,
+                                const occ_insert_params_t *params);
+
+/* The same bound computed for one scan: per ray the keys the DDA can emit (|dk|_1 + 4), summed.
+ * Bad points count 0. O(n). Returns 0 if an argument is NULL. */
+size_t occ_insert_scratch_bytes_scan(const occ_map_t *map, const occ_vec3_t *origin,
+                                     const occ_vec3_t *points, size_t n_points,
+                                     const occ_insert_params_t *params);
+
+/* Integrate one scan taken from sensor position `origin` (map frame, metres). `points` are in
+ * the map frame. `scratch` (any alignment, owned by the call only while it runs) holds the
+ * per-scan sets; less than the bound above may still work: the sets are compacted when full.
+ * `out` (may be NULL) gets the counters, also on error (then nothing was applied).
+ * Errors: OCC_ERR_ARG (NULL map/origin/params, points NULL with n > 0, origin NaN/Inf, bad
+ * method or fast_d >= depth_levels), OCC_ERR_RANGE (origin outside the map), OCC_ERR_NOMEM
+ * (scratch or pools too small: the map is unchanged, oom_count is bumped by the pool case).
+ * Bad points are not an error: they are skipped and counted.
+ * Differences to OctoMap: an origin outside the map is an error (OctoMap would still mark the
+ * end points); with discretize=true OctoMap wraps out-of-map points into the map, here they
+ * are skipped. */
+occ_err_t occ_map_insert_cloud(occ_map_t *map, const occ_vec3_t *origin,
+                               const occ_vec3_t *points, size_t n_points,
+                               const occ_insert_params_t *params, void *scratch,
+                               size_t scratch_bytes, occ_insert_result_t *out);
+
+/* ---- Exact ray keys ----------------------------------------------------------------------- */
+/* The voxels OctoMap's computeRayKeys(origin, end) visits, in its order: the origin's voxel
+ * first, every voxel crossed after it, the end point's voxel excluded; none when both are in the
+ * same voxel. `keys` gets up to `cap` keys, `*n_keys` the count (also the count needed when
+ * OCC_ERR_NOMEM is returned; then keys hold the first cap). OCC_ERR_ARG (NULL, NaN/Inf),
+ * OCC_ERR_RANGE (origin or end outside the map, as OctoMap's false). At most
+ * |dk_x| + |dk_y| + |dk_z| + 4 keys (occ_ray_max_keys). O(keys). No map access. */
+occ_err_t occ_ray_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end,
+                       occ_key_t *keys, size_t cap, size_t *n_keys);
+/* Upper bound of the keys occ_ray_keys() returns between two points (0 if invalid). */
+size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

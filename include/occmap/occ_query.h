@@ -1,0 +1,293 @@
+/*
+ * occ_query.h - reading the map through volumes: iteration with state predicates, voxel counts,
+ * nearest-first search, collision checks, ray casts, line of sight, information gain.
+ * Included by occmap.h. Implemented in src/map/query.c, nearest.c, collide.c,
+ * castray.c, infogain.c (core: no heap, no recursion, float math). Convex shapes through libccd
+ * are in occ_collide_ccd.h (host builds only).
+ *
+ * Geometry: every volume and node is a closed set in the map frame (metres). A node at `level`
+ * is the axis-aligned cube of edge resolution * 2^level holding voxel keys
+ * [key, key + 2^level) per axis. "A node intersects a volume" means the closed cube and the
+ * closed volume share a point (exact tests, float arithmetic: separating axes for OBB and
+ * frustum, exact segment-to-box distance for capsules). Space outside the map volume holds no
+ * node: iteration never reports it; collision checks treat it as UNKNOWN.
+ *
+ * Cost: iteration skips whole branches that miss the volume or cannot match the predicate
+ * (inner max value for "occupied", indicator flags for "free"/"unknown"), so it is proportional
+ * to the nodes touched near the volume's boundary and the nodes reported, not to the volume.
+ */
+#ifndef OCC_QUERY_H_INCLUDED
+#define OCC_QUERY_H_INCLUDED
+
+#include "occmap/occmap.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- Volumes (caller-owned values; constructors validate and precompute) -------------------- */
+typedef enum {
+    OCC_VOL_AABB = 0,
+    OCC_VOL_OBB = 1,
+    OCC_VOL_SPHERE = 2,
+    OCC_VOL_CAPSULE = 3, /* the points within r of segment [a, b] (a swept sphere) */
+    OCC_VOL_FRUSTUM = 4, /* a view frustum (truncated pyramid); near 0 gives a pyramid */
+    OCC_VOL_SEGMENT = 5  /* the segment [a, b] itself */
+} occ_volume_kind_t;
+
+typedef struct {
+    occ_volume_kind_t kind;
+    occ_vec3_t bmin, bmax; /* axis-aligned bounds of the volume (the AABB itself for OCC_VOL_AABB) */
+    union {
+        struct { occ_vec3_t c; float r; } sphere;
+        struct { occ_vec3_t c; occ_vec3_t axis[3]; float half[3]; } obb;
+        struct { occ_vec3_t a, b; float r; } capsule; /* also the segment (r = 0) */
+        struct {
+            occ_vec3_t n[6];      /* outward plane normals (unit); inside: n.p <= d */
+            float d[6];
+            occ_vec3_t corner[8]; /* 0..3 near face, 4..7 far face (same order) */
+            occ_vec3_t left, up;  /* the camera's lateral axes (edges of near and far faces) */
+            occ_vec3_t origin;    /* the apex (sensor position) */
+        } frustum;
+    } u;
+} occ_volume_t;
+
+/* Each returns OCC_ERR_ARG (volume untouched) for a NULL pointer or any NaN/Inf input. O(1). */
+/* min <= max per axis (a flat box is valid). */
+occ_err_t occ_volume_aabb(occ_volume_t *v, occ_vec3_t min, occ_vec3_t max);
+/* radius >= 0 (0: the point). */
+occ_err_t occ_volume_sphere(occ_volume_t *v, occ_vec3_t center, float radius_m);
+/* Box of half extents half[i] >= 0 along axes[i]; the axes must be unit length and mutually
+ * orthogonal within 1e-3 (else OCC_ERR_ARG: degenerate axes). Either handedness. */
+occ_err_t occ_volume_obb(occ_volume_t *v, occ_vec3_t center, const float half_m[3],
+                         const occ_vec3_t axes[3]);
+/* OBB rotated by yaw (rad, about z) then shown as axes (cos,sin,0), (-sin,cos,0), (0,0,1). */
+occ_err_t occ_volume_obb_yaw(occ_volume_t *v, occ_vec3_t center, const float half_m[3],
+                             float yaw_rad);
+/* Capsule: radius >= 0; a == b gives a sphere. */
+occ_err_t occ_volume_capsule(occ_volume_t *v, occ_vec3_t a, occ_vec3_t b, float radius_m);
+occ_err_t occ_volume_segment(occ_volume_t *v, occ_vec3_t a, occ_vec3_t b);
+/* View frustum at `origin` looking along axes[0] with axes[1] = left, axes[2] = up (unit,
+ * orthogonal within 1e-3), full fields of view 0 < hfov, vfov < pi (rad), 0 <= near < far (m).
+ * OCC_ERR_ARG otherwise. */
+occ_err_t occ_volume_frustum(occ_volume_t *v, occ_vec3_t origin, const occ_vec3_t axes[3],
+                             float hfov_rad, float vfov_rad, float near_m, float far_m);
+
+/* Exact tests of a node cube (centre c, half edge h) against a volume (used by the iterator;
+ * exposed for tests and for callers with their own grids). O(1). */
+bool occ_volume_hits_box(const occ_volume_t *v, occ_vec3_t c, float h);
+/* True when the whole cube lies inside the volume (never for segments). */
+bool occ_volume_holds_box(const occ_volume_t *v, occ_vec3_t c, float h);
+
+/* ---- Predicates ------------------------------------------------------------------------------ */
+#define OCC_PRED_OCCUPIED 0x01u
+#define OCC_PRED_FREE 0x02u
+#define OCC_PRED_UNKNOWN 0x04u /* unobserved, or observed in the band free_max..occupied_min */
+#define OCC_PRED_ANY 0x07u
+
+/* Split uniform nodes that lie partly in the volume down to min_level (virtually: the tree is not
+ * touched), so that the reported nodes cover exactly the volume's cells at min_level; uniform
+ * nodes wholly inside stay whole (occ_query_node_t.inside). Without it a uniform (pruned) node is
+ * reported once, whatever its size. */
+#define OCC_ITER_SPLIT 0x01u
+
+typedef struct {
+    uint8_t states;    /* OR of OCC_PRED_*: report nodes in one of these states (0 = any) */
+    uint8_t min_level; /* do not descend below this level (0 = voxels). A node that has children
+                        * but sits at min_level is reported when it CONTAINS a wanted state
+                        * (indicators / max value); its `state` is then the state of its max. */
+    uint8_t options;   /* OCC_ITER_* */
+} occ_pred_t;
+
+/* One reported node. */
+typedef struct {
+    occ_key_t key;       /* first voxel of the node (lowest `level` bits clear) */
+    uint8_t level;
+    bool uniform;        /* no children below (all voxels share `logodds`/`state`) */
+    bool inside;         /* the whole node lies in the volume (computed with OCC_ITER_SPLIT only) */
+    bool observed;
+    occ_state_t state;
+    uint8_t flags;       /* OCC_NODE_HAS_* (and OCC_NODE_UNIFORM) */
+    float logodds;       /* max of the observed voxels below (0 if unobserved) */
+    occ_vec3_t center;   /* metres */
+    float size_m;        /* edge */
+} occ_query_node_t;
+
+/* The iterator: caller-owned, fixed-size (no heap), valid while `map` and `vol` are unchanged.
+ * Visits nodes depth first in Morton order (children 0..7), so reported nodes come sorted by
+ * Morton code of their first voxel. It does not start at the root: the volume's bounds fall in
+ * at most 2x2x2 nodes of the smallest level that can hold them, and the walk starts at those
+ * (reached by direct descent), so a small volume costs O(depth) plus the nodes near it.
+ * Fields are private. */
+typedef struct {
+    const occ_map_t *map;
+    const occ_volume_t *vol;
+    occ_pred_t pred;
+    uint8_t sp;            /* entries on the stack */
+    uint8_t base;          /* first stack entry of the current start node */
+    uint8_t virt_sp;       /* entries >= virt_sp are virtual (split of a uniform node) */
+    uint8_t start_level;   /* level of the start nodes */
+    uint8_t want_flags;    /* OCC_NODE_HAS_FREE / HAS_UNKNOWN bits wanted by the predicate */
+    uint8_t nstart, istart;
+    occ_value_t virt_value;
+    occ_key_t path;        /* key bits of the current node at each stack level */
+    occ_key_t start[8];    /* the start nodes, in Morton order */
+    uint32_t block[OCC_MAX_DEPTH]; /* block[D-L]: child block of the path node at level L */
+    uint8_t mask[OCC_MAX_DEPTH];  /* children of block[i] still to visit (match and touch) */
+} occ_query_iter_t;
+
+/* Start iterating the nodes of `map` that intersect `vol` and match `pred`. OCC_ERR_ARG for
+ * NULL, bad states bits, min_level > depth_levels. O(1). */
+occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_volume_t *vol,
+                          occ_pred_t pred);
+/* Next node; false when done. Amortized O(depth) per node touched. */
+bool occ_query_next(occ_query_iter_t *it, occ_query_node_t *out);
+
+/* Voxels (level 0) of the map inside `vol`, by state. Whole nodes inside the volume count
+ * 8^level voxels without being split. `outside` is true when the volume reaches beyond the map. */
+typedef struct {
+    uint64_t occupied, free, unknown;
+    bool outside;
+} occ_query_counts_t;
+occ_err_t occ_query_count(const occ_map_t *map, const occ_volume_t *vol, occ_query_counts_t *out);
+
+/* ---- Point lookups with a path cache ----------------------------------------------------------
+ * For streams of nearby points (a trajectory, a sensor footprint): the cursor keeps the path of
+ * the last voxel and re-descends only below the highest key bit that changed, so a lookup next to
+ * the previous one touches one or two blocks instead of depth_levels. Caller-owned, no heap;
+ * valid while the map is not modified (re-init after any write). */
+typedef struct {
+    const occ_map_t *map;
+    occ_key_t key;        /* last voxel looked up */
+    uint8_t lu;           /* level of the uniform node (or voxel) holding it */
+    bool valid;
+    occ_value_t val;
+    uint32_t blk[OCC_MAX_DEPTH + 1u]; /* blk[L]: child block of the path node at level L > lu */
+} occ_lookup_t;
+
+/* Start a cursor on `map`. O(1). */
+void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map);
+/* State of the voxel at `p`: exactly occ_map_state_at(map, p) (UNKNOWN for NaN or off-map).
+ * O(levels below the highest key bit that differs from the previous lookup). */
+occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p);
+
+/* ---- Nearest-first iteration -------------------------------------------------------------------- */
+typedef struct {
+    float dist2;       /* squared distance from the query point to the node cube */
+    uint32_t child;    /* child block, OCC_NONE if uniform */
+    occ_key_t key;
+    occ_value_t value;
+    uint8_t level;
+    uint8_t flags;
+} occ_nearest_entry_t;
+
+typedef struct {
+    const occ_map_t *map;
+    occ_vec3_t p;
+    float max_dist2;
+    occ_pred_t pred;
+    occ_nearest_entry_t *heap; /* caller buffer: a binary min-heap on dist2 */
+    size_t cap, n;
+} occ_nearest_t;
+
+/* Start a nearest-first search from `p` over nodes within `max_dist_m` (>= 0) that match `pred`
+ * (OCC_ITER_SPLIT is ignored: uniform nodes come whole, at their distance). `buf` holds `cap`
+ * entries (a few hundred suffice for max_dist of a few metres; each entry is a node waiting to
+ * be opened). OCC_ERR_ARG for NULL, NaN, negative distance, cap == 0. p may lie outside the map. */
+occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t p,
+                            float max_dist_m, occ_pred_t pred, occ_nearest_entry_t *buf,
+                            size_t cap);
+/* Next node by increasing distance (ties in any order): *found false when none is left.
+ * OCC_ERR_NOMEM when `buf` overflowed (the search stops; results so far were exact).
+ * O(log cap) per heap operation. `dist_m` (may be NULL) gets the point-to-cube distance. */
+occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist_m, bool *found);
+
+/* ---- Collision checks --------------------------------------------------------------------------- */
+typedef enum {
+    OCC_UNKNOWN_UNSAFE = 0, /* default: unknown and off-map space block (never flown through) */
+    OCC_UNKNOWN_SAFE = 1    /* unknown counts as free */
+} occ_unknown_policy_t;
+
+typedef struct {
+    bool safe;             /* no blocking node intersects the volume */
+    bool outside;          /* blocked (policy unsafe) because the volume leaves the map */
+    occ_query_node_t node; /* first blocking node in Morton order when !safe && !outside */
+} occ_collision_t;
+
+/* Is the volume free of OCCUPIED voxels (and of UNKNOWN ones and off-map space under
+ * OCC_UNKNOWN_UNSAFE)? Stops at the first blocking node. OCC_ERR_ARG for NULL, NaN/Inf, negative
+ * radius, degenerate axes, a policy outside the enum. */
+occ_err_t occ_collide_volume(const occ_map_t *map, const occ_volume_t *vol,
+                             occ_unknown_policy_t policy, occ_collision_t *out);
+occ_err_t occ_collide_sphere(const occ_map_t *map, occ_vec3_t center, float radius_m,
+                             occ_unknown_policy_t policy, occ_collision_t *out);
+occ_err_t occ_collide_aabb(const occ_map_t *map, occ_vec3_t min, occ_vec3_t max,
+                           occ_unknown_policy_t policy, occ_collision_t *out);
+occ_err_t occ_collide_obb(const occ_map_t *map, occ_vec3_t center, const float half_m[3],
+                          const occ_vec3_t axes[3], occ_unknown_policy_t policy,
+                          occ_collision_t *out);
+/* A sphere of radius_m swept from a to b. */
+occ_err_t occ_collide_capsule(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b, float radius_m,
+                              occ_unknown_policy_t policy, occ_collision_t *out);
+/* Distance from p to the nearest blocking node (policy as above, off-map space excluded),
+ * searched up to max_dist_m: *found false when none is that close. Buffer as occ_nearest_begin. */
+occ_err_t occ_distance_to_obstacle(const occ_map_t *map, occ_vec3_t p, float max_dist_m,
+                                   occ_unknown_policy_t policy, occ_nearest_entry_t *buf,
+                                   size_t cap, float *dist_m, bool *found);
+
+/* ---- Ray casts ---------------------------------------------------------------------------------- */
+typedef enum {
+    OCC_RAY_HIT = 0,       /* stopped on an occupied voxel */
+    OCC_RAY_MAX_RANGE = 1, /* the next voxel centre was beyond max_range */
+    OCC_RAY_UNKNOWN = 2,   /* entered an unknown voxel with ignore_unknown false */
+    OCC_RAY_MAP_EDGE = 3   /* reached the border of the map */
+} occ_ray_stop_t;
+
+typedef struct {
+    bool hit;           /* OctoMap's return value */
+    occ_ray_stop_t stop;
+    occ_key_t key;      /* the voxel the ray stopped in */
+    occ_vec3_t end;     /* its centre (OctoMap's `end`) */
+} occ_ray_result_t;
+
+/* OctoMap's castRay: walk the voxels from the one holding `origin` along `direction` (need not
+ * be unit) by 3D-DDA, voxel by voxel, and stop at the first OCCUPIED one (hit = true, its centre
+ * in end). An UNKNOWN voxel stops the ray with hit = false unless ignore_unknown; max_range_m > 0
+ * stops it (hit = false) at the first voxel whose centre is farther than max_range_m from the
+ * origin (<= 0: unbounded, up to the map border). The origin's own voxel is tested first.
+ * Same voxels, same ties and the same double arithmetic as OctoMap when OCC_RAY_DOUBLE.
+ * OCC_ERR_ARG: NULL, NaN/Inf, zero direction; OCC_ERR_RANGE: origin outside the map.
+ * O(voxels crossed), O(1) per voxel inside uniform (pruned) nodes. */
+occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
+                       bool ignore_unknown, float max_range_m, occ_ray_result_t *out);
+
+/* Line of sight from a to b: the voxels the segment crosses (3D-DDA from a's voxel to b's, both
+ * included) hold nothing OCCUPIED (nor UNKNOWN under OCC_UNKNOWN_UNSAFE). `blocker` (may be NULL)
+ * gets the first blocking voxel. OCC_ERR_ARG (NULL, NaN, bad policy), OCC_ERR_RANGE (a or b
+ * outside the map). O(voxels crossed). */
+occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
+                            occ_unknown_policy_t policy, bool *visible,
+                            occ_ray_result_t *blocker);
+
+/* ---- Information gain (UFOMap's exploration example) --------------------------------------------- */
+#define OCC_GAIN_OCCLUSION 0x01u /* count a cell only if the line of sight from the sensor origin
+                                  * (frustum apex / sphere centre) to its centre is not blocked by
+                                  * an occupied voxel (unknown does not block) */
+typedef struct {
+    uint64_t unknown_cells; /* cells at `level` intersecting the volume whose state is UNKNOWN */
+    float entropy_bits;     /* sum over those cells of H(p), p = sigmoid(max log-odds);
+                             * an unobserved cell contributes 1 bit */
+} occ_info_gain_t;
+
+/* Information gain of a sensor volume (typically a frustum or a sphere; any kind works) at cells
+ * of `level` (0 = voxels). A cell's state is the state of its max value, as occ_map_read_key.
+ * Cells outside the map are not counted. OCC_ERR_ARG for NULL, level > depth_levels, bad options.
+ * O(cells reported) (with OCC_GAIN_OCCLUSION times the ray length in voxels). */
+occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned level,
+                        unsigned options, occ_info_gain_t *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* OCC_QUERY_H_INCLUDED */

@@ -1,0 +1,53 @@
+# firmware.mk - the firmware build (issue 8), on top of `make cross`:
+#   - port/baremetal (weak CAN hooks, the example main) for Cortex-M4F and Cortex-M0+;
+#   - build/fw/example_m4.elf: the example image (startup, linker script, static arena, test cloud,
+#     DroneCAN through a stub driver) for qemu's mps2-an386 (Cortex-M4F), and its size table per
+#     module (text / data / bss from the link map), the worst -fstack-usage frames and a
+#     recursion check on the image's call graph (port/baremetal/fw_report.py);
+#   - build/fw/m4_selftest.elf: the core's self-test (tests/can/m4_selftest.c).
+# test-m4-qemu runs both images under qemu-system-arm with semihosting; their exit status is the
+# verdict (a fault exits 100, a hang ends in timeout's 124).
+APT_PKGS += qemu-system-arm gcc-arm-none-eabi libnewlib-arm-none-eabi
+
+FW_DIR := $(BUILD)/fw
+FW_LD := port/baremetal/mps2_an386.ld
+FW_LDFLAGS = $(CROSS_M4) -T $(FW_LD) -nostartfiles --specs=nano.specs --specs=rdimon.specs \
+              -Wl,--gc-sections
+FW_PORT_SRC := port/baremetal/can_hooks.c port/baremetal/example_main.c
+FW_M4_PORT_OBJ := $(FW_PORT_SRC:%.c=$(BUILD)/cross/m4/%.o) $(BUILD)/cross/m4/port/baremetal/startup_m4.o
+FW_M0_PORT_OBJ := $(FW_PORT_SRC:%.c=$(BUILD)/cross/m0/%.o)
+FW_SELFTEST_OBJ := $(BUILD)/cross/m4/tests/can/m4_selftest.o $(BUILD)/cross/m4/port/baremetal/startup_m4.o
+
+$(BUILD)/cross/m4/port/baremetal/startup_m4.o: EXTRA_CFLAGS += -DOCC_BM_SEMIHOSTING=1
+
+# The core for the images as an archive, so the link takes only the modules it needs.
+$(FW_DIR)/libocc_m4.a: $(patsubst %.c,$(BUILD)/cross/m4/%.o,$(OCC_CORE_SRC) $(OCC_FEED_SRC))
+	@mkdir -p $(dir $@)
+	@rm -f $@
+	arm-none-eabi-ar rcs $@ $^
+
+$(FW_DIR)/example_m4.elf: $(FW_M4_PORT_OBJ) $(FW_DIR)/libocc_m4.a $(FW_LD)
+	$(CROSS_CC) $(FW_LDFLAGS) -Wl,-Map=$@.map -o $@ $(FW_M4_PORT_OBJ) $(FW_DIR)/libocc_m4.a -lm
+
+$(FW_DIR)/m4_selftest.elf: $(FW_SELFTEST_OBJ) $(FW_DIR)/libocc_m4.a $(FW_LD)
+	$(CROSS_CC) $(FW_LDFLAGS) -Wl,-Map=$@.map -o $@ $(FW_SELFTEST_OBJ) $(FW_DIR)/libocc_m4.a -lm
+
+# Printed by `make cross` (a prerequisite of cross-objs, so it runs before cross_report.sh).
+firmware-report: $(FW_DIR)/example_m4.elf
+	@python3 port/baremetal/fw_report.py $(FW_DIR)/example_m4.elf $(BUILD)/cross/m4
+
+CROSS_EXTRA += $(FW_M4_PORT_OBJ) $(FW_M0_PORT_OBJ) $(FW_DIR)/example_m4.elf $(FW_DIR)/m4_selftest.elf \
+               firmware-report
+
+QEMU_ARM_RUN := timeout --foreground -k 2 60 qemu-system-arm -M mps2-an386 -nographic -monitor none \
+                -serial null -semihosting-config enable=on,target=native -kernel
+test-m4-qemu: $(FW_DIR)/m4_selftest.elf $(FW_DIR)/example_m4.elf
+	@command -v qemu-system-arm >/dev/null || { echo "SKIP test-m4-qemu: qemu-system-arm not installed (environment limit)"; exit 0; }
+	@set -e; for img in m4_selftest example_m4; do \
+	  t0=$$(date +%s%N); rc=0; \
+	  (cd $(FW_DIR) && $(QEMU_ARM_RUN) $$img.elf) || rc=$$?; \
+	  echo "qemu-system-arm mps2-an386: $$img.elf exit $$rc in $$(( ($$(date +%s%N) - t0) / 1000000 )) ms"; \
+	  [ $$rc -eq 0 ] || { echo "FAIL test-m4-qemu: $$img (100 = fault, 124 = hang, else failed checks)"; exit 1; }; \
+	done
+TEST_STEPS += test-m4-qemu
+.PHONY: firmware-report test-m4-qemu

@@ -1,0 +1,252 @@
+/* mavlink_feed.c - poses in, OBSTACLE_DISTANCE + HEARTBEAT out, on the caller's clock. */
+#include "occmap/occ_mavlink.h"
+
+#include <math.h>
+#include <string.h>
+
+#define MAV_TYPE_ONBOARD_CONTROLLER_ 18u
+#define MAV_AUTOPILOT_INVALID_ 8u
+#define MAV_STATE_ACTIVE_ 4u
+
+/* MAV_FRAME values whose positions are local NED-like: LOCAL_NED 1, VISION_NED 16,
+ * ESTIM_NED 18, LOCAL_FRD 20 (north/east replaced by the autopilot's local axes). */
+static bool odometry_frame_ok(uint8_t frame)
+{
+    return frame == 1u || frame == 16u || frame == 18u || frame == 20u;
+}
+
+occ_mav_feed_config_t occ_mav_feed_config_default(void)
+{
+    occ_mav_feed_config_t c;
+    c.sysid = 1u;
+    c.compid = OCC_MAV_COMP_ID_OBSTACLE_AVOIDANCE;
+    c.period_us = 100000u;
+    c.heartbeat_period_us = 1000000u;
+    c.pose_timeout_us = 300000u;
+    c.autopilot = OCC_AUTOPILOT_ARDUPILOT;
+    c.map_frame = OCC_MAP_FRAME_ENU;
+    c.sensor_type = 0u;
+    c.sectors = occ_sectors_config_default();
+    return c;
+}
+
+occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg)
+{
+    if (f == NULL || cfg == NULL || cfg->period_us == 0u || cfg->heartbeat_period_us == 0u ||
+        cfg->pose_timeout_us == 0u || occ_sectors_config_check(&cfg->sectors) != OCC_OK) {
+        return OCC_ERR_ARG;
+    }
+    if (cfg->autopilot != OCC_AUTOPILOT_ARDUPILOT && cfg->autopilot != OCC_AUTOPILOT_PX4) {
+        return OCC_ERR_ARG;
+    }
+    if (cfg->map_frame != OCC_MAP_FRAME_ENU && cfg->map_frame != OCC_MAP_FRAME_NED) {
+        return OCC_ERR_ARG;
+    }
+    if (cfg->autopilot == OCC_AUTOPILOT_PX4 &&
+        (float)cfg->sectors.n_sectors * cfg->sectors.increment_deg < 360.0f - 1e-3f) {
+        return OCC_ERR_ARG;
+    }
+    memset(f, 0, sizeof *f);
+    f->cfg = *cfg;
+    f->cfg.sectors.map_ned = cfg->map_frame == OCC_MAP_FRAME_NED;
+    occ_mav_parser_init(&f->parser);
+    f->tx.sysid = cfg->sysid;
+    f->tx.compid = cfg->compid;
+    f->tx.seq = 0;
+    return OCC_OK;
+}
+
+static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
+{
+    if (fr->sysid == f->cfg.sysid && fr->compid == f->cfg.compid) {
+        f->counters.ignored_rx++;
+        return;
+    }
+    switch (fr->msgid) {
+    case OCC_MAV_MSG_LOCAL_POSITION_NED: {
+        occ_mav_local_position_ned_t m;
+        if (occ_mav_decode_local_position_ned(fr, &m) == OCC_OK && isfinite(m.x) &&
+            isfinite(m.y) && isfinite(m.z)) {
+            f->north = m.x;
+            f->east = m.y;
+            f->down = m.z;
+            f->pos_us = now_us;
+            f->have_pos = true;
+            f->counters.positions_rx++;
+            return;
+        }
+        break;
+    }
+    case OCC_MAV_MSG_ATTITUDE: {
+        occ_mav_attitude_t m;
+        if (occ_mav_decode_attitude(fr, &m) == OCC_OK && isfinite(m.yaw)) {
+            f->yaw_ned = m.yaw;
+            f->roll = m.roll;
+            f->pitch = m.pitch;
+            f->att_us = now_us;
+            f->have_att = true;
+            f->counters.attitudes_rx++;
+            return;
+        }
+        break;
+    }
+    case OCC_MAV_MSG_ATTITUDE_QUATERNION: {
+        occ_mav_attitude_quaternion_t m;
+        if (occ_mav_decode_attitude_quaternion(fr, &m) == OCC_OK) {
+            const float yaw = occ_mav_quat_yaw(m.q, &f->roll, &f->pitch);
+            if (isfinite(yaw)) {
+                f->yaw_ned = yaw;
+                f->att_us = now_us;
+                f->have_att = true;
+                f->counters.attitudes_rx++;
+                return;
+            }
+        }
+        break;
+    }
+    case OCC_MAV_MSG_ODOMETRY: {
+        occ_mav_odometry_t m;
+        if (occ_mav_decode_odometry(fr, &m) == OCC_OK && odometry_frame_ok(m.frame_id) &&
+            isfinite(m.x) && isfinite(m.y) && isfinite(m.z)) {
+            float roll, pitch;
+            const float yaw = occ_mav_quat_yaw(m.q, &roll, &pitch);
+            if (isfinite(yaw)) {
+                f->north = m.x;
+                f->east = m.y;
+                f->down = m.z;
+                f->yaw_ned = yaw;
+                f->roll = roll;
+                f->pitch = pitch;
+                f->pos_us = now_us;
+                f->att_us = now_us;
+                f->have_pos = true;
+                f->have_att = true;
+                f->counters.positions_rx++;
+                f->counters.attitudes_rx++;
+                return;
+            }
+        }
+        break;
+    }
+    default:
+        break;
+    }
+    f->counters.ignored_rx++;
+}
+
+void occ_mav_feed_rx(occ_mav_feed_t *f, const uint8_t *data, size_t n, uint64_t now_us)
+{
+    if (f == NULL || data == NULL) {
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        occ_mav_frame_t fr;
+        if (occ_mav_parser_push(&f->parser, data[i], &fr) == OCC_MAV_OK) {
+            take_frame(f, &fr, now_us);
+        }
+    }
+}
+
+bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose)
+{
+    if (f == NULL || !f->have_pos || !f->have_att) {
+        return false;
+    }
+    const uint64_t t = f->cfg.pose_timeout_us;
+    const bool fresh = now_us >= f->pos_us && now_us >= f->att_us && now_us - f->pos_us <= t &&
+                       now_us - f->att_us <= t;
+    if (pose != NULL) {
+        if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
+            pose->x = f->north;
+            pose->y = f->east;
+            pose->z = f->down;
+            pose->yaw_rad = f->yaw_ned;
+        } else {
+            *pose = occ_pose_from_ned(f->north, f->east, f->down, f->yaw_ned);
+        }
+        pose->roll_rad = f->roll;
+        pose->pitch_rad = f->pitch;
+    }
+    return fresh;
+}
+
+uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f)
+{
+    if (f == NULL || !f->started) {
+        return 0;
+    }
+    return f->next_obstacle_us < f->next_heartbeat_us ? f->next_obstacle_us : f->next_heartbeat_us;
+}
+
+/* Advance a deadline past now by whole periods. */
+static uint64_t advance(uint64_t due, uint32_t period, uint64_t now_us)
+{
+    due += period;
+    if (due <= now_us) {
+        due = now_us + period - ((now_us - due) % period);
+    }
+    return due;
+}
+
+size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_us, uint8_t *out,
+                         size_t cap)
+{
+    if (f == NULL || out == NULL || cap < OCC_MAV_FRAME_MAX) {
+        return 0;
+    }
+    if (!f->started) {
+        f->started = true;
+        f->next_heartbeat_us = now_us;
+        f->next_obstacle_us = now_us;
+    }
+    if (now_us >= f->next_heartbeat_us) {
+        f->next_heartbeat_us = advance(f->next_heartbeat_us, f->cfg.heartbeat_period_us, now_us);
+        occ_mav_heartbeat_t hb;
+        hb.custom_mode = 0;
+        hb.type = MAV_TYPE_ONBOARD_CONTROLLER_;
+        hb.autopilot = MAV_AUTOPILOT_INVALID_;
+        hb.base_mode = 0;
+        hb.system_status = MAV_STATE_ACTIVE_;
+        hb.mavlink_version = 3;
+        const size_t n = occ_mav_encode_heartbeat(&f->tx, &hb, out, cap);
+        if (n > 0u) {
+            f->counters.heartbeat_tx++;
+        }
+        return n;
+    }
+    if (now_us < f->next_obstacle_us) {
+        return 0;
+    }
+    f->next_obstacle_us = advance(f->next_obstacle_us, f->cfg.period_us, now_us);
+    occ_pose_t pose;
+    if (map == NULL || !occ_mav_feed_pose(f, now_us, &pose)) {
+        f->counters.stale_skips++;
+        return 0;
+    }
+    const occ_sectors_config_t *const sc = &f->cfg.sectors;
+    if (occ_sectors_compute(map, &pose, sc, &f->sectors) != OCC_OK) {
+        f->counters.sector_errors++;
+        return 0;
+    }
+    occ_mav_obstacle_distance_t m;
+    m.time_usec = now_us;
+    m.sensor_type = f->cfg.sensor_type;
+    for (unsigned i = 0; i < 72u; i++) {
+        m.distances[i] = i < f->sectors.n ? f->sectors.distance_cm[i] : UINT16_MAX;
+    }
+    const float inc = sc->increment_deg;
+    m.increment = 0;
+    if (f->cfg.autopilot == OCC_AUTOPILOT_ARDUPILOT && inc >= 1.0f && inc <= 255.0f) {
+        m.increment = (uint8_t)(inc + 0.5f);
+    }
+    m.min_distance = sc->min_distance_cm;
+    m.max_distance = sc->max_distance_cm;
+    m.increment_f = inc;
+    m.angle_offset = sc->angle_offset_deg;
+    m.frame = OCC_MAV_FRAME_BODY_FRD;
+    const size_t n = occ_mav_encode_obstacle_distance(&f->tx, &m, out, cap);
+    if (n > 0u) {
+        f->counters.obstacle_tx++;
+    }
+    return n;
+}

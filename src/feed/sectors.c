@@ -1,0 +1,597 @@
+/* sectors.c - nearest occupied / unknown footprint per horizontal sector (see occ_feed.h). */
+#include "occmap/occ_feed.h"
+
+#include <math.h>
+
+#define PI_F 3.14159265358979f
+#define TWO_PI_F 6.28318530717959f
+#define DEG2RAD_F 0.0174532925199433f
+
+enum { KIND_OCC = 0, KIND_UNK = 1 };
+
+/* Everything one computation needs besides `out`. Kept small: it lives on the C stack. */
+typedef struct {
+    float px, py;          /* vehicle, map metres */
+    float yaw;             /* map yaw, rad */
+    float offset;          /* rad */
+    float inc;             /* rad */
+    float inv_inc;
+    float period;          /* sector positions per turn: 2 pi / inc */
+    float range;           /* search radius, metres */
+    uint8_t n;
+    float sgn;             /* +1 ENU (body angles run against bearings), -1 NED */
+    float margin;          /* sector units within which fast_atan2f may be wrong */
+    bool full;             /* the sectors cover the whole turn */
+    float bound;           /* >= max over sectors of min(d_occ, d_unk); exact when !dirty */
+    bool dirty;
+} ctx_t;
+
+occ_pose_t occ_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad)
+{
+    occ_pose_t p;
+    float yaw = 0.5f * PI_F - yaw_ned_rad;
+    if (isfinite(yaw)) {
+        yaw = fmodf(yaw, TWO_PI_F);
+        if (yaw > PI_F) {
+            yaw -= TWO_PI_F;
+        } else if (yaw <= -PI_F) {
+            yaw += TWO_PI_F;
+        }
+    }
+    p.x = east_m;
+    p.y = north_m;
+    p.z = -down_m;
+    p.yaw_rad = yaw;
+    p.roll_rad = 0.0f;
+    p.pitch_rad = 0.0f;
+    return p;
+}
+
+occ_sectors_config_t occ_sectors_config_default(void)
+{
+    occ_sectors_config_t c;
+    c.n_sectors = 72u;
+    c.increment_deg = 5.0f;
+    c.angle_offset_deg = 0.0f;
+    c.band_below_m = 0.5f;
+    c.band_above_m = 0.5f;
+    c.min_distance_cm = 20u;
+    c.max_distance_cm = 2000u;
+    c.unknown_as_distance = false;
+    c.map_ned = false;
+    return c;
+}
+
+occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg)
+{
+    if (cfg == NULL || cfg->n_sectors < 1u || cfg->n_sectors > OCC_SECTORS_MAX) {
+        return OCC_ERR_ARG;
+    }
+    if (!isfinite(cfg->increment_deg) || !(cfg->increment_deg > 0.0f) ||
+        cfg->increment_deg > 90.0f ||
+        (float)cfg->n_sectors * cfg->increment_deg > 360.0f + 1e-3f) {
+        return OCC_ERR_ARG;
+    }
+    if (!isfinite(cfg->angle_offset_deg) || !isfinite(cfg->band_below_m) ||
+        !isfinite(cfg->band_above_m) || cfg->band_below_m < 0.0f || cfg->band_above_m < 0.0f ||
+        !(cfg->band_below_m + cfg->band_above_m > 0.0f)) {
+        return OCC_ERR_ARG;
+    }
+    if (cfg->min_distance_cm < 1u || cfg->min_distance_cm >= cfg->max_distance_cm ||
+        cfg->max_distance_cm > 65534u) {
+        return OCC_ERR_ARG;
+    }
+    return OCC_OK;
+}
+
+/* floor() of a float well inside the int32 range, without a libm call (no SSE4.1 baseline). */
+static int32_t ifloor(float v)
+{
+    const int32_t i = (int32_t)v;
+    return (float)i > v ? i - 1 : i;
+}
+
+static float clampf(float v, float lo, float hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+
+/* Wrap a sector-unit angle into [0, period). Inputs stay within a few turns (yaw and offset are
+ * normalized once per call), so a loop beats fmodf. */
+static float wrap_units(float u, float period)
+{
+    while (u < 0.0f) {
+        u += period;
+    }
+    while (u >= period) {
+        u -= period;
+    }
+    return u;
+}
+
+/* atan2 within ~1e-5 rad (a minimax polynomial on [0, 1]); callers that decide sector
+ * membership re-check near boundaries with exact cross products. */
+static float fast_atan2f(float y, float x)
+{
+    const float ax = fabsf(x);
+    const float ay = fabsf(y);
+    const float mx = ax > ay ? ax : ay;
+    const float mn = ax > ay ? ay : ax;
+    if (!(mx > 0.0f)) {
+        return 0.0f;
+    }
+    const float t = mn / mx;
+    const float s = t * t;
+    float r = (((0.0208351f * s - 0.0851330f) * s + 0.1801410f) * s - 0.3302995f) * s * t +
+              0.9998660f * t;
+    if (ay > ax) {
+        r = 0.5f * PI_F - r;
+    }
+    if (x < 0.0f) {
+        r = PI_F - r;
+    }
+    return y < 0.0f ? -r : r;
+}
+
+/* Sector units of a map bearing: 0 at the lower edge of sector 0, +1 per sector (clockwise). */
+static float units_of_bearing(const ctx_t *c, float bearing)
+{
+    return wrap_units((c->sgn * (c->yaw - bearing) - c->offset) * c->inv_inc + 0.5f, c->period);
+}
+
+/* Sector holding the vehicle-relative point (x, y), or -1 when none does. Exact at the
+ * boundaries: a point within `margin` of one is placed with a cross product against the same
+ * boundary ray the distance code uses. */
+static int32_t sector_of_point(const ctx_t *c, const occ_sectors_t *out, float x, float y)
+{
+    const float u = units_of_bearing(c, fast_atan2f(y, x));
+    int32_t p = ifloor(u);
+    const float frac = u - (float)p;
+    const int32_t n = (int32_t)c->n;
+    if (frac < c->margin && p <= n) {
+        /* In p iff the point is at or past ray p (clockwise in ENU). */
+        const float cr = c->sgn * (out->ray_c[p] * y - out->ray_s[p] * x);
+        if (cr > 0.0f) {
+            p = p > 0 ? p - 1 : (c->full ? n - 1 : -1);
+        }
+    } else if (frac > 1.0f - c->margin && p + 1 <= n) {
+        const float cr = c->sgn * (out->ray_c[p + 1] * y - out->ray_s[p + 1] * x);
+        if (cr <= 0.0f) {
+            p = p + 1;
+        }
+    }
+    if (p >= n) {
+        p = (c->full && p == n) ? 0 : -1;
+    }
+    return p;
+}
+
+/* Entry distance of boundary ray k into the rectangle (vehicle-relative), or -1 on a miss. */
+static float ray_entry(const occ_sectors_t *out, unsigned k, float ax0, float ay0, float ax1,
+                       float ay1)
+{
+    const float dc = out->ray_c[k];
+    const float ds = out->ray_s[k];
+    float tmin = 0.0f;
+    float tmax = OCC_SECTORS_FAR;
+    if (fabsf(dc) < 1e-20f) {
+        if (ax0 > 0.0f || ax1 < 0.0f) {
+            return -1.0f;
+        }
+    } else {
+        float t1 = ax0 / dc;
+        float t2 = ax1 / dc;
+        if (t1 > t2) {
+            const float t = t1;
+            t1 = t2;
+            t2 = t;
+        }
+        tmin = t1 > tmin ? t1 : tmin;
+        tmax = t2 < tmax ? t2 : tmax;
+    }
+    if (fabsf(ds) < 1e-20f) {
+        if (ay0 > 0.0f || ay1 < 0.0f) {
+            return -1.0f;
+        }
+    } else {
+        float t1 = ay0 / ds;
+        float t2 = ay1 / ds;
+        if (t1 > t2) {
+            const float t = t1;
+            t1 = t2;
+            t2 = t;
+        }
+        tmin = t1 > tmin ? t1 : tmin;
+        tmax = t2 < tmax ? t2 : tmax;
+    }
+    return tmin <= tmax ? tmin : -1.0f;
+}
+
+static void take(ctx_t *c, occ_sectors_t *out, int kind, unsigned s, float d)
+{
+    float *const best = kind == KIND_OCC ? out->d_occ_m : out->d_unk_m;
+    if (d < best[s]) {
+        best[s] = d;
+        c->dirty = true;
+    }
+}
+
+/* Fold the sectors of one linear stretch [a, b] of sector units. */
+static void fold_units(ctx_t *c, occ_sectors_t *out, int kind, float a, float b, int32_t sq,
+                       float dnear, const float rect[4])
+{
+    const int32_t s_lo = ifloor(a);
+    int32_t s_hi = ifloor(b);
+    if (s_hi > (int32_t)c->n - 1) {
+        s_hi = (int32_t)c->n - 1;
+    }
+    for (int32_t s = s_lo < 0 ? 0 : s_lo; s <= s_hi; s++) {
+        float d;
+        if (s == sq) {
+            d = dnear;
+        } else {
+            const float d0 = ray_entry(out, (unsigned)s, rect[0], rect[1], rect[2], rect[3]);
+            const float d1 = ray_entry(out, (unsigned)s + 1u, rect[0], rect[1], rect[2], rect[3]);
+            if (d0 < 0.0f && d1 < 0.0f) {
+                continue; /* the padded span reached a sector the rectangle misses */
+            } else if (d0 < 0.0f) {
+                d = d1;
+            } else if (d1 < 0.0f) {
+                d = d0;
+            } else {
+                d = d0 < d1 ? d0 : d1;
+            }
+        }
+        if (d < c->range) {
+            take(c, out, kind, (unsigned)s, d);
+        }
+    }
+}
+
+/* Fold one non-free axis-aligned footprint [x0,x1] x [y0,y1] (map metres) into the sectors. */
+static void fold_rect(ctx_t *c, occ_sectors_t *out, int kind, float x0, float y0, float x1,
+                      float y1)
+{
+    float rect[4];
+    rect[0] = x0 - c->px;
+    rect[1] = y0 - c->py;
+    rect[2] = x1 - c->px;
+    rect[3] = y1 - c->py;
+    const float qx = clampf(0.0f, rect[0], rect[2]);
+    const float qy = clampf(0.0f, rect[1], rect[3]);
+    const float dnear = sqrtf(qx * qx + qy * qy);
+    if (dnear >= c->range) {
+        return;
+    }
+    out->leaves_used++;
+    if (!(dnear > 0.0f)) {
+        for (unsigned s = 0; s < c->n; s++) {
+            take(c, out, kind, s, 0.0f);
+        }
+        return;
+    }
+    /* The two silhouette corners, chosen by where the rectangle lies. */
+    const int cx = rect[0] > 0.0f ? 1 : (rect[2] < 0.0f ? -1 : 0);
+    const int cy = rect[1] > 0.0f ? 1 : (rect[3] < 0.0f ? -1 : 0);
+    float e1x, e1y, e2x, e2y;
+    if (cy == 0) {
+        e1x = cx > 0 ? rect[0] : rect[2];
+        e2x = e1x;
+        e1y = rect[1];
+        e2y = rect[3];
+    } else if (cx == 0) {
+        e1y = cy > 0 ? rect[1] : rect[3];
+        e2y = e1y;
+        e1x = rect[0];
+        e2x = rect[2];
+    } else if (cx == cy) { /* NE or SW quadrant */
+        e1x = rect[0];
+        e1y = rect[3];
+        e2x = rect[2];
+        e2y = rect[1];
+    } else {               /* NW or SE quadrant */
+        e1x = rect[0];
+        e1y = rect[1];
+        e2x = rect[2];
+        e2y = rect[3];
+    }
+    const float b1 = fast_atan2f(e1y, e1x);
+    const float b2 = fast_atan2f(e2y, e2x);
+    float w = b2 - b1;
+    if (w < 0.0f) {
+        w += TWO_PI_F;
+    }
+    float hi_bearing = b2;
+    if (w > PI_F) {
+        w = TWO_PI_F - w;
+        hi_bearing = b1;
+    }
+    /* ENU: body angles run against bearings, the highest bearing is the lowest body angle. */
+    /* Padded by the atan error: extra sectors are rejected exactly in fold_units. */
+    const float u_lo = wrap_units(
+        units_of_bearing(c, c->sgn > 0.0f ? hi_bearing : hi_bearing - w) - c->margin, c->period);
+    const float u_hi = u_lo + w * c->inv_inc + 2.0f * c->margin;
+    const int32_t sq = sector_of_point(c, out, qx, qy);
+    if (u_hi < c->period) {
+        fold_units(c, out, kind, u_lo, u_hi, sq, dnear, rect);
+    } else {
+        fold_units(c, out, kind, u_lo, c->period, sq, dnear, rect);
+        fold_units(c, out, kind, 0.0f, u_hi - c->period, sq, dnear, rect);
+    }
+}
+
+static bool range_open(const ctx_t *c, const occ_sectors_t *out, float a, float b, float dmin)
+{
+    int32_t hi = ifloor(b);
+    if (hi > (int32_t)c->n - 1) {
+        hi = (int32_t)c->n - 1;
+    }
+    for (int32_t s = ifloor(a); s <= hi; s++) {
+        if (s >= 0) {
+            /* Open unless an obstacle is at or nearer than dmin (a tie cannot change it) or
+             * unknown is strictly nearer (an obstacle at the same distance would win). */
+            if (out->d_occ_m[s] > dmin && out->d_unk_m[s] >= dmin) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+/* True if some sector the square (vehicle-relative corner ax0, ay0, edge `size`) may touch has
+ * not yet found anything at or nearer than dmin. Conservative span: centre bearing +- the angle
+ * of the circumscribed circle. */
+static bool sectors_open(const ctx_t *c, const occ_sectors_t *out, float ax0, float ay0,
+                         float size, float dmin)
+{
+    const float hs = 0.5f * size;
+    const float cx = ax0 + hs;
+    const float cy = ay0 + hs;
+    const float dc = sqrtf(cx * cx + cy * cy);
+    const float r = hs * 1.41421356f;
+    if (dc <= r * 1.01f) {
+        return true;
+    }
+    /* tan(asin(r / dc)) >= asin(r / dc): a cheap, wider half angle. */
+    const float half_w = r / sqrtf(dc * dc - r * r) * c->inv_inc + 0.01f;
+    const float w = 2.0f * half_w;
+    if (w >= c->period) {
+        return true;
+    }
+    const float lo = units_of_bearing(c, fast_atan2f(cy, cx)) - half_w;
+    const float a = lo < 0.0f ? lo + c->period : lo;
+    if (range_open(c, out, a, a + w < c->period ? a + w : c->period, dmin)) {
+        return true;
+    }
+    return a + w > c->period && range_open(c, out, 0.0f, a + w - c->period, dmin);
+}
+
+static float refresh_bound(ctx_t *c, const occ_sectors_t *out)
+{
+    if (c->dirty) {
+        float m = 0.0f;
+        for (unsigned s = 0; s < c->n; s++) {
+            const float b = out->d_occ_m[s] < out->d_unk_m[s] ? out->d_occ_m[s] : out->d_unk_m[s];
+            m = b > m ? b : m;
+        }
+        c->bound = m;
+        c->dirty = false;
+    }
+    return c->bound;
+}
+
+static int32_t key_of(float v, float inv_res, int32_t half)
+{
+    return (int32_t)floorf(v * inv_res) + half;
+}
+
+static int32_t clamp_key(int32_t k, int32_t hi)
+{
+    return k < 0 ? 0 : (k > hi ? hi : k);
+}
+
+static uint16_t to_cm(float d, const occ_sectors_config_t *cfg)
+{
+    const float cm = floorf(d * 100.0f);
+    if (cm <= (float)cfg->min_distance_cm) {
+        return cfg->min_distance_cm;
+    }
+    if (cm >= (float)cfg->max_distance_cm) {
+        return cfg->max_distance_cm;
+    }
+    return (uint16_t)cm;
+}
+
+occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
+                              const occ_sectors_config_t *cfg, occ_sectors_t *out)
+{
+    if (out == NULL) {
+        return OCC_ERR_ARG;
+    }
+    out->n = 0;
+    out->nodes_read = 0;
+    out->leaves_used = 0;
+    if (map == NULL || pose == NULL || occ_sectors_config_check(cfg) != OCC_OK ||
+        !isfinite(pose->x) || !isfinite(pose->y) || !isfinite(pose->z) ||
+        !isfinite(pose->yaw_rad)) {
+        return OCC_ERR_ARG;
+    }
+    const unsigned depth = map->cfg.depth_levels;
+    const float res = map->cfg.resolution_m;
+    const float inv_res = 1.0f / res;
+    const int32_t half = (int32_t)1 << (depth - 1u);
+    const int32_t kmax = ((int32_t)1 << depth) - 1;
+    const float vol_lo = -(float)half * res;
+    const float vol_hi = (float)half * res;
+    if (pose->x < vol_lo || pose->x >= vol_hi || pose->y < vol_lo || pose->y >= vol_hi ||
+        pose->z < vol_lo || pose->z >= vol_hi) {
+        return OCC_ERR_RANGE;
+    }
+
+    ctx_t c;
+    c.px = pose->x;
+    c.py = pose->y;
+    c.yaw = fmodf(pose->yaw_rad, TWO_PI_F);
+    c.offset = fmodf(cfg->angle_offset_deg * DEG2RAD_F, TWO_PI_F);
+    c.inc = cfg->increment_deg * DEG2RAD_F;
+    c.inv_inc = 1.0f / c.inc;
+    c.period = 360.0f / cfg->increment_deg;
+    c.range = (float)cfg->max_distance_cm * 0.01f;
+    c.n = cfg->n_sectors;
+    c.sgn = cfg->map_ned ? -1.0f : 1.0f;
+    c.margin = 3e-4f * c.inv_inc;
+    c.full = c.period - (float)c.n < 1e-3f;
+    c.bound = OCC_SECTORS_FAR;
+    c.dirty = false;
+    for (unsigned s = 0; s < c.n; s++) {
+        out->d_occ_m[s] = OCC_SECTORS_FAR;
+        out->d_unk_m[s] = OCC_SECTORS_FAR;
+    }
+    for (unsigned k = 0; k <= c.n; k++) {
+        /* Boundary k: body angle offset + (k - 1/2) inc, clockwise; map angle yaw - that. */
+        const float a = c.yaw - c.sgn * (c.offset + ((float)k - 0.5f) * c.inc);
+        out->ray_c[k] = cosf(a);
+        out->ray_s[k] = sinf(a);
+    }
+
+    /* Space outside the map volume is unknown. */
+    const float za = pose->z - (cfg->map_ned ? cfg->band_above_m : cfg->band_below_m);
+    const float zb = pose->z + (cfg->map_ned ? cfg->band_below_m : cfg->band_above_m);
+    const float r = c.range;
+    if (za < vol_lo || zb > vol_hi) {
+        fold_rect(&c, out, KIND_UNK, c.px - r, c.py - r, c.px + r, c.py + r);
+    }
+    if (c.px - r < vol_lo) {
+        fold_rect(&c, out, KIND_UNK, vol_lo - 2.0f * r - 1.0f, c.py - r - 1.0f, vol_lo,
+                  c.py + r + 1.0f);
+    }
+    if (c.px + r > vol_hi) {
+        fold_rect(&c, out, KIND_UNK, vol_hi, c.py - r - 1.0f, vol_hi + 2.0f * r + 1.0f,
+                  c.py + r + 1.0f);
+    }
+    if (c.py - r < vol_lo) {
+        fold_rect(&c, out, KIND_UNK, c.px - r - 1.0f, vol_lo - 2.0f * r - 1.0f, c.px + r + 1.0f,
+                  vol_lo);
+    }
+    if (c.py + r > vol_hi) {
+        fold_rect(&c, out, KIND_UNK, c.px - r - 1.0f, vol_hi, c.px + r + 1.0f,
+                  vol_hi + 2.0f * r + 1.0f);
+    }
+
+    /* Key box of the search cylinder; the band is half-open [za, zb). */
+    int32_t lo[3], hi[3];
+    lo[0] = clamp_key(key_of(c.px - r, inv_res, half), kmax);
+    hi[0] = clamp_key(key_of(c.px + r, inv_res, half), kmax);
+    lo[1] = clamp_key(key_of(c.py - r, inv_res, half), kmax);
+    hi[1] = clamp_key(key_of(c.py + r, inv_res, half), kmax);
+    lo[2] = clamp_key(key_of(za, inv_res, half), kmax);
+    hi[2] = clamp_key((int32_t)ceilf(zb * inv_res) - 1 + half, kmax);
+    if (hi[2] < lo[2]) {
+        hi[2] = lo[2];
+    }
+
+    /* Depth-first, nearest child first: close to best-first in the nodes it reads (a heap
+     * read 10% fewer and ran slower), with a stack of at most 7 entries per level. */
+    unsigned sp = 0;
+    unsigned pops = 0;
+    occ_map_node_root(map, &out->stack[0].node);
+    out->stack[0].dmin = 0.0f;
+    sp = 1;
+    while (sp > 0) {
+        const occ_sectors_item_t it = out->stack[--sp];
+        if ((++pops & 15u) == 0u) {
+            (void)refresh_bound(&c, out);
+        }
+        if (it.dmin > c.bound) {
+            continue;
+        }
+        const float size = res * (float)((uint32_t)1 << it.node.level);
+        const float x0 = (float)((int32_t)it.node.key.k[0] - half) * res;
+        const float y0 = (float)((int32_t)it.node.key.k[1] - half) * res;
+        if (it.dmin > 0.0f && !sectors_open(&c, out, x0 - c.px, y0 - c.py, size, it.dmin)) {
+            continue;
+        }
+        const occ_node_t *const info = &it.node;
+        out->nodes_read++;
+        const bool uniform = info->level == 0u || (info->flags & OCC_NODE_UNIFORM) != 0u;
+        if (uniform) {
+            const occ_state_t st = info->observed ? info->state : OCC_STATE_UNKNOWN;
+            if (st == OCC_STATE_FREE) {
+                continue;
+            }
+            fold_rect(&c, out, st == OCC_STATE_OCCUPIED ? KIND_OCC : KIND_UNK, x0, y0,
+                      x0 + size, y0 + size);
+            continue;
+        }
+        const uint8_t kinds = (uint8_t)(info->flags & (OCC_NODE_HAS_OCCUPIED | OCC_NODE_HAS_UNKNOWN |
+                                                      OCC_NODE_HAS_FREE));
+        if ((kinds & (OCC_NODE_HAS_OCCUPIED | OCC_NODE_HAS_UNKNOWN)) == 0u) {
+            continue;
+        }
+        if (kinds == OCC_NODE_HAS_OCCUPIED || kinds == OCC_NODE_HAS_UNKNOWN) {
+            /* Every voxel below has the same state (values differ): the whole footprint. */
+            fold_rect(&c, out, kinds == OCC_NODE_HAS_OCCUPIED ? KIND_OCC : KIND_UNK, x0, y0,
+                      x0 + size, y0 + size);
+            continue;
+        }
+        /* Children inside the key box, pushed farthest first so the nearest pops next. The
+         * horizontal distance depends on the x and y halves only: four values. */
+        const unsigned cl = info->level - 1u;
+        const uint32_t step = (uint32_t)1 << cl;
+        const float csize = size * 0.5f;
+        bool in[3][2];
+        for (unsigned a = 0; a < 3u; a++) {
+            for (unsigned hh = 0; hh < 2u; hh++) {
+                const int32_t k0 = (int32_t)(info->key.k[a] + (hh != 0u ? step : 0u));
+                in[a][hh] = k0 <= hi[a] && k0 + (int32_t)step - 1 >= lo[a];
+            }
+        }
+        float dxy[4];
+        for (unsigned q = 0; q < 4u; q++) {
+            const float cx0 = x0 + ((q & 1u) != 0u ? csize : 0.0f) - c.px;
+            const float cy0 = y0 + ((q & 2u) != 0u ? csize : 0.0f) - c.py;
+            const float qx = clampf(0.0f, cx0, cx0 + csize);
+            const float qy = clampf(0.0f, cy0, cy0 + csize);
+            dxy[q] = sqrtf(qx * qx + qy * qy);
+        }
+        uint8_t kid[8];
+        float kid_d[8];
+        unsigned nk = 0;
+        for (unsigned ci = 0; ci < 8u; ci++) {
+            const float dm = dxy[ci & 3u];
+            if (!in[0][ci & 1u] || !in[1][(ci >> 1) & 1u] || !in[2][(ci >> 2) & 1u] || dm >= r ||
+                dm > c.bound) {
+                continue;
+            }
+            unsigned j = nk++;
+            while (j > 0u && kid_d[j - 1u] < dm) {
+                kid[j] = kid[j - 1u];
+                kid_d[j] = kid_d[j - 1u];
+                j--;
+            }
+            kid[j] = (uint8_t)ci;
+            kid_d[j] = dm;
+        }
+        for (unsigned j = 0; j < nk && sp < OCC_SECTORS_STACK; j++) {
+            occ_sectors_item_t *const ch = &out->stack[sp++];
+            (void)occ_map_node_child(map, info, kid[j], &ch->node);
+            ch->dmin = kid_d[j];
+        }
+    }
+
+    for (unsigned s = 0; s < c.n; s++) {
+        const float dO = out->d_occ_m[s];
+        const float dU = out->d_unk_m[s];
+        uint16_t v;
+        if (dO <= dU && dO < r) {
+            v = to_cm(dO, cfg);
+        } else if (dU < r) {
+            v = cfg->unknown_as_distance ? to_cm(dU, cfg) : OCC_SECTORS_UNKNOWN;
+        } else {
+            v = cfg->max_distance_cm;
+        }
+        out->distance_cm[s] = v;
+    }
+    out->n = c.n;
+    return OCC_OK;
+}

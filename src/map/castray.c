@@ -1,0 +1,476 @@
+/*
+ * castray.c - OctoMap's castRay (3D-DDA, Amanatides & Woo) and line of sight.
+ * The voxel sequence, the tie rule and the arithmetic are OctoMap's (double on hosts when
+ * OCC_RAY_DOUBLE); what differs is the lookup: instead of a search from the root per voxel, a
+ * cursor keeps the path to the current voxel and re-descends only below the highest key bit that
+ * changed, and not at all while the ray stays inside a uniform (pruned) node.
+ */
+#include <float.h>
+#include "map/query_internal.h"
+
+#if OCC_RAY_DOUBLE
+typedef double real_t;
+#define REAL_MAX DBL_MAX
+#define RSQRT sqrt
+#else
+typedef float real_t;
+#define REAL_MAX FLT_MAX
+#define RSQRT sqrtf
+#endif
+
+/* The path from the root to the node holding the current voxel. */
+typedef struct {
+    const occ_map_t *m;
+    uint32_t key[3];
+    unsigned lu;      /* level of the deepest node on the path (uniform, or 0) */
+    occ_value_t val;  /* its value */
+    uint32_t blk[OCC_MAX_DEPTH + 1u]; /* blk[L]: child block of the path node at level L > lu */
+} cursor_t;
+
+static void descend(cursor_t *c, unsigned level)
+{
+    const occ_map_t *const m = c->m;
+    uint32_t b = c->blk[level];
+    if (level == 1u) { /* a sibling voxel in the same leaf block: the common case */
+        const unsigned slot = (c->key[0] & 1u) | ((c->key[1] & 1u) << 1) | ((c->key[2] & 1u) << 2);
+        c->lu = 0;
+        c->val = occ_leaf_at(m, b)->value[slot];
+        return;
+    }
+    while (level > 1u) {
+        const unsigned l = level - 1u;
+        const unsigned slot = ((c->key[0] >> l) & 1u) | (((c->key[1] >> l) & 1u) << 1) |
+                              (((c->key[2] >> l) & 1u) << 2);
+        const occ_inner_block_t *const ib = occ_inner_at(m, b);
+        const uint32_t ch = ib->child[slot];
+        if (ch == OCC_NONE) {
+            c->lu = l;
+            c->val = ib->value[slot];
+            return;
+        }
+        c->blk[l] = ch;
+        b = ch;
+        level = l;
+    }
+    const unsigned slot = (c->key[0] & 1u) | ((c->key[1] & 1u) << 1) | ((c->key[2] & 1u) << 2);
+    c->lu = 0;
+    c->val = occ_leaf_at(m, b)->value[slot];
+}
+
+static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3])
+{
+    c->m = m;
+    c->key[0] = key[0];
+    c->key[1] = key[1];
+    c->key[2] = key[2];
+    const unsigned d = m->cfg.depth_levels;
+    if (m->root_child == OCC_NONE) {
+        c->lu = d;
+        c->val = m->root_value;
+        return;
+    }
+    c->blk[d] = m->root_child;
+    descend(c, d);
+}
+
+/* key[dim] changed from `old`: refresh the path below the highest changed bit. */
+static inline void cursor_moved(cursor_t *c, unsigned dim, uint32_t old)
+{
+    const uint32_t x = old ^ c->key[dim];
+    if ((x >> c->lu) == 0u) {
+        return; /* still inside the same uniform node */
+    }
+#if defined(__GNUC__)
+    const unsigned hb = 31u - (unsigned)__builtin_clz(x);
+#else
+    unsigned hb = 0;
+    for (uint32_t y = x >> 1; y != 0u; y >>= 1) {
+        hb++;
+    }
+#endif
+    descend(c, hb + 1u);
+}
+
+/* The resolution as OctoMap holds it: a double. A float resolution read from a file or typed as
+ * 0.04 is taken to mean the shortest decimal that rounds to it (0.04, not 0.0399999991), so keys
+ * and voxel borders are bit-identical to an octomap::OcTree of that resolution. */
+static real_t ray_resolution(const occ_map_t *m)
+{
+    const float rf = m->cfg.resolution_m;
+#if OCC_RAY_DOUBLE
+    const double r = (double)rf;
+    double p = 1.0;
+    while (r * p < 1.0 && p < 1e12) {
+        p *= 10.0;
+    }
+    for (unsigned d = 0; d < 9u; d++, p *= 10.0) {
+        const double cand = (double)(int64_t)(r * p + 0.5) / p; /* round half up, r * p > 0 */
+        const float back = (float)cand;
+        if (!(back < rf) && !(back > rf)) {
+            return cand;
+        }
+    }
+    return r;
+#else
+    return rf;
+#endif
+}
+
+/* OctoMap's coordToKeyChecked with that resolution. */
+static occ_err_t ray_key(const occ_map_t *m, real_t res, occ_vec3_t p, uint32_t key[3])
+{
+    const real_t factor = (real_t)1 / res;
+    const int32_t tmv = (int32_t)1 << (m->cfg.depth_levels - 1u);
+    const float c[3] = {p.x, p.y, p.z};
+    for (unsigned i = 0; i < 3u; i++) {
+        const real_t scaled = factor * (real_t)c[i];
+        if (!(scaled >= -(real_t)tmv) || !(scaled < (real_t)tmv)) {
+            return OCC_ERR_RANGE;
+        }
+        /* floor() by truncation (scaled is within +-2^20 here), no libm call. */
+        int32_t fl = (int32_t)scaled;
+        fl -= (real_t)fl > scaled ? 1 : 0;
+        const int32_t k = fl + tmv;
+        if (k < 0 || k >= 2 * tmv) {
+            return OCC_ERR_RANGE;
+        }
+        key[i] = (uint32_t)k;
+    }
+    return OCC_OK;
+}
+
+static occ_err_t check_policy(occ_unknown_policy_t policy)
+{
+    return (policy == OCC_UNKNOWN_UNSAFE || policy == OCC_UNKNOWN_SAFE) ? OCC_OK : OCC_ERR_ARG;
+}
+
+/* OctoMap's keyToCoord for one axis. */
+static inline real_t key_coord(real_t res, int32_t tmv, uint32_t k)
+{
+    return ((real_t)((int32_t)k - tmv) + (real_t)0.5) * res;
+}
+
+static void set_result(const cursor_t *c, real_t res, int32_t tmv, occ_ray_result_t *out,
+                       bool hit, occ_ray_stop_t stop)
+{
+    out->hit = hit;
+    out->stop = stop;
+    out->key.k[0] = c->key[0];
+    out->key.k[1] = c->key[1];
+    out->key.k[2] = c->key[2];
+    out->end.x = (float)key_coord(res, tmv, c->key[0]);
+    out->end.y = (float)key_coord(res, tmv, c->key[1]);
+    out->end.z = (float)key_coord(res, tmv, c->key[2]);
+}
+
+/* DDA set-up, as OctoMap: direction normalized in float, borders from voxel centres. */
+typedef struct {
+    int step[3];
+    real_t tmax[3], tdelta[3];
+} dda_t;
+
+static inline void dda_init(dda_t *d, const cursor_t *c, real_t res, int32_t tmv, const float o[3],
+                     const float dir[3])
+{
+    for (unsigned i = 0; i < 3u; i++) {
+        if (dir[i] > 0.0f) {
+            d->step[i] = 1;
+        } else if (dir[i] < 0.0f) {
+            d->step[i] = -1;
+        } else {
+            d->step[i] = 0;
+        }
+        if (d->step[i] != 0) {
+            real_t border = key_coord(res, tmv, c->key[i]);
+            border += (real_t)d->step[i] * res * (real_t)0.5;
+            d->tmax[i] = (border - (real_t)o[i]) / (real_t)dir[i];
+            d->tdelta[i] = res / (real_t)fabsf(dir[i]);
+        } else {
+            d->tmax[i] = REAL_MAX;
+            d->tdelta[i] = REAL_MAX;
+        }
+    }
+}
+
+
+/* The ray is in a uniform node of level lu >= 1 that it passes through: step on without
+ * looking anything up while the next voxel is still in the node and (when the range is bounded)
+ * entered before `safe_t`, where the centre distance test cannot fail. Same events, same order,
+ * same arithmetic as stepping. */
+static inline void dda_coast(dda_t *d, uint32_t key[3], unsigned lu, bool bounded, real_t safe_t)
+{
+    const uint32_t size = (uint32_t)1 << lu;
+    int32_t room[3];
+    for (unsigned i = 0; i < 3u; i++) {
+        const uint32_t base = key[i] & ~(size - 1u);
+        room[i] = d->step[i] > 0 ? (int32_t)(base + size - 1u - key[i])
+                                 : (d->step[i] < 0 ? (int32_t)(key[i] - base) : 0);
+    }
+    /* Registers only: the loop-carried chain is one add and two compares per step. */
+    real_t t0 = d->tmax[0];
+    real_t t1 = d->tmax[1];
+    real_t t2 = d->tmax[2];
+    const real_t dt0 = d->tdelta[0];
+    const real_t dt1 = d->tdelta[1];
+    const real_t dt2 = d->tdelta[2];
+    const real_t stop = bounded ? safe_t : REAL_MAX;
+    int32_t n0 = 0;
+    int32_t n1 = 0;
+    int32_t n2 = 0;
+    for (;;) {
+        if (t0 < t1 && t0 < t2) {
+            if (n0 == room[0] || !(t0 < stop)) {
+                break;
+            }
+            n0++;
+            t0 += dt0;
+        } else if (t1 < t2) {
+            if (n1 == room[1] || !(t1 < stop)) {
+                break;
+            }
+            n1++;
+            t1 += dt1;
+        } else {
+            if (n2 == room[2] || !(t2 < stop)) {
+                break;
+            }
+            n2++;
+            t2 += dt2;
+        }
+    }
+    d->tmax[0] = t0;
+    d->tmax[1] = t1;
+    d->tmax[2] = t2;
+    key[0] = (uint32_t)((int32_t)key[0] + n0 * d->step[0]);
+    key[1] = (uint32_t)((int32_t)key[1] + n1 * d->step[1]);
+    key[2] = (uint32_t)((int32_t)key[2] + n2 * d->step[2]);
+}
+
+static bool normalize(const occ_vec3_t v, float out[3])
+{
+    const float sq = v.x * v.x + v.y * v.y + v.z * v.z;
+    const real_t len = RSQRT((real_t)sq);
+    if (!(len > (real_t)0)) {
+        return false;
+    }
+    const float lf = (float)len;
+    out[0] = v.x / lf;
+    out[1] = v.y / lf;
+    out[2] = v.z / lf;
+    return true;
+}
+
+occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
+                       bool ignore_unknown, float max_range_m, occ_ray_result_t *out)
+{
+    if (map == NULL || out == NULL || !occ_q_finite3(origin) || !occ_q_finite3(direction) ||
+        !occ_q_finite(max_range_m)) {
+        return OCC_ERR_ARG;
+    }
+    float dir[3];
+    if (!normalize(direction, dir)) {
+        return OCC_ERR_ARG;
+    }
+    const real_t res = ray_resolution(map);
+    occ_key_t k0;
+    const occ_err_t e = ray_key(map, res, origin, k0.k);
+    if (e != OCC_OK) {
+        return e;
+    }
+    const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
+    const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
+    cursor_t c;
+    cursor_init(&c, map, k0.k);
+    {
+        const occ_state_t s = occ_q_state(map, c.val);
+        if (s == OCC_STATE_OCCUPIED) {
+            set_result(&c, res, tmv, out, true, OCC_RAY_HIT);
+            return OCC_OK;
+        }
+        if (s == OCC_STATE_UNKNOWN && !ignore_unknown) {
+            set_result(&c, res, tmv, out, false, OCC_RAY_UNKNOWN);
+            return OCC_OK;
+        }
+    }
+    const float o[3] = {origin.x, origin.y, origin.z};
+    dda_t d;
+    dda_init(&d, &c, res, tmv, o, dir);
+    if (d.step[0] == 0 && d.step[1] == 0 && d.step[2] == 0) {
+        return OCC_ERR_ARG; /* direction too small to normalize to a non-zero float vector */
+    }
+    const bool range_set = max_range_m > 0.0f;
+    const real_t range_sq = (real_t)max_range_m * (real_t)max_range_m;
+    /* A voxel entered at ray parameter t has its centre within t + 0.87 res of the origin, so
+     * OctoMap's exact centre-distance test can only fail once t passes this (with margin). */
+    const real_t safe_t = (real_t)max_range_m - res * (real_t)1.01 - (real_t)1e-5 * (real_t)max_range_m;
+    const occ_value_t occ_min = map->q_occ_min;
+    const occ_value_t free_max = map->q_free_max;
+    /* The last key a step may leave from, per axis (never reached for a zero step). */
+    const uint32_t lim[3] = {d.step[0] > 0 ? kmax : 0u, d.step[1] > 0 ? kmax : 0u,
+                             d.step[2] > 0 ? kmax : 0u};
+    bool entered = true; /* in a node the ray passes through, not yet coasted */
+    for (;;) {
+        if (entered && c.lu > 0u) {
+            dda_coast(&d, c.key, c.lu, range_set, safe_t);
+        }
+        entered = false;
+        /* OctoMap's choice of axis (smallest tMax, ties to the higher axis), on locals. */
+        unsigned dim;
+        real_t t_entry;
+        if (d.tmax[0] < d.tmax[1] && d.tmax[0] < d.tmax[2]) {
+            dim = 0u;
+        } else if (d.tmax[1] < d.tmax[2]) {
+            dim = 1u;
+        } else {
+            dim = 2u;
+        }
+        t_entry = d.tmax[dim];
+        const uint32_t old = c.key[dim];
+        if (old == lim[dim]) {
+            set_result(&c, res, tmv, out, false, OCC_RAY_MAP_EDGE);
+            return OCC_OK;
+        }
+        c.key[dim] = (uint32_t)((int32_t)old + d.step[dim]);
+        d.tmax[dim] += d.tdelta[dim];
+        if (range_set && !(t_entry < safe_t)) {
+            /* OctoMap: float centre minus float origin, squared in float, summed in double. */
+            real_t dist_sq = (real_t)0;
+            for (unsigned j = 0; j < 3u; j++) {
+                const float ej = (float)key_coord(res, tmv, c.key[j]);
+                const float dj = ej - o[j];
+                dist_sq += (real_t)(dj * dj);
+            }
+            if (dist_sq > range_sq) {
+                set_result(&c, res, tmv, out, false, OCC_RAY_MAX_RANGE);
+                return OCC_OK;
+            }
+        }
+        if (((old ^ c.key[dim]) >> c.lu) == 0u) {
+            continue; /* same uniform node: same value, already let through */
+        }
+        cursor_moved(&c, dim, old);
+        const occ_value_t v = c.val;
+        if (v >= occ_min && occ_is_observed(v)) {
+            set_result(&c, res, tmv, out, true, OCC_RAY_HIT);
+            return OCC_OK;
+        }
+        if (!(v < free_max && occ_is_observed(v)) && !ignore_unknown) {
+            set_result(&c, res, tmv, out, false, OCC_RAY_UNKNOWN);
+            return OCC_OK;
+        }
+        entered = true;
+    }
+}
+
+static bool blocks(const occ_map_t *map, occ_value_t v, occ_unknown_policy_t policy)
+{
+    const occ_state_t s = occ_q_state(map, v);
+    return s == OCC_STATE_OCCUPIED || (s == OCC_STATE_UNKNOWN && policy == OCC_UNKNOWN_UNSAFE);
+}
+
+occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
+                            occ_unknown_policy_t policy, bool *visible,
+                            occ_ray_result_t *blocker)
+{
+    if (map == NULL || visible == NULL || check_policy(policy) != OCC_OK || !occ_q_finite3(a) ||
+        !occ_q_finite3(b)) {
+        return OCC_ERR_ARG;
+    }
+    const real_t res = ray_resolution(map);
+    occ_key_t ka;
+    occ_key_t kb;
+    occ_err_t e = ray_key(map, res, a, ka.k);
+    if (e == OCC_OK) {
+        e = ray_key(map, res, b, kb.k);
+    }
+    if (e != OCC_OK) {
+        return e;
+    }
+    const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
+    occ_ray_result_t scratch;
+    occ_ray_result_t *const res_out = blocker != NULL ? blocker : &scratch;
+    cursor_t c;
+    cursor_init(&c, map, ka.k);
+    *visible = false;
+    if (blocks(map, c.val, policy)) {
+        set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
+        return OCC_OK;
+    }
+    const occ_vec3_t dv = {b.x - a.x, b.y - a.y, b.z - a.z};
+    float dir[3];
+    if (!normalize(dv, dir) || (ka.k[0] == kb.k[0] && ka.k[1] == kb.k[1] && ka.k[2] == kb.k[2])) {
+        *visible = true;
+        return OCC_OK;
+    }
+    bool reached_b = false; /* b's voxel checked on the way (else looked up at the end) */
+    const float o[3] = {a.x, a.y, a.z};
+    const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
+    const real_t len = RSQRT((real_t)dv.x * (real_t)dv.x + (real_t)dv.y * (real_t)dv.y +
+                             (real_t)dv.z * (real_t)dv.z);
+    dda_t d;
+    dda_init(&d, &c, res, tmv, o, dir);
+    const occ_value_t occ_min = map->q_occ_min;
+    const occ_value_t free_max = map->q_free_max;
+    const bool unknown_blocks = policy == OCC_UNKNOWN_UNSAFE;
+    bool entered = true;
+    for (;;) {
+        if (entered && c.lu > 0u) {
+            /* b inside this pass-through node: the rest of the segment is in it too (convex). */
+            const uint32_t sh = c.lu;
+            if (((c.key[0] ^ kb.k[0]) >> sh) == 0u && ((c.key[1] ^ kb.k[1]) >> sh) == 0u &&
+                ((c.key[2] ^ kb.k[2]) >> sh) == 0u) {
+                reached_b = true; /* b's voxel has this node's (passable) value */
+                break;
+            }
+            dda_coast(&d, c.key, c.lu, false, (real_t)0);
+        }
+        entered = false;
+        unsigned dim;
+        if (d.tmax[0] < d.tmax[1] && d.tmax[0] < d.tmax[2]) {
+            dim = 0u;
+        } else if (d.tmax[1] < d.tmax[2]) {
+            dim = 1u;
+        } else {
+            dim = 2u;
+        }
+        if (d.tmax[dim] > len) {
+            break; /* past b (its voxel was checked above) */
+        }
+        const uint32_t old = c.key[dim];
+        if ((d.step[dim] < 0 && old == 0u) || (d.step[dim] > 0 && old == kmax)) {
+            break; /* rounding at the map border: nothing beyond */
+        }
+        c.key[dim] = (uint32_t)((int32_t)old + d.step[dim]);
+        d.tmax[dim] += d.tdelta[dim];
+        const bool at_b = c.key[0] == kb.k[0] && c.key[1] == kb.k[1] && c.key[2] == kb.k[2];
+        if (((old ^ c.key[dim]) >> c.lu) == 0u) {
+            if (at_b) {
+                reached_b = true;
+                break;
+            }
+            continue; /* same uniform node */
+        }
+        cursor_moved(&c, dim, old);
+        const occ_value_t v = c.val;
+        const bool obs = occ_is_observed(v);
+        if ((obs && v >= occ_min) || (unknown_blocks && !(obs && v < free_max))) {
+            set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
+            return OCC_OK;
+        }
+        if (at_b) {
+            reached_b = true;
+            break;
+        }
+        entered = true;
+    }
+    if (!reached_b) {
+        cursor_t cb;
+        cursor_init(&cb, map, kb.k);
+        if (blocks(map, cb.val, policy)) {
+            set_result(&cb, res, tmv, res_out, true, OCC_RAY_HIT);
+            return OCC_OK;
+        }
+    }
+    *visible = true;
+    return OCC_OK;
+}

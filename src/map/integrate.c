@@ -1,0 +1,517 @@
+/*
+ * integrate.c - occ_map_insert_cloud(): OctoMap's per-scan semantics (each voxel updated once,
+ * hit wins over free) with the sets kept as Morton codes in the caller's scratch: rays emit
+ * codes through a small exact filter, one radix sort + collapse, one occ_map_observe_codes().
+ */
+#include <math.h>
+#include <string.h>
+
+#include "coarse_internal.h"
+#include "integrate_internal.h"
+
+#define FILTER_N ((size_t)1 << OCC_INSERT_FILTER_BITS)
+#define FIXED_BYTES (FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u + 64u)
+
+occ_insert_params_t occ_insert_params_default(void)
+{
+    occ_insert_params_t p;
+    memset(&p, 0, sizeof p);
+    p.method = OCC_INSERT_SIMPLE;
+    p.max_range_m = -1.0f;
+    p.fast_n = 0;
+    p.fast_d = 2;
+    p.super_k = 4;
+    return p;
+}
+
+static size_t sat_mul(const size_t a, const size_t b)
+{
+    if (a != 0u && b > SIZE_MAX / a) {
+        return SIZE_MAX;
+    }
+    return a * b;
+}
+
+static size_t sat_add(const size_t a, const size_t b)
+{
+    return a > SIZE_MAX - b ? SIZE_MAX : a + b;
+}
+
+static bool uses_ends(const occ_insert_method_t m)
+{
+    return m != OCC_INSERT_SIMPLE;
+}
+
+size_t occ_insert_scratch_bytes(const occ_map_t *const map, const size_t n_points,
+                                const float max_ray_m, const occ_insert_params_t *const params)
+{
+    if (map == NULL || params == NULL) {
+        return 0;
+    }
+    const float res = map->cfg.resolution_m;
+    const float edge = (float)((uint32_t)1 << map->cfg.depth_levels);
+    float cells = isfinite(max_ray_m) && max_ray_m > 0.0f ? ceilf(max_ray_m / res) : edge;
+    if (!(cells < edge)) {
+        cells = edge;
+    }
+    const size_t per_ray = 3u * ((size_t)cells + 2u) + 2u;
+    size_t bytes = sat_mul(sat_mul(16u, n_points), per_ray);
+    bytes = sat_add(bytes, sat_mul(16u, n_points));
+    return sat_add(bytes, FIXED_BYTES);
+}
+
+size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_t *const origin,
+                                     const occ_vec3_t *const points, const size_t n_points,
+                                     const occ_insert_params_t *const params)
+{
+    if (map == NULL || origin == NULL || params == NULL || (points == NULL && n_points > 0u)) {
+        return 0;
+    }
+    occ_raygeo_t g;
+    occ_raygeo_init(&g, map);
+    const float o[3] = {origin->x, origin->y, origin->z};
+    uint32_t ko[3];
+    if (!occ_raygeo_key(&g, o, ko)) {
+        return FIXED_BYTES;
+    }
+    size_t codes = 0;
+    for (size_t i = 0; i < n_points; i++) {
+        float p[3] = {points[i].x, points[i].y, points[i].z};
+        if (params->max_range_m > 0.0f &&
+            occ_raygeo_dist(o, p) > (occ_rr_t)params->max_range_m) {
+            float c[3];
+            occ_raygeo_clip(o, p, params->max_range_m, c);
+            memcpy(p, c, sizeof p);
+        }
+        uint32_t k[3];
+        if (occ_raygeo_key(&g, p, k)) {
+            codes = sat_add(codes, occ_dda_bound(ko, k) + 1u);
+        }
+    }
+    size_t bytes = sat_mul(16u, codes);
+    bytes = sat_add(bytes, sat_mul(16u, n_points));
+    return sat_add(bytes, FIXED_BYTES);
+}
+
+/* ---- the insert context -------------------------------------------------------------------- */
+bool occ_ictx_reserve(occ_ictx_t *const x, const size_t need)
+{
+    if (x->cap - x->n >= need) {
+        return true;
+    }
+    occ_code_t *const s = occ_keyset_sort(x->a, x->b, x->n, x->hist);
+    const size_t m = occ_keyset_unique(s, x->n);
+    if (s != x->a) {
+        memcpy(x->a, s, m * sizeof *s);
+    }
+    x->n = m;
+    return x->cap - x->n >= need;
+}
+
+static inline size_t filt_slot(const occ_code_t c)
+{
+    return (size_t)((c * 0x9E3779B97F4A7C15ull) >> (64u - OCC_INSERT_FILTER_BITS));
+}
+
+void occ_ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+{
+    if (x->cbs != NULL) {
+        occ_fast_ray(x, e, ke);
+        return;
+    }
+    if (x->bs != NULL) {
+        x->r->voxel_visits += occ_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
+        x->r->rays_cast++;
+        return;
+    }
+    occ_code_t *const base = x->a + x->n;
+    const size_t m = occ_dda_codes(&x->g, x->o, e, x->ko, ke, base, x->cap - x->n);
+    x->r->voxel_visits += m;
+    x->r->rays_cast++;
+    occ_code_t *const filt = x->filt;
+    size_t w = 0;
+    for (size_t i = 0; i < m; i++) {
+        const occ_code_t c = base[i];
+        const size_t s = filt_slot(c);
+        if (filt[s] != c) {
+            filt[s] = c;
+            base[w++] = c;
+        }
+    }
+    x->n += w;
+}
+
+int occ_ictx_point(occ_ictx_t *const x, const float p[3])
+{
+    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
+        return 1;
+    }
+    uint32_t ke[3];
+    if (x->max_range > 0.0f && occ_raygeo_dist(x->o, p) > x->max_range_r) {
+        float e[3];
+        occ_raygeo_clip(x->o, p, x->max_range, e);
+        if (!occ_raygeo_key(&x->g, e, ke)) {
+            return 1;
+        }
+        if (x->bs == NULL && !occ_ictx_reserve(x, occ_dda_bound(x->ko, ke))) {
+            return -1;
+        }
+        occ_ictx_ray(x, e, ke);
+        x->r->rays_clipped++;
+        return 0;
+    }
+    if (!occ_raygeo_key(&x->g, p, ke)) {
+        return 1;
+    }
+    if (!occ_ictx_reserve(x, (x->bs == NULL ? occ_dda_bound(x->ko, ke) : 0u) + 1u)) {
+        return -1;
+    }
+    occ_ictx_ray(x, p, ke);
+    const occ_key_t k = {{ke[0], ke[1], ke[2]}};
+    const occ_code_t c = occ_morton_encode(k);
+    if (x->bs == NULL) {
+        x->filt[filt_slot(c)] = c; /* later free visits of this voxel are moot: hit wins */
+    }
+    occ_ictx_emit(x, c | OCC_CODE_HIT_BIT);
+    return 0;
+}
+
+/* ---- DISCRETE: one ray per distinct end voxel, to its centre ------------------------------- */
+static size_t discretize(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                         occ_code_t *const ends)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        const float p[3] = {points[i].x, points[i].y, points[i].z};
+        uint32_t k[3];
+        if (occ_raygeo_key(&x->g, p, k)) { /* also rejects NaN / Inf */
+            const occ_key_t key = {{k[0], k[1], k[2]}};
+            ends[m++] = occ_morton_encode(key);
+        } else {
+            x->r->points_skipped++;
+        }
+    }
+    x->r->points_integrated = m;
+    /* a and b are still empty: use them as the sort's buffers. */
+    occ_code_t *const s = occ_keyset_sort(ends, x->a, m, x->hist);
+    const size_t u = occ_keyset_unique(s, m);
+    if (s != ends) {
+        memcpy(ends, s, u * sizeof *s);
+    }
+    return u;
+}
+
+static int run_discrete(occ_ictx_t *const x, const occ_code_t *const ends, const size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        const occ_key_t k = occ_morton_decode(ends[i]);
+        const float c[3] = {occ_raygeo_center(&x->g, k.k[0]), occ_raygeo_center(&x->g, k.k[1]),
+                            occ_raygeo_center(&x->g, k.k[2])};
+        const int rc = occ_ictx_point(x, c);
+        if (rc < 0) {
+            return rc;
+        }
+    }
+    return 0;
+}
+
+/* ---- method dispatch and the scan's box ----------------------------------------------------- */
+static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                      const occ_vec3_t *const points, const size_t n_points,
+                      occ_code_t *const ends)
+{
+    occ_insert_result_t *const r = x->r;
+    int rc = 0;
+    switch (params->method) {
+    case OCC_INSERT_SIMPLE:
+        for (size_t i = 0; i < n_points && rc >= 0; i++) {
+            const float q[3] = {points[i].x, points[i].y, points[i].z};
+            rc = occ_ictx_point(x, q);
+            if (rc == 0) {
+                r->points_integrated++;
+            } else if (rc > 0) {
+                r->points_skipped++;
+            }
+        }
+        return rc < 0 ? rc : 0;
+    case OCC_INSERT_DISCRETE:
+    case OCC_INSERT_FAST_DISCRETE: {
+        if (x->cap < n_points) {
+            return -1; /* the end-voxel sort borrows a[] */
+        }
+        const size_t u = discretize(x, points, n_points, ends);
+        return run_discrete(x, ends, u);
+    }
+    case OCC_INSERT_SUPER_RAYS:
+        return occ_superray_run(x, points, n_points, params->super_k) ? 0 : -1;
+    default:
+        return -1;
+    }
+}
+
+/* Bricks of the box around the origin and every (clipped) end point, padded by 2 voxels for
+ * the DDA's rounding; fills bs->b0/nb. 0 when the box is too large to consider. */
+static size_t box_bricks(occ_ictx_t *const x, const occ_vec3_t *const points,
+                         const size_t n, occ_bitset_t *const bs)
+{
+    uint32_t lo[3] = {x->ko[0], x->ko[1], x->ko[2]}, hi[3] = {x->ko[0], x->ko[1], x->ko[2]};
+    for (size_t i = 0; i < n; i++) {
+        float q[3] = {points[i].x, points[i].y, points[i].z};
+        if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
+            continue;
+        }
+        if (x->max_range > 0.0f && occ_raygeo_dist(x->o, q) > x->max_range_r) {
+            float c[3];
+            occ_raygeo_clip(x->o, q, x->max_range, c);
+            memcpy(q, c, sizeof q);
+        }
+        uint32_t k[3];
+        if (!occ_raygeo_key(&x->g, q, k)) {
+            continue;
+        }
+        for (unsigned a = 0; a < 3u; a++) {
+            lo[a] = k[a] < lo[a] ? k[a] : lo[a];
+            hi[a] = k[a] > hi[a] ? k[a] : hi[a];
+        }
+    }
+    size_t bricks = 1;
+    const uint32_t kmax = ((uint32_t)1 << x->g.depth) - 1u;
+    for (unsigned a = 0; a < 3u; a++) {
+        lo[a] = lo[a] >= 2u ? lo[a] - 2u : 0u;
+        hi[a] = hi[a] + 2u <= kmax ? hi[a] + 2u : kmax;
+        x->box_lo[a] = lo[a];
+        x->box_hi[a] = hi[a];
+        bs->b0[a] = (lo[a] >> 2) & ~7u;
+        bs->nb[a] = (((hi[a] >> 2) - bs->b0[a]) | 7u) + 1u;
+        if (bricks > SIZE_MAX / 64u / bs->nb[a]) {
+            return 0;
+        }
+        bricks *= bs->nb[a];
+    }
+    bs->stride_y = bs->nb[0] >> 3;
+    bs->stride_z = (size_t)(bs->nb[0] >> 3) * (bs->nb[1] >> 3);
+    return bricks;
+}
+
+/* FAST_DISCRETE: the coarse nodes' codes, a capacity check covering them and the fine codes,
+ * then the coarse update (cfg.miss / (2d + 1) on every voxel below each node). After this the
+ * fine batch cannot run out of blocks. */
+static occ_err_t apply_coarse(occ_ictx_t *const x, occ_bitset_t *const cbs,
+                              const occ_code_t *const fine, const size_t nf,
+                              occ_code_t *const spare, const size_t spare_cap)
+{
+    occ_map_t *const map = x->map;
+    if (spare_cap < cbs->n_touched) {
+        map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    const size_t nc = occ_bitset_extract(cbs, NULL, 0, spare, spare_cap, spare, x->hist);
+    if (nc == SIZE_MAX) {
+        map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    const unsigned d = x->cd;
+    for (size_t i = 0; i < nc; i++) {
+        spare[i] <<= 3u * d; /* the node's first voxel */
+    }
+    uint64_t ci, cl, fi, fl;
+    occ_coarse_need(spare, nc, d, map->cfg.depth_levels, &ci, &cl);
+    occ_coarse_need(fine, nf, 0, map->cfg.depth_levels, &fi, &fl);
+    if (ci + fi > OCC_NONE || cl + fl > OCC_NONE ||
+        !occ_pool_can_supply(map, (uint32_t)(ci + fi), (uint32_t)(cl + fl))) {
+        map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    const float delta = map->cfg.miss / (float)(2u * d + 1u);
+    (void)occ_coarse_apply(map, spare, nc, d, occ_value_from_logodds(delta));
+    x->r->coarse_updated = nc;
+    return OCC_OK;
+}
+
+/* ---- entry point ----------------------------------------------------------------------------- */
+static uint8_t *align8(void *const p)
+{
+    const uintptr_t u = (uintptr_t)p;
+    return (uint8_t *)p + ((8u - (u & 7u)) & 7u);
+}
+
+occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const origin,
+                               const occ_vec3_t *const points, const size_t n_points,
+                               const occ_insert_params_t *const params, void *const scratch,
+                               const size_t scratch_bytes, occ_insert_result_t *const out)
+{
+    occ_insert_result_t local;
+    occ_insert_result_t *const r = out != NULL ? out : &local;
+    memset(r, 0, sizeof *r);
+    if (map == NULL || origin == NULL || params == NULL || (points == NULL && n_points > 0u) ||
+        (scratch == NULL && scratch_bytes > 0u)) {
+        return OCC_ERR_ARG;
+    }
+    if ((unsigned)params->method > (unsigned)OCC_INSERT_SUPER_RAYS ||
+        params->fast_d >= map->cfg.depth_levels || isnan(params->max_range_m)) {
+        return OCC_ERR_ARG;
+    }
+    if (!isfinite(origin->x) || !isfinite(origin->y) || !isfinite(origin->z)) {
+        return OCC_ERR_ARG;
+    }
+    occ_ictx_t x;
+    memset(&x, 0, sizeof x);
+    x.map = map;
+    x.r = r;
+    occ_raygeo_init(&x.g, map);
+    x.o[0] = origin->x;
+    x.o[1] = origin->y;
+    x.o[2] = origin->z;
+    if (!occ_raygeo_key(&x.g, x.o, x.ko)) {
+        return OCC_ERR_RANGE;
+    }
+    x.max_range = params->max_range_m > 0.0f ? params->max_range_m : -1.0f;
+    x.max_range_r = (occ_rr_t)x.max_range;
+
+    /* Carve the scratch: filter | histograms | end voxels (n) | the rest. */
+    uint8_t *p = scratch != NULL ? align8(scratch) : NULL;
+    const size_t usable = p != NULL ? scratch_bytes - (size_t)(p - (uint8_t *)scratch) : 0u;
+    const size_t fixed = FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u;
+    const size_t ends_bytes = uses_ends(params->method) ? n_points * 8u : 0u;
+    if (p == NULL || scratch_bytes < 8u || usable < fixed + ends_bytes + 16u) {
+        map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    x.filt = (occ_code_t *)(void *)p;
+    x.hist = (uint32_t *)(void *)(p + FILTER_N * 8u);
+    occ_code_t *const ends = (occ_code_t *)(void *)(p + fixed);
+    uint8_t *const rest0 = p + fixed + ends_bytes;
+    const size_t rest0_bytes = usable - fixed - ends_bytes;
+    r->scratch_used = (size_t)(p - (uint8_t *)scratch) + fixed + ends_bytes;
+
+    /* Dense set when the scan's box is small enough for the scratch, else sorted codes. */
+    occ_bitset_t bs, cbs;
+    memset(&bs, 0, sizeof bs);
+    memset(&cbs, 0, sizeof cbs);
+    size_t bricks = box_bricks(&x, points, n_points, &bs);
+    uint8_t *rest = rest0;
+    size_t rest_bytes = rest0_bytes;
+    size_t cbricks = 0;
+    if (params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u) {
+        /* The coarse nodes' set, over the same box at level d. */
+        x.cd = params->fast_d;
+        x.cn = params->fast_n;
+        cbricks = 1;
+        for (unsigned a = 0; a < 3u; a++) {
+            cbs.b0[a] = ((x.box_lo[a] >> x.cd) >> 2) & ~7u;
+            cbs.nb[a] = ((((x.box_hi[a] >> x.cd) >> 2) - cbs.b0[a]) | 7u) + 1u;
+            cbricks *= cbs.nb[a];
+        }
+        cbs.stride_y = cbs.nb[0] >> 3;
+        cbs.stride_z = (size_t)(cbs.nb[0] >> 3) * (cbs.nb[1] >> 3);
+        if (cbricks > rest_bytes / 32u) {
+            map->oom_count++;
+            return OCC_ERR_NOMEM;
+        }
+        cbs.words = (uint64_t *)(void *)rest;
+        cbs.touched = cbs.words + cbricks;
+        rest += 16u * cbricks;
+        rest_bytes -= 16u * cbricks;
+        x.cbs = &cbs;
+    }
+    const size_t hits_cap = n_points + 1u;
+    /* FAST_DISCRETE with n = 0 casts no voxel rays: only hits, no dense set needed. */
+    const bool no_fine = x.cbs != NULL && x.cn == 0u;
+    bool dense = !no_fine && bricks > 0u && bricks <= rest_bytes / 64u &&
+                 hits_cap <= (rest_bytes / 2u - 16u * bricks) / 16u;
+    size_t m = 0;
+    occ_code_t *codes = NULL;
+    int rc = 0;
+    for (unsigned attempt = 0; attempt < 2u; attempt++) {
+        const occ_insert_result_t keep = *r;
+        x.n = 0;
+        if (x.cbs != NULL) {
+            memset(cbs.words, 0, cbricks * 8u);
+            cbs.n_touched = 0;
+            cbs.n_set = 0;
+            cbs.overflow = false;
+        }
+        if (dense) {
+            bs.words = (uint64_t *)(void *)rest;
+            bs.touched = bs.words + bricks;
+            bs.n_touched = 0;
+            bs.n_set = 0;
+            bs.overflow = false;
+            memset(bs.words, 0, bricks * 8u);
+            x.bs = &bs;
+            x.a = bs.touched + bricks;
+            x.cap = hits_cap;
+            x.b = x.a + hits_cap;
+            x.b_cap = (size_t)((rest + rest_bytes) - (uint8_t *)(void *)x.b) / 8u;
+        } else {
+            memset(x.filt, 0xFF, FILTER_N * 8u); /* bit 63 set: never a code */
+            x.bs = NULL;
+            x.cap = rest_bytes / 16u;
+            x.a = (occ_code_t *)(void *)rest;
+            x.b = x.a + x.cap;
+        }
+        rc = run_method(&x, params, points, n_points, ends);
+        if (rc >= 0 && dense && bs.overflow) {
+            *r = keep; /* cannot happen with the padded box; stay exact regardless */
+            dense = false;
+            continue;
+        }
+        break;
+    }
+    if (rc < 0 || (x.cbs != NULL && cbs.overflow)) {
+        map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    occ_code_t *spare = NULL; /* free scratch after the fine codes, for the coarse ones */
+    size_t spare_cap = 0;
+    if (dense) {
+        const size_t bcap = (size_t)((rest + rest_bytes) - (uint8_t *)(void *)x.b) / 8u;
+        if (bcap < x.n || bcap < bs.n_touched) {
+            map->oom_count++;
+            return OCC_ERR_NOMEM;
+        }
+        occ_code_t *const hs = occ_keyset_sort(x.a, x.b, x.n, x.hist);
+        const size_t nh = occ_keyset_unique(hs, x.n);
+        if (hs != x.a) {
+            memcpy(x.a, hs, nh * sizeof *hs);
+        }
+        m = occ_bitset_extract(&bs, x.a, nh, x.b, bcap, x.b, x.hist);
+        if (m == SIZE_MAX) {
+            map->oom_count++;
+            return OCC_ERR_NOMEM;
+        }
+        codes = x.b;
+        spare = x.b + m;
+        spare_cap = bcap - m;
+        r->scratch_used += 16u * bricks + 8u * hits_cap + 8u * m;
+    } else {
+        /* Sort and collapse everything. */
+        codes = occ_keyset_sort(x.a, x.b, x.n, x.hist);
+        m = occ_keyset_unique(codes, x.n);
+        spare = codes == x.a ? x.b : x.a;
+        spare_cap = x.cap;
+        r->scratch_used += FILTER_N * 0u + 16u * x.cap; /* both halves may have been written */
+    }
+    size_t hits = 0;
+    for (size_t i = 0; i < m; i++) {
+        hits += (size_t)(codes[i] >> 63);
+    }
+    if (x.cbs != NULL) {
+        const occ_err_t ce = apply_coarse(&x, &cbs, codes, m, spare, spare_cap);
+        if (ce != OCC_OK) {
+            return ce;
+        }
+        r->scratch_used += 16u * cbricks;
+    }
+    /* One coherent batch update in Morton order (all or nothing). */
+    size_t changed = 0;
+    const occ_err_t e = occ_map_observe_codes(map, codes, m, &changed);
+    if (e != OCC_OK) {
+        return e;
+    }
+    r->voxels_updated = m;
+    r->voxels_occupied = hits;
+    r->voxels_free = m - hits;
+    r->voxels_changed = changed;
+    return OCC_OK;
+}

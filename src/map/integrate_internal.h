@@ -1,0 +1,201 @@
+/*
+ * integrate_internal.h - what raycast.c, keyset.c, integrate.c and superray.c share (src/map
+ * only): OctoMap's key arithmetic, the exact DDA writing Morton codes, the key-set sort.
+ */
+#ifndef OCC_INTEGRATE_INTERNAL_H_INCLUDED
+#define OCC_INTEGRATE_INTERNAL_H_INCLUDED
+
+#include "occmap/occmap.h"
+
+#if OCC_RAY_DOUBLE
+typedef double occ_rr_t;
+#else
+typedef float occ_rr_t;
+
+#endif
+
+/* Key arithmetic of one map, as OctoMap's: key = (int)floor(x * (1/res)) + 2^(D-1). */
+typedef struct {
+    occ_rr_t res;      /* resolution */
+    occ_rr_t rf;       /* 1 / res */
+    occ_rr_t tmv_r;    /* 2^(D-1) as a real */
+    int32_t tmv;       /* 2^(D-1) */
+    uint8_t depth;     /* D */
+} occ_raygeo_t;
+
+void occ_raygeo_init(occ_raygeo_t *g, const occ_map_t *map);
+/* Key of one coordinate; false when NaN/Inf or outside [0, 2^D). */
+bool occ_raygeo_key1(const occ_raygeo_t *g, float c, uint32_t *k);
+/* Key of a point (all three axes valid). */
+bool occ_raygeo_key(const occ_raygeo_t *g, const float p[3], uint32_t k[3]);
+/* Centre coordinate of key k, as OctoMap's float(keyToCoord(k)). */
+float occ_raygeo_center(const occ_raygeo_t *g, uint32_t k);
+/* OctoMap's |p - o| (float squares, double sqrt when OCC_RAY_DOUBLE). */
+occ_rr_t occ_raygeo_dist(const float o[3], const float p[3]);
+/* OctoMap's origin + normalized(p - o) * (float)range. */
+void occ_raygeo_clip(const float o[3], const float p[3], float range, float out[3]);
+
+/* What the DDA decides with: OctoMap's float direction and length, tMax / tDelta per axis. */
+typedef struct {
+    occ_rr_t tmax[3], tdelta[3];
+    int32_t step[3];
+    float length;
+} occ_dda_param_t;
+void occ_dda_setup(const occ_raygeo_t *g, const float o[3], const float e[3], const uint32_t ko[3],
+                   occ_dda_param_t *out);
+
+/* Upper bound of the codes occ_dda_codes() writes for keys ko -> ke. */
+size_t occ_dda_bound(const uint32_t ko[3], const uint32_t ke[3]);
+
+/* computeRayKeys(o, e) as Morton codes: the origin's code first, the end's excluded, nothing
+ * when ko == ke. Writes at most `cap` codes; returns the count (which may exceed cap). ko/ke
+ * must be the keys of o/e. */
+size_t occ_dda_codes(const occ_raygeo_t *g, const float o[3], const float e[3],
+                     const uint32_t ko[3], const uint32_t ke[3], occ_code_t *out, size_t cap);
+
+/* Dilated (Morton) +-1 along axis `dim`. */
+static inline occ_code_t occ_code_step(occ_code_t c, unsigned dim, int step)
+{
+    const occ_code_t m = (occ_code_t)0x1249249249249249ull << dim;
+    const occ_code_t part = step > 0 ? (((c | ~m) + 1u) & m) : (((c & m) - 1u) & m);
+    return (c & ~m) | part;
+}
+
+/* ---- key sets (keyset.c) ----------------------------------------------------------------- */
+#define OCC_KS_RADIX (1u << OCC_INSERT_RADIX_BITS)
+#define OCC_KS_PASSES ((63u + OCC_INSERT_RADIX_BITS - 1u) / OCC_INSERT_RADIX_BITS)
+/* Histogram words the sort needs (uint32_t). */
+#define OCC_KS_HIST_WORDS ((size_t)OCC_KS_PASSES * OCC_KS_RADIX)
+
+/* Stable LSD radix sort of a[0..n) by bits 0..62 (bit 63, the hit flag, is carried along),
+ * using tmp[n] and hist[OCC_KS_HIST_WORDS]; n < 2^32. Returns a or tmp: where the result is. */
+occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, size_t n, uint32_t *hist);
+/* The same sort of keys k[0..n) (bits 0..62) carrying v[]; tk/tv are the temporaries. Returns
+ * the key array holding the result; its values are in v if it is k, else in tv. */
+uint64_t *occ_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t *tv, size_t n,
+                                uint32_t *hist);
+/* Collapse runs of equal codes (bits 0..62) of a sorted array to one entry whose hit bit is the
+ * OR of the run's. Returns the new length. */
+size_t occ_keyset_unique(occ_code_t *a, size_t n);
+
+/* ---- dense per-scan voxel set over the scan's bounding box (keyset.c, raycast.c) -------------
+ * One 64-bit word per 4x4x4-voxel brick aligned to absolute keys, so a brick's voxels are the
+ * 64 consecutive Morton codes (brick code << 6) + bit. Bricks are stored in chunks of 8x8x8
+ * (4 KiB, Morton order inside) so that a ray stays on one page for 32 voxels. Used when the box
+ * fits the scratch: a visit is a test-and-set, and only first visits are ever stored. */
+typedef struct {
+    uint64_t *words;     /* chunks * 512 words, zeroed */
+    uint64_t *touched;   /* word indices of bricks in first-touch order (cap: all bricks) */
+    size_t n_touched;
+    size_t n_set;        /* voxels in the set */
+    uint32_t b0[3];      /* first brick (key >> 2) per axis, a multiple of 8 */
+    uint32_t nb[3];      /* bricks per axis, multiples of 8 */
+    size_t stride_y, stride_z; /* chunks per y step and per z step */
+    bool overflow;       /* a visit fell outside the box: the caller falls back to sorting */
+} occ_bitset_t;
+
+/* Spread 3 bits to every third bit. */
+static inline uint32_t occ_spread3b(uint32_t v)
+{
+    return (v & 1u) | ((v & 2u) << 2) | ((v & 4u) << 4);
+}
+
+/* Word index of brick (bx, by, bz) relative to b0 (each < nb). */
+static inline size_t occ_bitset_index(const occ_bitset_t *bs, uint32_t bx, uint32_t by,
+                                      uint32_t bz)
+{
+    const size_t chunk = (size_t)(bx >> 3) +
+                         (size_t)(bs->nb[0] >> 3) *
+                             ((size_t)(by >> 3) + (size_t)(bs->nb[1] >> 3) * (size_t)(bz >> 3));
+    return (chunk << 9) | occ_spread3b(bx & 7u) | (occ_spread3b(by & 7u) << 1) |
+           (occ_spread3b(bz & 7u) << 2);
+}
+
+/* Bit of voxel key (low 2 bits per axis) inside its brick word: Morton order. */
+static inline unsigned occ_brick_bit(uint32_t kx, uint32_t ky, uint32_t kz)
+{
+    return (kx & 1u) | ((ky & 1u) << 1) | ((kz & 1u) << 2) | ((kx & 2u) << 2) | ((ky & 2u) << 3) |
+           ((kz & 2u) << 4);
+}
+
+/* Morton interleave of the low 5 bits of a key for one axis (shift by the axis). */
+extern const uint16_t occ_spread5[32];
+
+/* Add voxel (kx, ky, kz); false when it is outside the box. */
+static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, uint32_t kz)
+{
+    const uint32_t cx = (kx >> 5) - (bs->b0[0] >> 3), cy = (ky >> 5) - (bs->b0[1] >> 3),
+                   cz = (kz >> 5) - (bs->b0[2] >> 3);
+    if (cx >= (bs->nb[0] >> 3) || cy >= (bs->nb[1] >> 3) || cz >= (bs->nb[2] >> 3)) {
+        return false;
+    }
+    const uint32_t local = (uint32_t)occ_spread5[kx & 31u] | ((uint32_t)occ_spread5[ky & 31u] << 1) |
+                           ((uint32_t)occ_spread5[kz & 31u] << 2);
+    const size_t idx = (((size_t)cx + bs->stride_y * cy + bs->stride_z * cz) << 9) | (local >> 6);
+    const uint64_t bit = (uint64_t)1 << (local & 63u);
+    const uint64_t w = bs->words[idx];
+    if ((w & bit) == 0u) {
+        if (w == 0u) {
+            bs->touched[bs->n_touched++] = idx;
+        }
+        bs->words[idx] = w | bit;
+        bs->n_set++;
+    }
+    return true;
+}
+
+/* computeRayKeys(o, e) into the set; returns the visits. Sets bs->overflow and stops when a
+ * voxel is outside the box. */
+size_t occ_dda_mark(const occ_raygeo_t *g, const float o[3], const float e[3],
+                    const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *bs);
+
+/* Sorted, collapsed codes of the set merged with `hits` (sorted, unique, hit bit set): a voxel
+ * in both is a hit. Writes to out (cap codes); returns the count, or SIZE_MAX when cap is too
+ * small. tmp must hold n_touched codes. The touched list is reordered. */
+size_t occ_bitset_extract(occ_bitset_t *bs, const occ_code_t *hits, size_t n_hits,
+                          occ_code_t *out, size_t cap, occ_code_t *tmp, uint32_t *hist);
+
+/* ---- one insert call (integrate.c); superray.c and fastdiscrete.c add rays through it ----- */
+typedef struct {
+    occ_map_t *map;
+    occ_raygeo_t g;
+    float o[3];            /* sensor origin */
+    uint32_t ko[3];        /* its key */
+    float max_range;       /* > 0: limited */
+    occ_rr_t max_range_r;
+    occ_code_t *filt;      /* 2^OCC_INSERT_FILTER_BITS recently emitted codes */
+    uint32_t *hist;        /* radix histograms */
+    occ_code_t *a, *b;     /* emitted codes (may repeat) and the sort's temporary, cap each */
+    size_t cap, n;
+    size_t b_cap;          /* dense path: codes that fit at b (free until the final merge) */
+    occ_bitset_t *bs;      /* non-NULL: free voxels go to this set, hits to a[] */
+    occ_bitset_t *cbs;     /* FAST_DISCRETE, d > 0: coarse nodes (keys >> cd) to clear */
+    uint8_t cd, cn;        /* FAST_DISCRETE: coarse level d and n */
+    uint32_t box_lo[3], box_hi[3]; /* keys of the scan's box (padded) */
+    occ_insert_result_t *r;
+} occ_ictx_t;
+
+/* Make room for `need` more codes in a (sorting and collapsing what is there if needed). */
+bool occ_ictx_reserve(occ_ictx_t *x, size_t need);
+/* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
+void occ_ictx_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
+/* Emit one voxel code (free, or hit with OCC_CODE_HIT_BIT); room must have been reserved. */
+static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
+{
+    x->a[x->n++] = c;
+}
+
+/* FAST_DISCRETE's ray (fastdiscrete.c): coarse marching, then fine DDA near the end. */
+void occ_fast_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
+
+/* One point as OctoMap's computeUpdate() treats it: max range, keys, ray, hit.
+ * Returns 0 (integrated), 1 (bad point, skipped) or -1 (no scratch). */
+int occ_ictx_point(occ_ictx_t *x, const float p[3]);
+
+/* SUPER_RAYS (superray.c): integrate the valid points whose end voxel codes are ends[0..n)
+ * (sorted, bit 63 clear) - equal result to occ_ictx_point() on each. `work` has work_cap codes.
+ * Returns false when scratch ran out. */
+bool occ_superray_run(occ_ictx_t *x, const occ_vec3_t *points, size_t n_points,
+                      uint16_t k_min);
+
+#endif

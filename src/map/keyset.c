@@ -1,0 +1,184 @@
+/*
+ * keyset.c - per-scan key sets as sorted Morton codes: LSD radix sort (digits that are equal in
+ * every code are skipped) and run collapsing. Sorting is what makes the later tree update
+ * touch memory in Morton order.
+ */
+#include <string.h>
+
+#include "integrate_internal.h"
+
+#define CODE_BITS ((occ_code_t)0x7FFFFFFFFFFFFFFFull)
+#define DIGIT_MASK ((occ_code_t)(OCC_KS_RADIX - 1u))
+
+occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint32_t *const hist)
+{
+    if (n < 2u) {
+        return a;
+    }
+    /* Which bits vary: digits above them need no pass. */
+    const occ_code_t first = a[0] & CODE_BITS;
+    occ_code_t diff = 0;
+    memset(hist, 0, OCC_KS_HIST_WORDS * sizeof hist[0]);
+    for (size_t i = 0; i < n; i++) {
+        const occ_code_t c = a[i] & CODE_BITS;
+        diff |= c ^ first;
+        occ_code_t v = c;
+        for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
+            hist[p * OCC_KS_RADIX + (unsigned)(v & DIGIT_MASK)]++;
+            v >>= OCC_INSERT_RADIX_BITS;
+        }
+    }
+    for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
+        const unsigned shift = p * OCC_INSERT_RADIX_BITS;
+        if (((diff >> shift) & DIGIT_MASK) == 0u) {
+            continue; /* every code has the same digit here */
+        }
+        uint32_t *const h = &hist[p * OCC_KS_RADIX];
+        uint32_t sum = 0;
+        for (unsigned b = 0; b < OCC_KS_RADIX; b++) {
+            const uint32_t c = h[b];
+            h[b] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) {
+            const occ_code_t c = a[i];
+            const unsigned b = (unsigned)(((c & CODE_BITS) >> shift) & DIGIT_MASK);
+            tmp[h[b]++] = c;
+        }
+        occ_code_t *const t = a;
+        a = tmp;
+        tmp = t;
+    }
+    return a;
+}
+
+size_t occ_keyset_unique(occ_code_t *const a, const size_t n)
+{
+    if (n == 0u) {
+        return 0;
+    }
+    size_t w = 0;
+    for (size_t i = 1; i < n; i++) {
+        const occ_code_t c = a[i];
+        if (((c ^ a[w]) & CODE_BITS) == 0u) {
+            a[w] |= c; /* same voxel: the hit flag wins */
+        } else {
+            a[++w] = c;
+        }
+    }
+    return w + 1u;
+}
+
+const uint16_t occ_spread5[32] = {
+    0x0000, 0x0001, 0x0008, 0x0009, 0x0040, 0x0041, 0x0048, 0x0049, 0x0200, 0x0201, 0x0208,
+    0x0209, 0x0240, 0x0241, 0x0248, 0x0249, 0x1000, 0x1001, 0x1008, 0x1009, 0x1040, 0x1041,
+    0x1048, 0x1049, 0x1200, 0x1201, 0x1208, 0x1209, 0x1240, 0x1241, 0x1248, 0x1249};
+
+static uint32_t compact3b(const uint32_t v)
+{
+    return (v & 1u) | ((v >> 2) & 2u) | ((v >> 4) & 4u);
+}
+
+size_t occ_bitset_extract(occ_bitset_t *const bs, const occ_code_t *const hits,
+                          const size_t n_hits, occ_code_t *const out, const size_t cap,
+                          occ_code_t *const tmp, uint32_t *const hist)
+{
+    /* Brick codes in place of the word indices, sorted. */
+    uint64_t *const t = bs->touched;
+    const size_t nt = bs->n_touched;
+    const size_t ncx = bs->nb[0] >> 3, ncy = bs->nb[1] >> 3;
+    for (size_t i = 0; i < nt; i++) {
+        const size_t idx = (size_t)t[i];
+        const size_t chunk = idx >> 9;
+        const uint32_t in = (uint32_t)(idx & 511u);
+        occ_key_t bk;
+        bk.k[0] = bs->b0[0] + (uint32_t)(chunk % ncx) * 8u + compact3b(in);
+        bk.k[1] = bs->b0[1] + (uint32_t)((chunk / ncx) % ncy) * 8u + compact3b(in >> 1);
+        bk.k[2] = bs->b0[2] + (uint32_t)(chunk / (ncx * ncy)) * 8u + compact3b(in >> 2);
+        t[i] = occ_morton_encode(bk);
+    }
+    occ_code_t *const s = occ_keyset_sort(t, tmp, nt, hist);
+    if (s != t) {
+        memcpy(t, s, nt * sizeof *t);
+    }
+    size_t n = 0, h = 0;
+    for (size_t i = 0; i < nt; i++) {
+        const occ_code_t base = t[i] << 6;
+        const occ_key_t bk = occ_morton_decode(t[i]);
+        const size_t idx = occ_bitset_index(bs, bk.k[0] - bs->b0[0], bk.k[1] - bs->b0[1],
+                                            bk.k[2] - bs->b0[2]);
+        uint64_t w = bs->words[idx];
+        while (w != 0u) {
+            const unsigned bit = (unsigned)__builtin_ctzll(w);
+            w &= w - 1u;
+            const occ_code_t c = base | bit;
+            while (h < n_hits && (hits[h] & ~OCC_CODE_HIT_BIT) < c) {
+                if (n == cap) {
+                    return SIZE_MAX;
+                }
+                out[n++] = hits[h++];
+            }
+            if (n == cap) {
+                return SIZE_MAX;
+            }
+            if (h < n_hits && (hits[h] & ~OCC_CODE_HIT_BIT) == c) {
+                out[n++] = hits[h++];
+            } else {
+                out[n++] = c;
+            }
+        }
+    }
+    while (h < n_hits) {
+        if (n == cap) {
+            return SIZE_MAX;
+        }
+        out[n++] = hits[h++];
+    }
+    return n;
+}
+
+uint64_t *occ_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t *tv,
+                                const size_t n, uint32_t *const hist)
+{
+    if (n < 2u) {
+        return k;
+    }
+    uint64_t diff = 0;
+    const uint64_t first = k[0] & CODE_BITS;
+    memset(hist, 0, OCC_KS_HIST_WORDS * sizeof hist[0]);
+    for (size_t i = 0; i < n; i++) {
+        const uint64_t c = k[i] & CODE_BITS;
+        diff |= c ^ first;
+        uint64_t x = c;
+        for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
+            hist[p * OCC_KS_RADIX + (unsigned)(x & DIGIT_MASK)]++;
+            x >>= OCC_INSERT_RADIX_BITS;
+        }
+    }
+    for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
+        const unsigned shift = p * OCC_INSERT_RADIX_BITS;
+        if (((diff >> shift) & DIGIT_MASK) == 0u) {
+            continue;
+        }
+        uint32_t *const h = &hist[p * OCC_KS_RADIX];
+        uint32_t sum = 0;
+        for (unsigned b = 0; b < OCC_KS_RADIX; b++) {
+            const uint32_t c = h[b];
+            h[b] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++) {
+            const unsigned b = (unsigned)(((k[i] & CODE_BITS) >> shift) & DIGIT_MASK);
+            const uint32_t at = h[b]++;
+            tk[at] = k[i];
+            tv[at] = v[i];
+        }
+        uint64_t *const t1 = k;
+        k = tk;
+        tk = t1;
+        uint32_t *const t2 = v;
+        v = tv;
+        tv = t2;
+    }
+    return k; /* the values are in the array paired with the returned keys */
+}

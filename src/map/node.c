@@ -1,0 +1,50 @@
+/* node.c - top-down node handles: one block read per child, no descent from the root. */
+#include "tree_internal.h"
+
+static void fill(const occ_map_t *const m, occ_node_t *const out, const occ_value_t v,
+                 const uint8_t flags, const uint32_t children)
+{
+    out->observed = occ_is_observed(v);
+    out->logodds = occ_value_to_logodds(v);
+    out->state = occ_value_state(m, v);
+    out->children = children;
+    out->flags = (uint8_t)(flags | (children == OCC_NONE ? OCC_NODE_UNIFORM : 0u));
+}
+
+void occ_map_node_root(const occ_map_t *const map, occ_node_t *const out)
+{
+    const occ_key_t zero = {{0u, 0u, 0u}};
+    out->key = zero;
+    out->level = map->cfg.depth_levels;
+    fill(map, out, map->root_value, map->root_flags, map->root_child);
+}
+
+occ_err_t occ_map_node_child(const occ_map_t *const map, const occ_node_t *const parent,
+                             const unsigned slot, occ_node_t *const out)
+{
+    if (map == NULL || parent == NULL || out == NULL || parent->level == 0u || slot > 7u) {
+        return OCC_ERR_ARG;
+    }
+    const unsigned level = parent->level - 1u;
+    occ_key_t key = parent->key;
+    key.k[0] |= (uint32_t)(slot & 1u) << level;
+    key.k[1] |= (uint32_t)((slot >> 1) & 1u) << level;
+    key.k[2] |= (uint32_t)((slot >> 2) & 1u) << level;
+    if (parent->children == OCC_NONE) {
+        const occ_node_t copy = *parent; /* out may alias parent */
+        *out = copy;
+        out->key = key;
+        out->level = (uint8_t)level;
+        return OCC_OK;
+    }
+    out->key = key;
+    out->level = (uint8_t)level;
+    if (level == 0u) {
+        const occ_value_t v = occ_leaf_at(map, parent->children)->value[slot];
+        fill(map, out, v, occ_value_flags(map, v), OCC_NONE);
+    } else {
+        const occ_inner_block_t *const b = occ_inner_at(map, parent->children);
+        fill(map, out, b->value[slot], b->flags[slot], b->child[slot]);
+    }
+    return OCC_OK;
+}

@@ -1,0 +1,376 @@
+/*
+ * raycast.c - OctoMap's computeRayKeys (Amanatides & Woo 3D-DDA), bit for bit: float direction
+ * and length, tMax/tDelta in occ_rr_t (double on hosts), the same tie-breaking (x before y
+ * before z only on strict <) and the same "passed the end by rounding" stop.
+ */
+#include <float.h>
+#include <math.h>
+
+#include "integrate_internal.h"
+
+#if OCC_RAY_DOUBLE
+#define RR_MAXV DBL_MAX
+#else
+#define RR_MAXV FLT_MAX
+#endif
+
+void occ_raygeo_init(occ_raygeo_t *const g, const occ_map_t *const map)
+{
+    g->depth = map->cfg.depth_levels;
+    g->tmv = (int32_t)1 << (g->depth - 1u);
+    g->tmv_r = (occ_rr_t)g->tmv;
+    g->res = (occ_rr_t)map->cfg.resolution_m;
+    g->rf = (occ_rr_t)1 / g->res;
+}
+
+bool occ_raygeo_key1(const occ_raygeo_t *const g, const float c, uint32_t *const k)
+{
+    const occ_rr_t s = g->rf * (occ_rr_t)c;
+    /* Same test as OctoMap's 0 <= floor(s) + tmv < 2 tmv, without overflowing the int cast. */
+    if (!(s >= -g->tmv_r && s < g->tmv_r)) {
+        return false;
+    }
+    /* floor() without a libm call: |s| < 2^20, so the truncation is exact. */
+    int32_t i = (int32_t)s;
+    i -= (occ_rr_t)i > s ? 1 : 0;
+    *k = (uint32_t)(i + g->tmv);
+    return true;
+}
+
+bool occ_raygeo_key(const occ_raygeo_t *const g, const float p[3], uint32_t k[3])
+{
+    return occ_raygeo_key1(g, p[0], &k[0]) && occ_raygeo_key1(g, p[1], &k[1]) &&
+           occ_raygeo_key1(g, p[2], &k[2]);
+}
+
+float occ_raygeo_center(const occ_raygeo_t *const g, const uint32_t k)
+{
+    return (float)(((occ_rr_t)((int32_t)k - g->tmv) + (occ_rr_t)0.5) * g->res);
+}
+
+occ_rr_t occ_raygeo_dist(const float o[3], const float p[3])
+{
+    const float dx = p[0] - o[0], dy = p[1] - o[1], dz = p[2] - o[2];
+    const float nsq = dx * dx + dy * dy + dz * dz;
+#if OCC_RAY_DOUBLE
+    return sqrt((double)nsq);
+#else
+    return sqrtf(nsq);
+#endif
+}
+
+void occ_raygeo_clip(const float o[3], const float p[3], const float range, float out[3])
+{
+    float d[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
+    const occ_rr_t len = occ_raygeo_dist(o, p);
+    if (len > (occ_rr_t)0) {
+        const float lf = (float)len;
+        d[0] /= lf;
+        d[1] /= lf;
+        d[2] /= lf;
+    }
+    for (unsigned i = 0; i < 3u; i++) {
+        out[i] = o[i] + d[i] * range;
+    }
+}
+
+size_t occ_dda_bound(const uint32_t ko[3], const uint32_t ke[3])
+{
+    size_t n = 4u;
+    for (unsigned i = 0; i < 3u; i++) {
+        n += ko[i] > ke[i] ? (size_t)(ko[i] - ke[i]) : (size_t)(ke[i] - ko[i]);
+    }
+    return n;
+}
+
+/* DDA state; dda_init/dda_next are inlined into both users below. */
+typedef struct {
+    occ_rr_t tmax[3], tdelta[3];
+    int32_t key[3];
+    int step[3];
+    int32_t kmax;
+    float length;
+    occ_code_t c;
+    size_t limit;
+} dda_t;
+
+/* Prepares the traversal; the first voxel (the origin's) is s->c. ko != ke. */
+static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const float o[3],
+                            const float e[3], const uint32_t ko[3], const uint32_t ke[3])
+{
+    float d[3] = {e[0] - o[0], e[1] - o[1], e[2] - o[2]};
+    s->length = (float)occ_raygeo_dist(o, e);
+    d[0] /= s->length;
+    d[1] /= s->length;
+    d[2] /= s->length;
+    for (unsigned i = 0; i < 3u; i++) {
+        s->key[i] = (int32_t)ko[i];
+        s->step[i] = d[i] > 0.0f ? 1 : (d[i] < 0.0f ? -1 : 0);
+        if (s->step[i] != 0) {
+            occ_rr_t border = ((occ_rr_t)((int32_t)ko[i] - g->tmv) + (occ_rr_t)0.5) * g->res;
+            border += (occ_rr_t)(float)((occ_rr_t)s->step[i] * g->res * (occ_rr_t)0.5);
+            s->tmax[i] = (border - (occ_rr_t)o[i]) / (occ_rr_t)d[i];
+            s->tdelta[i] = g->res / (occ_rr_t)fabsf(d[i]);
+        } else {
+            s->tmax[i] = RR_MAXV;
+            s->tdelta[i] = RR_MAXV;
+        }
+    }
+    const occ_key_t k0 = {{ko[0], ko[1], ko[2]}};
+    s->c = occ_morton_encode(k0);
+    s->kmax = 2 * g->tmv;
+    s->limit = occ_dda_bound(ko, ke);
+}
+
+void occ_dda_setup(const occ_raygeo_t *const g, const float o[3], const float e[3],
+                   const uint32_t ko[3], occ_dda_param_t *const out)
+{
+    dda_t s;
+    dda_init(&s, g, o, e, ko, ko);
+    for (unsigned i = 0; i < 3u; i++) {
+        out->tmax[i] = s.tmax[i];
+        out->tdelta[i] = s.tdelta[i];
+        out->step[i] = s.step[i];
+    }
+    out->length = s.length;
+}
+
+/* The hot loop, with the state in scalars so that it stays in registers. EMIT(kx, ky, kz) is
+ * called for every voxel after the origin's; it may `goto out`. */
+#define DDA_LOOP(s, EMIT)                                                                         \
+    do {                                                                                          \
+        occ_rr_t t0 = (s).tmax[0], t1 = (s).tmax[1], t2 = (s).tmax[2];                            \
+        const occ_rr_t d0 = (s).tdelta[0], d1 = (s).tdelta[1], d2 = (s).tdelta[2];               \
+        const int32_t s0 = (s).step[0], s1 = (s).step[1], s2 = (s).step[2];                      \
+        const int32_t e0 = (int32_t)ke[0], e1 = (int32_t)ke[1], e2 = (int32_t)ke[2];             \
+        int32_t k0 = (s).key[0], k1 = (s).key[1], k2 = (s).key[2];                                \
+        const occ_rr_t len = (occ_rr_t)(s).length;                                                \
+        const uint32_t kmax = (uint32_t)(s).kmax;                                                 \
+        size_t left = (s).limit - 1u;                                                             \
+        for (;;) {                                                                                \
+            if (t0 < t1) {                                                                        \
+                if (t0 < t2) {                                                                    \
+                    k0 += s0;                                                                     \
+                    t0 += d0;                                                                     \
+                } else {                                                                          \
+                    k2 += s2;                                                                     \
+                    t2 += d2;                                                                     \
+                }                                                                                 \
+            } else if (t1 < t2) {                                                                 \
+                k1 += s1;                                                                         \
+                t1 += d1;                                                                         \
+            } else {                                                                              \
+                k2 += s2;                                                                         \
+                t2 += d2;                                                                         \
+            }                                                                                     \
+            if (k0 == e0 && k1 == e1 && k2 == e2) {                                               \
+                break;                                                                            \
+            }                                                                                     \
+            occ_rr_t dist = t1 < t0 ? t1 : t0;                                                    \
+            dist = t2 < dist ? t2 : dist;                                                         \
+            /* past the end by rounding (OctoMap's stop), or left the map (OctoMap wraps) */      \
+            if (dist > len || ((uint32_t)k0 | (uint32_t)k1 | (uint32_t)k2) >= kmax) {             \
+                break;                                                                            \
+            }                                                                                     \
+            EMIT((uint32_t)k0, (uint32_t)k1, (uint32_t)k2);                                       \
+            if (--left == 0u) {                                                                   \
+                break; /* cannot happen with finite input; bounds the work regardless */          \
+            }                                                                                     \
+        }                                                                                         \
+    } while (0)
+
+size_t occ_dda_codes(const occ_raygeo_t *const g, const float o[3], const float e[3],
+                     const uint32_t ko[3], const uint32_t ke[3], occ_code_t *const out,
+                     const size_t cap)
+{
+    if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
+        return 0;
+    }
+    dda_t s;
+    dda_init(&s, g, o, e, ko, ke);
+    size_t n = 0;
+    if (cap > 0u) {
+        out[0] = s.c;
+    }
+    n = 1;
+#define EMIT_CODE(x, y, z)                                                                        \
+    do {                                                                                          \
+        if (n < cap) {                                                                            \
+            const occ_key_t kk = {{(x), (y), (z)}};                                               \
+            out[n] = occ_morton_encode(kk);                                                       \
+        }                                                                                         \
+        n++;                                                                                      \
+    } while (0)
+    DDA_LOOP(s, EMIT_CODE);
+#undef EMIT_CODE
+    return n;
+}
+
+/* The DDA_LOOP decisions with the set's word index kept incrementally: a step moves the voxel's
+ * 15-bit Morton offset inside its 32^3 chunk by dilated +-1, and the chunk only on a wrap. */
+#define MARK_STEP(a, ka, sa, ta, da)                                                          \
+    do {                                                                                          \
+        const uint32_t m_ = 0x1249u << (a);                                                       \
+        ka += sa;                                                                                 \
+        ta += da;                                                                                 \
+        if (sa > 0) {                                                                             \
+            local = (((local | ~m_) + 1u) & m_) | (local & ~m_);                                  \
+            if (((uint32_t)ka & 31u) == 0u) {                                                     \
+                chunk += stride[a];                                                               \
+                cc[a]++;                                                                          \
+                moved = true;                                                                     \
+            }                                                                                     \
+        } else {                                                                                  \
+            local = (((local & m_) - 1u) & m_) | (local & ~m_);                                   \
+            if (((uint32_t)ka & 31u) == 31u) {                                                    \
+                chunk -= stride[a];                                                               \
+                cc[a]--;                                                                          \
+                moved = true;                                                                     \
+            }                                                                                     \
+        }                                                                                         \
+    } while (0)
+
+size_t occ_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
+                    const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *const bs)
+{
+    if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
+        return 0;
+    }
+    dda_t s;
+    dda_init(&s, g, o, e, ko, ke);
+    if (!occ_bitset_add(bs, ko[0], ko[1], ko[2])) {
+        bs->overflow = true;
+        return 0;
+    }
+    const size_t stride[3] = {1u, bs->stride_y, bs->stride_z};
+    const uint32_t ncs[3] = {bs->nb[0] >> 3, bs->nb[1] >> 3, bs->nb[2] >> 3};
+    uint32_t cc[3];
+    for (unsigned a = 0; a < 3u; a++) {
+        cc[a] = (ko[a] >> 5) - (bs->b0[a] >> 3);
+    }
+    size_t chunk = cc[0] + stride[1] * cc[1] + stride[2] * cc[2];
+    uint32_t local = (uint32_t)occ_spread5[ko[0] & 31u] | ((uint32_t)occ_spread5[ko[1] & 31u] << 1) |
+                     ((uint32_t)occ_spread5[ko[2] & 31u] << 2);
+    uint64_t *const words = bs->words;
+    size_t n = 1;
+    occ_rr_t t0 = s.tmax[0], t1 = s.tmax[1], t2 = s.tmax[2];
+    const occ_rr_t d0 = s.tdelta[0], d1 = s.tdelta[1], d2 = s.tdelta[2];
+    const int32_t s0 = s.step[0], s1 = s.step[1], s2 = s.step[2];
+    const int32_t e0 = (int32_t)ke[0], e1 = (int32_t)ke[1], e2 = (int32_t)ke[2];
+    int32_t k0 = s.key[0], k1 = s.key[1], k2 = s.key[2];
+    const occ_rr_t len = (occ_rr_t)s.length;
+    size_t left = s.limit - 1u;
+    bool pending = false, moved = false;
+    /* OctoMap's order per step: advance, stop at the end key, stop when min(tMax) > length,
+     * else add the key. The min is the next step's choice, so the length test and the add
+     * happen at the top of the next iteration. Leaving the map means leaving the box (which
+     * lies inside it): the caller then redoes the scan on the sorted path, which stops there. */
+    for (;;) {
+        unsigned dim;
+        occ_rr_t tsel;
+        if (t0 < t1) {
+            dim = t0 < t2 ? 0u : 2u;
+            tsel = t0 < t2 ? t0 : t2;
+        } else {
+            dim = t1 < t2 ? 1u : 2u;
+            tsel = t1 < t2 ? t1 : t2;
+        }
+        if (pending) {
+            if (tsel > len) {
+                break;
+            }
+            if (moved && (cc[0] >= ncs[0] || cc[1] >= ncs[1] || cc[2] >= ncs[2])) {
+                bs->overflow = true;
+                break;
+            }
+            const size_t wi = (chunk << 9) | (local >> 6);
+            const uint64_t bit = (uint64_t)1 << (local & 63u);
+            const uint64_t w = words[wi];
+            if ((w & bit) == 0u) {
+                if (w == 0u) {
+                    bs->touched[bs->n_touched++] = wi;
+                }
+                words[wi] = w | bit;
+                bs->n_set++;
+            }
+            n++;
+            if (--left == 0u) {
+                break;
+            }
+            moved = false;
+        }
+        if (dim == 0u) {
+            MARK_STEP(0u, k0, s0, t0, d0);
+        } else if (dim == 1u) {
+            MARK_STEP(1u, k1, s1, t1, d1);
+        } else {
+            MARK_STEP(2u, k2, s2, t2, d2);
+        }
+        if (k0 == e0 && k1 == e1 && k2 == e2) {
+            break;
+        }
+        pending = true;
+    }
+    return n;
+}
+
+/* ---- public: occ_ray_keys ------------------------------------------------------------------ */
+static bool finite3(const occ_vec3_t p)
+{
+    return isfinite(p.x) && isfinite(p.y) && isfinite(p.z);
+}
+
+size_t occ_ray_max_keys(const occ_map_t *const map, const occ_vec3_t origin, const occ_vec3_t end)
+{
+    if (map == NULL) {
+        return 0;
+    }
+    occ_raygeo_t g;
+    occ_raygeo_init(&g, map);
+    const float o[3] = {origin.x, origin.y, origin.z};
+    const float e[3] = {end.x, end.y, end.z};
+    uint32_t ko[3], ke[3];
+    if (!occ_raygeo_key(&g, o, ko) || !occ_raygeo_key(&g, e, ke)) {
+        return 0;
+    }
+    return occ_dda_bound(ko, ke);
+}
+
+occ_err_t occ_ray_keys(const occ_map_t *const map, const occ_vec3_t origin, const occ_vec3_t end,
+                       occ_key_t *const keys, const size_t cap, size_t *const n_keys)
+{
+    if (map == NULL || n_keys == NULL || (keys == NULL && cap > 0u)) {
+        return OCC_ERR_ARG;
+    }
+    *n_keys = 0;
+    if (!finite3(origin) || !finite3(end)) {
+        return OCC_ERR_ARG;
+    }
+    occ_raygeo_t g;
+    occ_raygeo_init(&g, map);
+    const float o[3] = {origin.x, origin.y, origin.z};
+    const float e[3] = {end.x, end.y, end.z};
+    uint32_t ko[3], ke[3];
+    if (!occ_raygeo_key(&g, o, ko) || !occ_raygeo_key(&g, e, ke)) {
+        return OCC_ERR_RANGE;
+    }
+    size_t n = 0;
+    if (ko[0] != ke[0] || ko[1] != ke[1] || ko[2] != ke[2]) {
+        dda_t s;
+        dda_init(&s, &g, o, e, ko, ke);
+#define EMIT_KEY(x, y, z)                                                                         \
+    do {                                                                                          \
+        if (n < cap) {                                                                            \
+            keys[n].k[0] = (x);                                                                   \
+            keys[n].k[1] = (y);                                                                   \
+            keys[n].k[2] = (z);                                                                   \
+        }                                                                                         \
+        n++;                                                                                      \
+    } while (0)
+        EMIT_KEY(ko[0], ko[1], ko[2]);
+        DDA_LOOP(s, EMIT_KEY);
+#undef EMIT_KEY
+    }
+    *n_keys = n;
+    return n > cap ? OCC_ERR_NOMEM : OCC_OK;
+}

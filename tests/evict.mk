@@ -1,0 +1,2 @@
+# evict.mk - bounded memory in flight (issue 9): the eviction tests are tests/test_evict.c
+# (auto-discovered); the soak run lives in tests/soak.mk.

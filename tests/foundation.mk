@@ -1,0 +1,83 @@
+# tests/foundation.mk - extras of the foundation tests (issue 3):
+#  * build/data/foundation/scan.dat: OctoMap's real scan for test_tree_octomap (its own copy, so
+#    this fragment does not depend on another fragment's rule; the test prefers build/data/scan.dat).
+#  * test-morton-bmi2: test_morton.c built a second time against a BMI2 build of morton.c (symbols
+#    renamed bmi2_*), comparing both paths with brute force; skipped when the CPU has no bmi2.
+#  * test-variant-float: the core rebuilt with -DOCC_VALUE_FLOAT=1 and the tree, pool, corruption
+#    and OctoMap oracle tests run against it (the issue: the oracle test passes with both).
+#  * test-variant-rayf: the core with -DOCC_RAY_DOUBLE=0 (firmware key arithmetic) against OctoMap.
+
+FOUNDATION_SCAN := $(BUILD)/data/foundation/scan.dat
+FOUNDATION_SCAN_BZ2 := /usr/share/doc/liboctomap-dev/examples/data/scan.dat.bz2
+FOUNDATION_HAVE_BMI2 := $(shell grep -qw bmi2 /proc/cpuinfo 2>/dev/null && echo 1)
+
+$(FOUNDATION_SCAN): | $(BUILD)/.deps-ok
+	@mkdir -p $(dir $@)
+	bzcat $(FOUNDATION_SCAN_BZ2) > $@.tmp && mv $@.tmp $@
+
+TEST_BUILD_EXTRA += $(FOUNDATION_SCAN)
+
+# ---- Morton: the BMI2 path ----------------------------------------------------------------------
+FOUNDATION_DIR := $(BUILD)/asan/foundation
+MORTON_BMI2_BIN := $(FOUNDATION_DIR)/bin/test_morton_bmi2
+
+$(FOUNDATION_DIR)/morton_bmi2.o: src/map/morton.c include/occmap/occmap.h
+	@mkdir -p $(dir $@)
+	$(CC) $(ASAN_CFLAGS) -DOCC_USE_BMI2=1 -mbmi2 -c $< -o $@.raw.o
+	@syms=$$(nm --defined-only -g $@.raw.o | awk '{print $$3}'); args=""; \
+	for s in $$syms; do args="$$args --redefine-sym $$s=bmi2_$$s"; done; \
+	objcopy $$args $@.raw.o $@ && rm -f $@.raw.o
+
+$(FOUNDATION_DIR)/test_morton_bmi2.o: tests/test_morton.c include/occmap/occmap.h src/map/tree_internal.h
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 -DTEST_MORTON_BMI2=1 -c $< -o $@
+
+$(MORTON_BMI2_BIN): $(FOUNDATION_DIR)/test_morton_bmi2.o $(FOUNDATION_DIR)/morton_bmi2.o $(BUILD)/asan/libocc.a
+	@mkdir -p $(dir $@)
+	$(CC) $(SAN) -o $@ $^ -lcmocka -lm
+
+test-morton-bmi2: $(MORTON_BMI2_BIN)
+	@if [ "$(FOUNDATION_HAVE_BMI2)" = 1 ]; then \
+	  CMOCKA_MESSAGE_OUTPUT=STDOUT $(MORTON_BMI2_BIN); \
+	else echo "skip: this CPU has no bmi2 (portable path tested by test_morton)"; fi
+
+# ---- compile-time variants of the core --------------------------------------------------------
+# $(1) name, $(2) flags, $(3) tests. Each variant rebuilds every core file with the flags and runs
+# the listed tests against it (test binaries are compiled with the same flags).
+define FOUNDATION_VARIANT
+$(1)_DIR := $(BUILD)/asan-$(1)
+$(1)_BINS := $$(patsubst %,$(BUILD)/asan-$(1)/bin/%,$(3))
+
+$(BUILD)/asan-$(1)/core/%.o: %.c
+	@mkdir -p $$(dir $$@)
+	$$(CC) $$(ASAN_CFLAGS) $(2) -MMD -MP -c $$< -o $$@
+$(BUILD)/asan-$(1)/host/%.o: %.c
+	@mkdir -p $$(dir $$@)
+	$$(CC) $$(HOST_WARN) -O1 -g $$(SAN) $$(INC) -DOCC_TESTING=1 $(2) -MMD -MP -c $$< -o $$@
+$(BUILD)/asan-$(1)/libocc.a: $$(OCC_CORE_SRC:%.c=$(BUILD)/asan-$(1)/core/%.o)
+	@rm -f $$@
+	$$(AR) rcs $$@ $$^
+$(BUILD)/asan-$(1)/bin/%: $(BUILD)/asan-$(1)/host/tests/%.o $(BUILD)/asan-$(1)/host/tests/support/shadow_grid.o \
+                    $(BUILD)/asan-$(1)/host/port/posix/scan_xyz.o $(BUILD)/asanhost/tests/support/oracle_tree.o \
+                    $(BUILD)/asan-$(1)/libocc.a
+	@mkdir -p $$(dir $$@)
+	$$(CXX) $$(SAN) -o $$@ $$^ -loctomap -loctomath -lcmocka -lm
+
+test-variant-$(1): $$($(1)_BINS) $(FOUNDATION_SCAN)
+	@rc=0; for b in $$($(1)_BINS); do \
+	  echo "== $$$$b ($(2), OCC_TEST_QUICK=1)"; OCC_TEST_QUICK=1 CMOCKA_MESSAGE_OUTPUT=STDOUT $$$$b || rc=1; \
+	done; exit $$$$rc
+
+TEST_STEPS += test-variant-$(1)
+TEST_BUILD_EXTRA += $$($(1)_BINS)
+.PHONY: test-variant-$(1)
+endef
+
+# The issue: "the OctoMap oracle test passes with both" value types.
+$(eval $(call FOUNDATION_VARIANT,float,-DOCC_VALUE_FLOAT=1,test_tree_shadow test_tree_octomap test_pool test_corrupt))
+# The firmware's float-only key arithmetic, against OctoMap within the documented border bound.
+$(eval $(call FOUNDATION_VARIANT,rayf,-DOCC_RAY_DOUBLE=0,test_tree_octomap))
+
+TEST_STEPS += test-morton-bmi2
+TEST_BUILD_EXTRA += $(MORTON_BMI2_BIN)
+.PHONY: test-morton-bmi2

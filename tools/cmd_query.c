@@ -1,0 +1,248 @@
+/* cmd_query.c - occmap query: collision checks and ray casts on a map file, one query or a batch. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "occmap/occ_file.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: occmap query MAP (--sphere x,y,z,r | --aabb x0,y0,z0,x1,y1,z1 |\n"
+            "                         --capsule x0,y0,z0,x1,y1,z1,r | --ray x,y,z,dx,dy,dz,max_m)\n"
+            "                        [--unknown safe|unsafe] [--json]\n"
+            "       occmap query MAP --batch FILE --json   (one query per line, same syntax)\n"
+            "Answers whether the volume is free of occupied voxels (and of unknown ones with\n"
+            "--unknown unsafe, the default), with counts of occupied and unknown voxels inside it.\n"
+            "A ray is OctoMap's castRay (unknown voxels stop it unless --unknown safe); its counts\n"
+            "are over the segment from the origin to max_m along the direction.\n");
+}
+
+typedef struct {
+    enum { Q_NONE, Q_SPHERE, Q_AABB, Q_CAPSULE, Q_RAY } kind;
+    float v[7];
+    occ_unknown_policy_t policy;
+    bool json;
+} query_t;
+
+/* Parse options argv[0..argc) into q; returns an error message or NULL. */
+static const char *parse(int argc, char **argv, query_t *q)
+{
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        int n = 0;
+        int kind = Q_NONE;
+        if (strcmp(a, "--json") == 0) {
+            q->json = true;
+            continue;
+        } else if (strcmp(a, "--unknown") == 0) {
+            if (val == NULL) return "--unknown needs safe or unsafe";
+            if (strcmp(val, "safe") == 0) q->policy = OCC_UNKNOWN_SAFE;
+            else if (strcmp(val, "unsafe") == 0) q->policy = OCC_UNKNOWN_UNSAFE;
+            else return "--unknown takes safe or unsafe";
+            i++;
+            continue;
+        } else if (strcmp(a, "--sphere") == 0) {
+            kind = Q_SPHERE;
+            n = 4;
+        } else if (strcmp(a, "--aabb") == 0) {
+            kind = Q_AABB;
+            n = 6;
+        } else if (strcmp(a, "--capsule") == 0) {
+            kind = Q_CAPSULE;
+            n = 7;
+        } else if (strcmp(a, "--ray") == 0) {
+            kind = Q_RAY;
+            n = 7;
+        } else {
+            return "unknown option";
+        }
+        if (q->kind != Q_NONE) return "give one of --sphere, --aabb, --capsule, --ray";
+        if (val == NULL || !cli_parse_floats(val, q->v, n)) return "malformed numbers";
+        q->kind = kind;
+        i++;
+    }
+    return q->kind == Q_NONE ? "give one of --sphere, --aabb, --capsule, --ray" : NULL;
+}
+
+static occ_vec3_t vec(const float *p)
+{
+    occ_vec3_t v = {p[0], p[1], p[2]};
+    return v;
+}
+
+/* Run one query and print its answer; returns 0 or 1 (error, printed). */
+static int run(const occ_map_t *map, const query_t *q, FILE *out)
+{
+    occ_volume_t vol;
+    occ_err_t e = OCC_OK;
+    occ_ray_result_t ray;
+    bool is_ray = q->kind == Q_RAY;
+    switch (q->kind) {
+    case Q_SPHERE:
+        e = occ_volume_sphere(&vol, vec(q->v), q->v[3]);
+        break;
+    case Q_AABB:
+        e = occ_volume_aabb(&vol, vec(q->v), vec(q->v + 3));
+        break;
+    case Q_CAPSULE:
+        e = occ_volume_capsule(&vol, vec(q->v), vec(q->v + 3), q->v[6]);
+        break;
+    case Q_RAY: {
+        const occ_vec3_t o = vec(q->v), d = vec(q->v + 3);
+        const float len = sqrtf(d.x * d.x + d.y * d.y + d.z * d.z);
+        if (!(len > 0.0f) || !(q->v[6] > 0.0f)) {
+            e = OCC_ERR_ARG;
+            break;
+        }
+        e = occ_cast_ray(map, o, d, q->policy == OCC_UNKNOWN_SAFE, q->v[6], &ray);
+        if (e == OCC_OK) {
+            const float s = q->v[6] / len;
+            const occ_vec3_t b = {o.x + d.x * s, o.y + d.y * s, o.z + d.z * s};
+            e = occ_volume_segment(&vol, o, b);
+        }
+        break;
+    }
+    case Q_NONE:
+    default:
+        e = OCC_ERR_ARG;
+        break;
+    }
+    occ_collision_t col;
+    occ_query_counts_t cnt;
+    if (e == OCC_OK && !is_ray) e = occ_collide_volume(map, &vol, q->policy, &col);
+    if (e == OCC_OK) e = occ_query_count(map, &vol, &cnt);
+    if (e != OCC_OK) {
+        if (q->json) fprintf(out, "{\"error\": \"%s\"}\n", occ_err_str(e));
+        else fprintf(stderr, "occmap query: %s\n", occ_err_str(e));
+        return 1;
+    }
+    bool collides;
+    if (is_ray) {
+        collides = ray.hit || (q->policy == OCC_UNKNOWN_UNSAFE && ray.stop == OCC_RAY_UNKNOWN);
+    } else {
+        collides = !col.safe;
+    }
+    static const char *const stops[] = {"hit", "max_range", "unknown", "map_edge"};
+    if (q->json) {
+        fprintf(out, "{\"collides\": %s, \"occupied_voxels\": %llu, \"unknown_voxels\": %llu",
+                collides ? "true" : "false", (unsigned long long)cnt.occupied,
+                (unsigned long long)cnt.unknown);
+        if (is_ray) {
+            fprintf(out, ", \"hit\": %s, \"hit_point\": ", ray.hit ? "true" : "false");
+            if (ray.hit) {
+                fprintf(out, "[%.4f, %.4f, %.4f]", (double)ray.end.x, (double)ray.end.y,
+                        (double)ray.end.z);
+            } else {
+                fprintf(out, "null");
+            }
+            fprintf(out, ", \"stop\": \"%s\"", stops[ray.stop]);
+        } else if (!col.safe) {
+            fprintf(out, ", \"outside_map\": %s", col.outside ? "true" : "false");
+        }
+        fprintf(out, "}\n");
+    } else {
+        fprintf(out, "%s: %llu occupied, %llu unknown voxels inside", collides ? "COLLIDES" : "safe",
+                (unsigned long long)cnt.occupied, (unsigned long long)cnt.unknown);
+        if (is_ray) {
+            if (ray.hit) {
+                fprintf(out, "; ray hit at %.4f %.4f %.4f", (double)ray.end.x, (double)ray.end.y,
+                        (double)ray.end.z);
+            } else {
+                fprintf(out, "; ray: no hit (%s)", stops[ray.stop]);
+            }
+        } else if (!col.safe && col.outside) {
+            fprintf(out, "; leaves the map");
+        }
+        fprintf(out, "\n");
+    }
+    return 0;
+}
+
+static int run_batch(const occ_map_t *map, const char *path, const query_t *defaults)
+{
+    FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
+    if (f == NULL) {
+        cli_error("query", "cannot open %s", path);
+        return 1;
+    }
+    char line[1024];
+    int status = 0;
+    while (fgets(line, sizeof line, f) != NULL) {
+        char *argv[16];
+        int argc = 0;
+        for (char *tok = strtok(line, " \t\r\n"); tok != NULL && argc < 16; tok = strtok(NULL, " \t\r\n")) {
+            argv[argc++] = tok;
+        }
+        if (argc == 0 || argv[0][0] == '#') continue;
+        query_t q = *defaults;
+        q.kind = Q_NONE;
+        const char *err = parse(argc, argv, &q);
+        if (err != NULL) {
+            fprintf(stdout, "{\"error\": \"%s\"}\n", err);
+            status = 1;
+            continue;
+        }
+        q.json = true;
+        status |= run(map, &q, stdout);
+    }
+    if (f != stdin) fclose(f);
+    return status;
+}
+
+int cmd_query(int argc, char **argv)
+{
+    if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+        usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    const char *map_path = argv[1];
+    const char *batch = NULL;
+    query_t q;
+    memset(&q, 0, sizeof q);
+    q.kind = Q_NONE;
+    q.policy = OCC_UNKNOWN_UNSAFE;
+    /* Pull --batch FILE out; the rest is one query. */
+    char *rest[64];
+    int nrest = 0;
+    for (int i = 2; i < argc; i++) {
+        if (strcmp(argv[i], "--batch") == 0 && i + 1 < argc) {
+            batch = argv[++i];
+        } else if (nrest < 64) {
+            rest[nrest++] = argv[i];
+        }
+    }
+    if (batch == NULL) {
+        const char *err = parse(nrest, rest, &q);
+        if (err != NULL) {
+            cli_error("query", "%s", err);
+            usage(stderr);
+            return 2;
+        }
+    } else {
+        for (int i = 0; i < nrest; i++) {
+            if (strcmp(rest[i], "--json") == 0) {
+                q.json = true;
+            } else if (strcmp(rest[i], "--unknown") == 0 && i + 1 < nrest) {
+                q.policy = strcmp(rest[++i], "safe") == 0 ? OCC_UNKNOWN_SAFE : OCC_UNKNOWN_UNSAFE;
+            } else {
+                cli_error("query", "--batch takes only --json and --unknown");
+                return 2;
+            }
+        }
+    }
+    occ_map_t map;
+    void *arena = NULL;
+    char msg[256] = "";
+    const occ_err_t e = occ_file_load_alloc(map_path, NULL, &map, 0, &arena, NULL, msg, sizeof msg);
+    if (e != OCC_OK) {
+        cli_error("query", "%s: %s (%s)", map_path, occ_err_str(e), msg);
+        return 1;
+    }
+    const int status = batch != NULL ? run_batch(&map, batch, &q) : run(&map, &q, stdout);
+    free(arena);
+    return status;
+}
