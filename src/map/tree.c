@@ -263,15 +263,32 @@ static occ_value_t delta_of(const occ_map_t *const m, const occ_code_t code, con
     return (code & OCC_CODE_HIT_BIT) != 0u ? m->q_hit : m->q_miss;
 }
 
-static bool codes_valid(const occ_map_t *const m, const occ_code_t *const codes, const size_t n)
+/* Checks order and range, and bounds the blocks the batch can need without reading the tree:
+ * every node that may need a child block (levels 1..D) is counted once, by the first code
+ * under it, which splits from its predecessor above that level. */
+static bool codes_valid(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
+                        uint64_t *const bound_inner, uint64_t *const bound_leaf)
 {
     const occ_code_t limit = (occ_code_t)1 << (3u * m->cfg.depth_levels);
+    uint64_t inner = 0u, leaf = 0u;
     for (size_t i = 0; i < n; i++) {
         const occ_code_t c = codes[i] & ~OCC_CODE_HIT_BIT;
-        if (c >= limit || (i > 0u && c <= (codes[i - 1u] & ~OCC_CODE_HIT_BIT))) {
+        if (c >= limit) {
             return false;
         }
+        unsigned s = m->cfg.depth_levels + 1u; /* the first code may need the root's block too */
+        if (i > 0u) {
+            const occ_code_t p = codes[i - 1u] & ~OCC_CODE_HIT_BIT;
+            if (c <= p) {
+                return false;
+            }
+            s = split_level(c, p);
+        }
+        leaf += s >= 2u ? 1u : 0u;
+        inner += s >= 3u ? s - 2u : 0u;
     }
+    *bound_inner = inner;
+    *bound_leaf = leaf;
     return true;
 }
 
@@ -323,9 +340,17 @@ static void count_blocks(occ_map_t *const m, const occ_code_t *const codes, cons
     }
 }
 
+static bool can_supply64(const occ_map_t *const m, const uint64_t n_inner, const uint64_t n_leaf)
+{
+    return n_inner <= OCC_NONE && n_leaf <= OCC_NONE &&
+           occ_pool_can_supply(m, (uint32_t)n_inner, (uint32_t)n_leaf);
+}
+
+/* `bound_fits`: the caller showed that an upper bound of the blocks needed fits, so the exact
+ * read-only count can be skipped. */
 static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, const size_t n,
                              const delta_mode_t mode, const occ_value_t fixed,
-                             size_t *const n_changed)
+                             const bool bound_fits, size_t *const n_changed)
 {
     if (n_changed != NULL) {
         *n_changed = 0u;
@@ -333,12 +358,13 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
     if (n == 0u) {
         return OCC_OK;
     }
-    uint64_t need_inner, need_leaf;
-    count_blocks(m, codes, n, mode, fixed, &need_inner, &need_leaf);
-    if (need_inner > OCC_NONE || need_leaf > OCC_NONE ||
-        !occ_pool_can_supply(m, (uint32_t)need_inner, (uint32_t)need_leaf)) {
-        m->oom_count++;
-        return OCC_ERR_NOMEM;
+    if (!bound_fits) {
+        uint64_t need_inner, need_leaf;
+        count_blocks(m, codes, n, mode, fixed, &need_inner, &need_leaf);
+        if (!can_supply64(m, need_inner, need_leaf)) {
+            m->oom_count++;
+            return OCC_ERR_NOMEM;
+        }
     }
     path_t p;
     const unsigned depth = m->cfg.depth_levels;
@@ -397,10 +423,12 @@ occ_err_t occ_map_observe_codes(occ_map_t *const map, const occ_code_t *const co
     if (map == NULL || (codes == NULL && n != 0u)) {
         return OCC_ERR_ARG;
     }
-    if (!codes_valid(map, codes, n)) {
+    uint64_t bound_inner, bound_leaf;
+    if (!codes_valid(map, codes, n, &bound_inner, &bound_leaf)) {
         return OCC_ERR_ARG;
     }
-    return apply_batch(map, codes, n, DELTA_TAGGED, 0, n_changed);
+    return apply_batch(map, codes, n, DELTA_TAGGED, 0, can_supply64(map, bound_inner, bound_leaf),
+                       n_changed);
 }
 
 static bool finite_f(const float x)
@@ -417,7 +445,8 @@ occ_err_t occ_map_update_key(occ_map_t *const map, const occ_key_t key, const fl
         return OCC_ERR_RANGE;
     }
     const occ_code_t code = occ_morton_encode(key);
-    return apply_batch(map, &code, 1u, DELTA_FIXED, occ_value_from_logodds(delta_logodds), NULL);
+    return apply_batch(map, &code, 1u, DELTA_FIXED, occ_value_from_logodds(delta_logodds), false,
+                       NULL);
 }
 
 occ_err_t occ_map_update(occ_map_t *const map, const occ_vec3_t p, const float delta_logodds)
@@ -436,7 +465,7 @@ occ_err_t occ_map_observe_key(occ_map_t *const map, const occ_key_t key, const b
         return OCC_ERR_RANGE;
     }
     const occ_code_t code = occ_morton_encode(key) | (occupied ? OCC_CODE_HIT_BIT : 0u);
-    return apply_batch(map, &code, 1u, DELTA_TAGGED, 0, NULL);
+    return apply_batch(map, &code, 1u, DELTA_TAGGED, 0, false, NULL);
 }
 
 /* ---- setting whole nodes ---------------------------------------------------------------------- */

@@ -83,12 +83,51 @@ static inline unsigned occ_code_slot(occ_code_t code, unsigned level)
     return (unsigned)((code >> (3u * (level - 1u))) & 7u);
 }
 
-/* State and indicator flags of a single (uniform) value. */
-occ_state_t occ_value_state(const occ_map_t *m, occ_value_t v);
-uint8_t occ_value_flags(const occ_map_t *m, occ_value_t v);
+/* State and indicator flags of a single (uniform) value. Inline: they sit on the update path. */
+static inline occ_state_t occ_value_state(const occ_map_t *const m, const occ_value_t v)
+{
+    if (!occ_is_observed(v)) {
+        return OCC_STATE_UNKNOWN;
+    }
+    if (v >= m->q_occ_min) {
+        return OCC_STATE_OCCUPIED;
+    }
+    return v < m->q_free_max ? OCC_STATE_FREE : OCC_STATE_UNKNOWN;
+}
+
+static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_t v)
+{
+    if (!occ_is_observed(v)) {
+        return (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    }
+    if (v >= m->q_occ_min) {
+        return (uint8_t)OCC_NODE_HAS_OCCUPIED;
+    }
+    return (uint8_t)(v < m->q_free_max ? OCC_NODE_HAS_FREE : OCC_NODE_HAS_UNKNOWN);
+}
+
 /* OctoMap's update of one voxel value: an unobserved voxel starts at 0; a value at a clamp
  * bound is kept when the delta pushes outward; the result is clamped to [clamp_min, clamp_max]. */
-occ_value_t occ_value_apply_delta(const occ_map_t *m, occ_value_t v, occ_value_t delta);
+static inline occ_value_t occ_value_apply_delta(const occ_map_t *const m, const occ_value_t v,
+                                                const occ_value_t delta)
+{
+    const bool observed = occ_is_observed(v);
+    /* OctoMap's updateNode returns early when the voxel sits at a clamp bound already. */
+    if (observed && ((delta >= 0 && v >= m->q_clamp_max) || (delta <= 0 && v <= m->q_clamp_min))) {
+        return v;
+    }
+#if OCC_VALUE_FLOAT
+    float nv = (observed ? v : 0.0f) + delta;
+#else
+    int32_t nv = (int32_t)(observed ? v : 0) + (int32_t)delta;
+#endif
+    if (nv < m->q_clamp_min) {
+        nv = m->q_clamp_min;
+    } else if (nv > m->q_clamp_max) {
+        nv = m->q_clamp_max;
+    }
+    return (occ_value_t)nv;
+}
 /* Equality of raw values (also for the float build, where -Wfloat-equal forbids ==). */
 static inline bool occ_value_eq(occ_value_t a, occ_value_t b)
 {

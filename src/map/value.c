@@ -40,48 +40,6 @@ bool occ_value_observed(const occ_value_t v)
     return occ_is_observed(v);
 }
 
-occ_state_t occ_value_state(const occ_map_t *const m, const occ_value_t v)
-{
-    if (!occ_is_observed(v)) {
-        return OCC_STATE_UNKNOWN;
-    }
-    if (v >= m->q_occ_min) {
-        return OCC_STATE_OCCUPIED;
-    }
-    return v < m->q_free_max ? OCC_STATE_FREE : OCC_STATE_UNKNOWN;
-}
-
-uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_t v)
-{
-    switch (occ_value_state(m, v)) {
-    case OCC_STATE_OCCUPIED: return (uint8_t)OCC_NODE_HAS_OCCUPIED;
-    case OCC_STATE_FREE: return (uint8_t)OCC_NODE_HAS_FREE;
-    case OCC_STATE_UNKNOWN: return (uint8_t)OCC_NODE_HAS_UNKNOWN;
-    default: return (uint8_t)OCC_NODE_HAS_UNKNOWN;
-    }
-}
-
-occ_value_t occ_value_apply_delta(const occ_map_t *const m, const occ_value_t v,
-                                  const occ_value_t delta)
-{
-    const bool observed = occ_is_observed(v);
-    /* OctoMap's updateNode returns early when the voxel sits at a clamp bound already. */
-    if (observed && ((delta >= 0 && v >= m->q_clamp_max) || (delta <= 0 && v <= m->q_clamp_min))) {
-        return v;
-    }
-#if OCC_VALUE_FLOAT
-    float nv = (observed ? v : 0.0f) + delta;
-#else
-    int32_t nv = (int32_t)(observed ? v : 0) + (int32_t)delta;
-#endif
-    if (nv < m->q_clamp_min) {
-        nv = m->q_clamp_min;
-    } else if (nv > m->q_clamp_max) {
-        nv = m->q_clamp_max;
-    }
-    return (occ_value_t)nv;
-}
-
 occ_state_t occ_map_state_of(const occ_map_t *const map, const float logodds)
 {
     if (map == NULL || !(logodds - logodds < 1.0f)) {
