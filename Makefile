@@ -136,10 +136,10 @@ CROSS_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC)
 
 $(BUILD)/cross/m4/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M4) $(EXTRA_CFLAGS) -c $< -o $@
+	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M4) $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
 $(BUILD)/cross/m0/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M0) $(EXTRA_CFLAGS) -c $< -o $@
+	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M0) $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
 
 cross-objs: $(DEPS_STAMP) $(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o) $(CROSS_EXTRA)
 cross: cross-objs
@@ -160,5 +160,5 @@ distclean:
 	rm -rf $(BUILD)
 
 .PHONY: all deps test test-build cross cross-objs symcheck demo bench fuzz clean distclean
-.SECONDARY:
+.PRECIOUS: %.o
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -86,10 +86,10 @@ IO_FLOAT_DIR := $(BUILD)/iofloat
 IO_FLOAT_CFLAGS := $(HOST_WARN) -O2 -g $(INC) -DOCC_VALUE_FLOAT=1
 $(IO_FLOAT_DIR)/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(IO_FLOAT_CFLAGS) -c $< -o $@
+	$(CC) $(IO_FLOAT_CFLAGS) -MMD -MP -c $< -o $@
 $(IO_FLOAT_DIR)/%.o: %.cpp
 	@mkdir -p $(dir $@)
-	$(CXX) $(CXXWARN) -O2 -g $(INC) -DOCC_VALUE_FLOAT=1 -c $< -o $@
+	$(CXX) $(CXXWARN) -O2 -g $(INC) -DOCC_VALUE_FLOAT=1 -MMD -MP -c $< -o $@
 IO_FLOAT_BIN := $(IO_FLOAT_DIR)/test_io_octomap_float
 $(IO_FLOAT_BIN): $(OCC_CORE_SRC:%.c=$(IO_FLOAT_DIR)/%.o) $(IO_FLOAT_DIR)/tests/test_io_octomap.o \
                  $(IO_FLOAT_DIR)/tests/support/iotest.o $(IO_FLOAT_DIR)/tests/support/oracle_io.o

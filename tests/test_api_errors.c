@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "occmap/occmap.h"
@@ -177,23 +178,45 @@ static void test_init_bad_config(void **state)
 }
 
 /* The header: OCC_ERR_NOMEM if the arena cannot hold one inner and one leaf block. */
+/* By design (occmap.h, occ_map_init): any arena size is accepted, even 0 bytes or NULL. Such a
+ * map holds only a uniform root: reads answer UNKNOWN, every write that needs a block returns
+ * OCC_ERR_NOMEM (counted), and the map stays consistent. */
 static void test_init_small_arena(void **state)
 {
     (void)state;
     static uint64_t a3[64];
     const occ_map_config_t c = occ_map_config_default();
     const size_t need = OCC_INNER_BLOCK_BYTES + OCC_LEAF_BLOCK_BYTES;
-    for (size_t bytes = 0; bytes < need; bytes++) {
-        occ_map_t m;
-        const occ_err_t e = occ_map_init(&m, &c, a3, bytes);
-        if (e != OCC_ERR_NOMEM) {
-            fail_msg("init with a %u-byte arena (< one inner + one leaf block = %u) gave %d (%s), "
-                     "want OCC_ERR_NOMEM", (unsigned)bytes, (unsigned)need, (int)e, occ_err_str(e));
+    const occ_key_t k = mk(5, 6, 7);
+    for (size_t bytes = 0; bytes <= need + OCC_ARENA_ALIGN; bytes++) {
+        for (unsigned misalign = 0; misalign < 2u; misalign++) {
+            occ_map_t m;
+            uint8_t *const base = (uint8_t *)a3 + misalign;
+            assert_int_equal(occ_map_init(&m, &c, base, bytes), OCC_OK);
+            assert_int_equal(occ_map_check(&m), OCC_OK);
+            assert_true(m.arena_bytes <= bytes);
+            const occ_err_t e = occ_map_observe_key(&m, k, true);
+            /* depth 16 needs 15 inner blocks and 1 leaf block for a first voxel */
+            const bool fits = m.arena_bytes >= 15u * OCC_INNER_BLOCK_BYTES + OCC_LEAF_BLOCK_BYTES;
+            assert_int_equal(e, fits ? OCC_OK : OCC_ERR_NOMEM);
+            assert_int_equal(m.oom_count, fits ? 0u : 1u);
+            occ_node_info_t info;
+            assert_int_equal(occ_map_read_key(&m, k, 0u, &info), OCC_OK);
+            assert_int_equal(info.state, fits ? OCC_STATE_OCCUPIED : OCC_STATE_UNKNOWN);
+            assert_int_equal(occ_map_check(&m), OCC_OK);
+            /* A whole-map write needs no block at all and always succeeds. */
+            assert_int_equal(occ_map_set_key(&m, k, c.depth_levels, -1.0f), OCC_OK);
+            assert_int_equal(occ_map_state_at(&m, (occ_vec3_t){0.0f, 0.0f, 0.0f}), OCC_STATE_FREE);
+            assert_int_equal(occ_map_check(&m), OCC_OK);
+            occ_map_clear(&m);
+            assert_int_equal(m.inner.used + m.leaf.used, 0u);
         }
     }
     occ_map_t m;
-    assert_int_equal(occ_map_init(&m, &c, a3, need), OCC_OK);
-    assert_int_equal(occ_map_init(&m, &c, NULL, 0u), OCC_ERR_NOMEM);
+    assert_int_equal(occ_map_init(&m, &c, NULL, 0u), OCC_OK);
+    assert_int_equal(occ_map_observe_key(&m, k, false), OCC_ERR_NOMEM);
+    assert_int_equal(occ_map_check(&m), OCC_OK);
+    assert_int_equal(occ_map_init(&m, &c, NULL, 8u), OCC_ERR_ARG);
 }
 
 static void test_coordinates(void **state)
@@ -240,6 +263,18 @@ static void test_coordinates(void **state)
     assert_int_equal(k.k[0], 32768u);
     assert_int_equal(k.k[1], 32768u);
     assert_int_equal(k.k[2], 32767u);
+    /* Node sizes and centres (hand-computed at res 0.1, depth 16). */
+    for (unsigned level = 0; level <= 16u; level++) {
+        const float want = 0.1f * (float)(1u << level);
+        assert_true(fabsf(occ_map_node_size(&map, level) - want) <= 1e-6f * want);
+    }
+    const occ_vec3_t c0 = occ_map_key_center(&map, mk(32768u, 32767u, 0u), 0u);
+    assert_true(fabsf(c0.x - 0.05f) < 1e-6f && fabsf(c0.y + 0.05f) < 1e-6f &&
+                fabsf(c0.z + 3276.75f) < 1e-3f);
+    const occ_vec3_t c16 = occ_map_key_center(&map, mk(5u, 60000u, 32768u), 16u);
+    assert_true(fabsf(c16.x) < 1e-6f && fabsf(c16.y) < 1e-6f && fabsf(c16.z) < 1e-6f);
+    const occ_vec3_t c2 = occ_map_key_center(&map, mk(32775u, 32768u, 32768u), 2u);
+    assert_true(fabsf(c2.x - 0.6f) < 1e-6f && fabsf(c2.y - 0.2f) < 1e-6f);
     /* NULL out-pointers and maps. */
     assert_int_equal(occ_map_key(&map, zero, NULL), OCC_ERR_ARG);
     assert_int_equal(occ_map_key(NULL, zero, &k), OCC_ERR_ARG);

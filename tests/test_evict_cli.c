@@ -1,7 +1,7 @@
 /*
  * test_evict_cli.c - the `occmap build --arena-bytes/--evict/--keep-radius` helper
  * (tools/evict_cli.c, compiled in): flag parsing and errors, the JSON members, and inserting
- * OctoMap's real laser scan (build/data/scan.dat) into an arena a fifth of the map's size with
+ * OctoMap's real laser scan (build/data/scan.dat) into an arena half the map's size with
  * the automatic eviction: every insert succeeds, the arena is never exceeded, check() holds.
  */
 #include <stdarg.h>
@@ -20,7 +20,7 @@
 
 #define SCAN_DAT "build/data/scan.dat"
 #ifndef ARENA_DIV
-#define ARENA_DIV 3u
+#define ARENA_DIV 2u
 #endif
 
 static int run_parse(evict_cli_t *c, int argc, char **argv)
@@ -84,8 +84,8 @@ static void test_json_and_insert(void **state)
     size_t n = 0;
     char msg[128];
     assert_int_equal(occ_scan_read_xyz(SCAN_DAT, &pts, &n, msg, sizeof msg), OCC_OK);
-    size_t kept = 0; /* every 8th point: enough rays, a small scratch */
-    for (size_t j = 0; j < n; j += 8u) {
+    size_t kept = 0; /* every 16th point: enough rays, a small scratch */
+    for (size_t j = 0; j < n; j += 16u) {
         pts[kept++] = pts[j];
     }
     n = kept;
@@ -99,14 +99,14 @@ static void test_json_and_insert(void **state)
     assert_string_equal(json, "\"arena_bytes\": null, \"evictions\": 0, \"blocks_evicted\": 0, "
                               "\"last_origin\": null");
 
-    /* The scan as 8 sweeps from origins 20 m apart, at 0.1 m, max range 10 m. */
+    /* The scan as 8 sweeps from origins 20 m apart, at 0.1 m, max range 6 m. */
     occ_map_config_t cfg = occ_map_config_default();
     occ_insert_params_t ip = occ_insert_params_default();
-    ip.max_range_m = 10.0f;
+    ip.max_range_m = 6.0f;
     static uint8_t big[16u << 20];
     occ_map_t ref;
     assert_int_equal(occ_map_init(&ref, &cfg, big, sizeof big), OCC_OK);
-    const size_t sb = occ_insert_scratch_bytes(&ref, n, 10.0f, &ip);
+    const size_t sb = occ_insert_scratch_bytes(&ref, n, 6.0f, &ip);
     void *scratch = malloc(sb);
     occ_vec3_t *moved = malloc(n * sizeof *moved);
     assert_non_null(scratch);
@@ -125,7 +125,7 @@ static void test_json_and_insert(void **state)
     evict_cli_init(&c);
     char a[32];
     snprintf(a, sizeof a, "%zu", st.bytes_peak / ARENA_DIV);
-    char *args[] = {"--arena-bytes", a, "--evict", "robot", "--keep-radius", "10"};
+    char *args[] = {"--arena-bytes", a, "--evict", "robot", "--keep-radius", "6"};
     assert_int_equal(run_parse(&c, 6, args), 0);
     uint8_t *arena = malloc(c.arena_bytes);
     assert_non_null(arena);
@@ -157,7 +157,7 @@ static void test_json_and_insert(void **state)
              c.arena_bytes, (unsigned long long)c.out.evictions,
              (unsigned long long)c.out.blocks_freed);
     assert_string_equal(json, want);
-    printf("evict_cli: scan.dat x %d sweeps in an arena of %zu bytes (a third of the map): "
+    printf("evict_cli: scan.dat x %d sweeps in an arena of %zu bytes (half the map): "
            "%u inserts needed eviction, %s\n", SWEEPS, c.arena_bytes, c.insert_retries, json);
     free(arena);
     occ_map_clear(&ref);

@@ -393,8 +393,10 @@ static void test_fast_discrete(void **state)
     p.fast_d = 2;
     p.fast_n = 0;
     occ_insert_result_t out;
-    assert_int_equal(occ_map_insert_cloud(&b, &c.origin, c.p, c.n, &p, scratch, SCRATCH_BYTES,
-                                          &out),
+    /* Exactly the documented bound is enough (and the sorted path runs with it). */
+    const size_t need = occ_insert_scratch_bytes_scan(&b, &c.origin, c.p, c.n, &p);
+    assert_true(need < SCRATCH_BYTES);
+    assert_int_equal(occ_map_insert_cloud(&b, &c.origin, c.p, c.n, &p, scratch, need, &out),
                      OCC_OK);
     assert_int_equal(occ_map_check(&b), OCC_OK);
     size_t missed = 0;
@@ -404,6 +406,22 @@ static void test_fast_discrete(void **state)
     printf("  fast d=2 n=0: %zu voxels, %zu coarse nodes, %zu end points not occupied\n",
            out.voxels_updated, out.coarse_updated, missed);
     assert_int_equal(missed, 0);
+    /* n = 2: exact voxels near the end, coarse marching before; dense and sorted paths agree. */
+    p.fast_n = 2;
+    occ_map_clear(&a);
+    occ_map_clear(&b);
+    assert_int_equal(occ_map_insert_cloud(&a, &c.origin, c.p, c.n, &p, scratch, SCRATCH_BYTES,
+                                          &out),
+                     OCC_OK);
+    const size_t need2 = occ_insert_scratch_bytes_scan(&b, &c.origin, c.p, c.n, &p);
+    assert_int_equal(occ_map_insert_cloud(&b, &c.origin, c.p, c.n, &p, scratch, need2 / 4u,
+                                          NULL),
+                     OCC_OK);
+    assert_int_equal(occ_map_check(&a), OCC_OK);
+    assert_int_equal(diff_maps(&a, &b), 0);
+    printf("  fast d=2 n=2: %zu voxels, %zu coarse nodes\n", out.voxels_updated,
+           out.coarse_updated);
+    assert_true(out.voxels_updated > out.voxels_occupied);
     free(c.p);
 }
 

@@ -165,7 +165,7 @@ static void test_corrupt(void **state)
 {
     (void)state;
     occ_map_t m;
-    build_random(&m, 500u, 16u);
+    build_random(&m, 150u, 16u);
     size_t n = 0;
     uint8_t *s = snap(&m, &n);
     uint8_t *b = (uint8_t *)malloc(n);
@@ -218,7 +218,7 @@ static void test_every_small_arena(void **state)
 {
     (void)state;
     occ_map_t m, v;
-    build_random(&m, 200u, 16u);
+    build_random(&m, 60u, 16u);
     size_t n = 0;
     uint8_t *s = snap(&m, &n);
     occ_io_info_t info;

@@ -241,6 +241,11 @@ static void test_arena_sizing(void **state)
 {
     (void)state;
     const occ_map_config_t cfg = occ_map_config_default();
+    /* The public size macros are the internal block sizes. */
+    assert_int_equal(OCC_INNER_BLOCK_BYTES, sizeof(occ_inner_block_t));
+    assert_int_equal(OCC_LEAF_BLOCK_BYTES, sizeof(occ_leaf_block_t));
+    assert_int_equal(OCC_INNER_BLOCK_BYTES % OCC_ARENA_ALIGN, 0u);
+    assert_int_equal(OCC_LEAF_BLOCK_BYTES % OCC_ARENA_ALIGN, 0u);
     for (uint32_t i = 0; i <= 6u; i++) {
         for (uint32_t j = 0; j <= MAX_UNITS; j++) {
             const size_t bytes = OCC_ARENA_BYTES(i, j);

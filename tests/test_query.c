@@ -224,7 +224,7 @@ static void random_volumes(float res, uint8_t depth, unsigned n_volumes)
         assert_true(qs_random_shape(&rng, &map, kind, reach, half * 0.6, &s));
         for (unsigned t = 0; t < 2u; t++) {
             const unsigned states = 1u + (unsigned)(qs_rand(&rng) % 7u);
-            const unsigned level = (unsigned)(qs_rand(&rng) % 3u);
+            const unsigned level = (unsigned)(qs_rand(&rng) % (t == 0u ? 3u : 5u));
             check_split(&s, states, level);
         }
         check_nosplit(&s, 1u + (unsigned)(qs_rand(&rng) % 7u));
@@ -328,6 +328,27 @@ static void test_uniform_root(void **state)
     assert_true(fabsf(g.entropy_bits - 27.0f) < 1e-4f);
     assert_int_equal(occ_info_gain(&map, &v, 1, 0, &g), OCC_OK);
     assert_int_equal(g.unknown_cells, 8); /* the 8 level-1 cells around the origin corner */
+    /* Occlusion: nothing occupied yet, every cell is seen; then a wall of occupied voxels at
+     * x = 0.1..0.2 hides the cells behind it from the sphere's centre. */
+    assert_int_equal(occ_info_gain(&map, &v, 0, OCC_GAIN_OCCLUSION, &g), OCC_OK);
+    assert_int_equal(g.unknown_cells, 27);
+    for (uint32_t y = 0; y < 16u; y++) {
+        for (uint32_t z = 0; z < 16u; z++) {
+            const occ_key_t k = {{9u, y, z}};
+            assert_int_equal(occ_map_set_key(&map, k, 0, 2.0f), OCC_OK);
+        }
+    }
+    assert_int_equal(occ_info_gain(&map, &v, 0, 0, &g), OCC_OK);
+    assert_int_equal(g.unknown_cells, 18); /* the 9 wall voxels are no longer unknown */
+    assert_int_equal(occ_info_gain(&map, &v, 0, OCC_GAIN_OCCLUSION, &g), OCC_OK);
+    assert_int_equal(g.unknown_cells, 18); /* the wall is the far layer: nothing behind it */
+    v.u.sphere.r = 0.25f;
+    v.bmin.x = v.bmin.y = v.bmin.z = 0.05f - 0.25f;
+    v.bmax.x = v.bmax.y = v.bmax.z = 0.05f + 0.25f;
+    occ_info_gain_t all;
+    assert_int_equal(occ_info_gain(&map, &v, 0, 0, &all), OCC_OK);
+    assert_int_equal(occ_info_gain(&map, &v, 0, OCC_GAIN_OCCLUSION, &g), OCC_OK);
+    assert_true(g.unknown_cells < all.unknown_cells); /* cells at x >= 0.2 are behind the wall */
 }
 
 static void test_nearest(void **state)

@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "evict_cli.h"
 #include "occmap/occ_file.h"
 #include "occmap/occ_scan.h"
 
@@ -102,9 +103,18 @@ int cmd_build(int argc, char **argv)
     unsigned long stride = 1, frames = 0, n = 0, d = 2, k = 4;
     size_t arena_bytes = (size_t)1 << 30;
     occ_insert_method_t method = OCC_INSERT_SIMPLE;
+    evict_cli_t ev;
+    evict_cli_init(&ev);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const bool has = i + 1 < argc;
+        const int ev_rc = evict_cli_parse(&ev, argc, argv, &i);
+        if (ev_rc < 0) {
+            return 2;
+        }
+        if (ev_rc > 0) {
+            continue; /* --arena-bytes, --evict, --keep-radius */
+        }
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage();
             return 0;
@@ -146,11 +156,6 @@ int cmd_build(int argc, char **argv)
                 cli_error("build", "bad %s '%s'", a, argv[i]);
                 return 2;
             }
-        } else if (strcmp(a, "--arena-bytes") == 0 && has) {
-            if (!cli_parse_size(argv[++i], &arena_bytes)) {
-                cli_error("build", "bad --arena-bytes '%s'", argv[i]);
-                return 2;
-            }
         } else if (strcmp(a, "-o") == 0 && has) {
             out_path = argv[++i];
         } else if (strcmp(a, "--json") == 0) {
@@ -159,6 +164,12 @@ int cmd_build(int argc, char **argv)
             cli_error("build", "unknown option '%s' (see --help)", a);
             return 2;
         }
+    }
+    if (evict_cli_finish(&ev) != 0) {
+        return 2;
+    }
+    if (ev.fixed_arena) {
+        arena_bytes = ev.arena_bytes; /* allocated exactly once, never grown */
     }
     if ((scan != NULL) + (graph != NULL) + (dir != NULL) != 1) {
         cli_error("build", "give exactly one of --scan, --graph, --depth-dir");
@@ -210,8 +221,8 @@ int cmd_build(int argc, char **argv)
     for (size_t i = 0; rc == 0 && i < in.n; i++) {
         occ_insert_result_t r;
         const double t0 = now_ms();
-        e = occ_map_insert_cloud(&map, &in.frames[i].origin, in.frames[i].points,
-                                 in.frames[i].n_points, &p, scratch, need, &r);
+        e = evict_cli_insert(&ev, &map, &in.frames[i].origin, in.frames[i].points,
+                             in.frames[i].n_points, &p, scratch, need, &r);
         ms += now_ms() - t0;
         if (e != OCC_OK) {
             cli_error("build", "scan %zu (%s): %s%s", i, in.frames[i].name, occ_err_str(e),
@@ -243,9 +254,11 @@ int cmd_build(int argc, char **argv)
             cli_print_stats_json(stdout, &map, &st);
             printf(", \"method\": \"%s\", \"scans\": %zu, \"points\": %zu, \"points_skipped\": %zu,"
                    " \"rays\": %zu, \"voxel_visits\": %zu, \"voxels_updated\": %zu,"
-                   " \"coarse_updated\": %zu, \"integrate_ms\": %.3f}\n",
+                   " \"coarse_updated\": %zu, \"integrate_ms\": %.3f, ",
                    names[method], in.n, sum.points_integrated, sum.points_skipped, sum.rays_cast,
                    sum.voxel_visits, sum.voxels_updated, sum.coarse_updated, ms);
+            evict_cli_print_json(stdout, &ev);
+            printf("}\n");
         } else {
             cli_print_stats_text(stdout, &map, &st);
             printf("method            %s, %zu scan(s), %zu points (%zu skipped) of %zu\n",

@@ -103,27 +103,24 @@ occ_err_t evict_cli_insert(evict_cli_t *const c, occ_map_t *const map, const occ
                            const occ_insert_params_t *const params, void *const scratch,
                            const size_t scratch_bytes, occ_insert_result_t *const res)
 {
-    occ_err_t e = occ_map_insert_cloud(map, origin, points, n_points, params, scratch,
-                                       scratch_bytes, res);
+    if (params == NULL) {
+        return OCC_ERR_ARG;
+    }
+    /* The core's automatic mode evicts around the origin before it fails for lack of blocks. */
+    occ_insert_params_t p = *params;
+    if (c->evict) {
+        p.auto_evict = &c->policy;
+        p.auto_evict_state = &c->out;
+    }
+    const uint64_t evictions_before = c->out.evictions;
+    const occ_err_t e = occ_map_insert_cloud(map, origin, points, n_points, &p, scratch,
+                                             scratch_bytes, res);
     if (origin != NULL && e != OCC_ERR_ARG && e != OCC_ERR_RANGE) {
         c->have_origin = true;
         c->last_origin = *origin;
     }
-    uint32_t want = 4096u;
-    uint32_t oom_before = map != NULL ? map->oom_count - 1u : 0u;
-    /* Only a pool shortage bumps oom_count; a short scratch is not helped by evicting. */
-    while (e == OCC_ERR_NOMEM && c->evict && map->oom_count != oom_before) {
-        oom_before = map->oom_count;
+    if (c->out.evictions != evictions_before) {
         c->insert_retries++;
-        if (occ_map_evict_for(map, origin, &c->policy, want, want, &c->out) != OCC_OK) {
-            break; /* nothing evictable is left outside the protected region */
-        }
-        e = occ_map_insert_cloud(map, origin, points, n_points, params, scratch, scratch_bytes,
-                                 res);
-        if (want > (UINT32_MAX >> 1)) {
-            break;
-        }
-        want *= 2u;
     }
     return e;
 }

@@ -9,7 +9,8 @@
  *    so everything below it reads OCC_STATE_UNKNOWN.
  *  - OCC_EVICT_COARSEN (keep coarse knowledge outside the window): an evicted node at level L
  *    loses its children and keeps one value for its whole cube, chosen so no voxel reads FREE
- *    that was not FREE before and no OCCUPIED voxel reads anything but OCCUPIED:
+ *    that was not FREE before and no OCCUPIED voxel reads anything but OCCUPIED (until the
+ *    fallback below forgets it):
  *      * max of the voxels below is OCCUPIED           -> the cube reads OCCUPIED (conservative);
  *      * max is FREE and every voxel below was FREE    -> the cube reads FREE (value = the max,
  *                                                         the least certain free voxel);
@@ -23,7 +24,9 @@
  *
  * In both modes evicted space is never FREE unless all of it was FREE, and the protected
  * region around the centre (a ball of keep_radius_m, or a box of half extents keep_half_m) is
- * never touched: every node whose cube intersects it keeps its content bit for bit.
+ * never touched: only nodes whose cube lies entirely outside it (by a margin of about
+ * res/1000 plus float rounding of the centre's coordinates) are collapsed, so every voxel whose
+ * cube meets the region keeps its value.
  *
  * Order: approximately farthest first. A sweep runs passes with a distance threshold T that
  * starts beyond the farthest detailed content and shrinks by 1/4 per pass down to 0; a pass
@@ -34,12 +37,15 @@
  * it only grows during a flight (a fresh sweep starts at the level the last one reached, so
  * exhausted levels are not swept again on every call); occ_evict_out_init() resets it.
  *
- * Slices: a call visits at most policy.budget_blocks blocks (0 = no limit), so eviction can run
- * a slice per control cycle. The sweep position is kept in the caller-owned occ_evict_out_t as
- * a Morton code and a level (not as block indices), so the map may be changed freely between
- * slices; the next call resumes where the last one stopped if the last one stopped because of
- * the budget, and starts a fresh sweep otherwise. Every call leaves the map consistent
- * (occ_map_check() holds after every call).
+ * Slices: a call visits at most policy.budget_blocks blocks (0 = no limit; plus at most one
+ * block, the root's, per pass started), so eviction can run a slice per control cycle. The
+ * sweep position is kept in the caller-owned occ_evict_out_t as a Morton code and a level (not
+ * as block indices), so the map may be changed freely between calls; the next call continues
+ * the sweep where the last one stopped when the budget ran out, and starts a new sweep (from
+ * the far end, around the centre it is given) after one reached its target or ended. Without
+ * a budget, a sweep that began in an earlier call is only believed "exhausted" after a second,
+ * complete sweep in the same call. Every call leaves the map consistent (occ_map_check()
+ * holds after every call).
  *
  * Memory and work: no heap, no recursion; the walk's stack (about 300 bytes) lives in
  * occ_evict_out_t. Work per call is O(budget_blocks + depth) block visits; without a budget it
@@ -64,7 +70,7 @@ typedef enum {
     OCC_EVICT_BOX = 1      /* protected axis-aligned box centre +- keep_half_m */
 } occ_evict_shape_t;
 
-typedef struct {
+typedef struct occ_evict_policy {
     occ_evict_mode_t mode;
     occ_evict_shape_t shape;
     float keep_radius_m;      /* SPHERE: protected radius, metres, >= 0 and finite */
@@ -79,7 +85,7 @@ occ_evict_policy_t occ_evict_policy_default(void);
 
 /* Where a sweep stands (internal; zero is "no sweep in progress"). */
 typedef struct {
-    uint8_t phase;        /* 0 idle, 1 running, 2 stopped by the budget (resume) */
+    uint8_t phase;        /* 0 idle, 1 running, 2 a sweep to continue */
     uint8_t coarse_level; /* current collapse level (COARSEN), depth+1 = forgetting */
     uint8_t depth;        /* map depth the sweep was started for */
     uint8_t resume_level; /* level of the next node to visit */
@@ -96,7 +102,7 @@ typedef struct {
 
 /* Caller-owned eviction state and statistics. Zero it (or call occ_evict_out_init) once and
  * pass the same struct to every call for one map; the totals accumulate. */
-typedef struct {
+typedef struct occ_evict_out {
     /* totals since init */
     uint64_t calls;
     uint64_t evictions;       /* nodes collapsed (forgotten or coarsened) */
@@ -109,7 +115,8 @@ typedef struct {
     uint32_t last_visited;    /* blocks visited (<= budget_blocks when a budget is set) */
     bool target_reached;      /* the pools can supply the target now */
     bool exhausted;           /* nothing outside the protected region is left to evict */
-    bool resumable;           /* stopped by the budget: the next call continues the sweep */
+    bool resumable;           /* stopped by the budget (target not reached yet) */
+    bool sweep_active;        /* a sweep is in progress: the next call continues it */
     /* the map's pools after the last call */
     size_t bytes_used;
     size_t bytes_peak;        /* the pools' peak since the map's init/clear */

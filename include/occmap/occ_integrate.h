@@ -78,9 +78,19 @@ typedef struct {
     uint8_t fast_n;     /* FAST_DISCRETE: coarse nodes before the end where fine marching starts */
     uint8_t fast_d;     /* FAST_DISCRETE: level of the coarse nodes, 0..depth_levels-1 */
     uint16_t super_k;   /* SUPER_RAYS: end voxels with fewer points are cast singly (paper: 20) */
+    /* Automatic eviction (occ_evict.h), NULL = off. When the pools are short for the scan's
+     * voxel updates, evict with this policy around `origin` (occ_map_evict_for, which never
+     * touches the protected region) and retry. If the whole scan still does not fit at once,
+     * its sorted updates are applied in Morton-ordered chunks, evicting before each chunk that
+     * needs it: the result equals one batch, but the call is then no longer all-or-nothing
+     * (on OCC_ERR_NOMEM the chunks before the failing one stay applied; out->voxels_updated
+     * says how many). `auto_evict_state` (required with a policy) accumulates the statistics.
+     * FAST_DISCRETE's coarse free-space pass is applied before and is not covered. */
+    const struct occ_evict_policy *auto_evict;  /* occ_evict_policy_t */
+    struct occ_evict_out *auto_evict_state;     /* occ_evict_out_t */
 } occ_insert_params_t;
 
-/* SIMPLE, unlimited range, n = 0, d = 2, k = 4. */
+/* SIMPLE, unlimited range, n = 0, d = 2, k = 4, no automatic eviction. */
 occ_insert_params_t occ_insert_params_default(void);
 
 typedef struct {
@@ -102,12 +112,16 @@ typedef struct {
  * distance); <= 0 or non-finite means "the whole map": a huge number). Formula:
  *   fixed + 16 * n_points * (3 * (ceil(max_ray_m / res) + 2) + 2) + 16 * n_points
  * where fixed = 2^OCC_INSERT_FILTER_BITS * 8 + 6 * 2^OCC_INSERT_RADIX_BITS * 4 + 64.
- * FAST_DISCRETE and SUPER_RAYS need no more than SIMPLE. Saturates at SIZE_MAX. O(1). */
+ * SUPER_RAYS needs no more than SIMPLE; FAST_DISCRETE with d > 0 needs in addition 32 bytes
+ * per 4x4x4 block of level-d nodes of the scan's bounding box and 16 bytes per coarse sample
+ * (occ_insert_scratch_bytes_scan() counts both; this function does not). Saturates at
+ * SIZE_MAX. O(1). */
 size_t occ_insert_scratch_bytes(const occ_map_t *map, size_t n_points, float max_ray_m,
                                 const occ_insert_params_t *params);
 
-/* The same bound computed for one scan: per ray the keys the DDA can emit (|dk|_1 + 4), summed.
- * Bad points count 0. O(n). Returns 0 if an argument is NULL. */
+/* The same bound computed for one scan: per ray the keys the DDA can emit (|dk|_1 + 4), summed
+ * (FAST_DISCRETE: plus its coarse set over the scan's box). Bad points count 0. O(n). Returns
+ * 0 if an argument is NULL. With at least this much scratch, OCC_ERR_NOMEM means the pools. */
 size_t occ_insert_scratch_bytes_scan(const occ_map_t *map, const occ_vec3_t *origin,
                                      const occ_vec3_t *points, size_t n_points,
                                      const occ_insert_params_t *params);

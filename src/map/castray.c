@@ -21,6 +21,8 @@ typedef float real_t;
 /* The path from the root to the node holding the current voxel. */
 typedef struct {
     const occ_map_t *m;
+    const occ_inner_block_t *inner_top; /* inner block 0 (blocks grow down from the arena end) */
+    const occ_leaf_block_t *leaf_base;  /* leaf block 0 */
     uint32_t key[3];
     unsigned lu;      /* level of the deepest node on the path (uniform, or 0) */
     occ_value_t val;  /* its value */
@@ -29,19 +31,16 @@ typedef struct {
 
 static void descend(cursor_t *c, unsigned level)
 {
-    const occ_map_t *const m = c->m;
+    /* Locals: the stores to c->blk must not make the compiler reload keys and bases. */
+    const uint32_t k0 = c->key[0];
+    const uint32_t k1 = c->key[1];
+    const uint32_t k2 = c->key[2];
+    const occ_inner_block_t *const top = c->inner_top;
     uint32_t b = c->blk[level];
-    if (level == 1u) { /* a sibling voxel in the same leaf block: the common case */
-        const unsigned slot = (c->key[0] & 1u) | ((c->key[1] & 1u) << 1) | ((c->key[2] & 1u) << 2);
-        c->lu = 0;
-        c->val = occ_leaf_at(m, b)->value[slot];
-        return;
-    }
     while (level > 1u) {
         const unsigned l = level - 1u;
-        const unsigned slot = ((c->key[0] >> l) & 1u) | (((c->key[1] >> l) & 1u) << 1) |
-                              (((c->key[2] >> l) & 1u) << 2);
-        const occ_inner_block_t *const ib = occ_inner_at(m, b);
+        const unsigned slot = ((k0 >> l) & 1u) | (((k1 >> l) & 1u) << 1) | (((k2 >> l) & 1u) << 2);
+        const occ_inner_block_t *const ib = top - b; /* occ_inner_at(m, b) */
         const uint32_t ch = ib->child[slot];
         if (ch == OCC_NONE) {
             c->lu = l;
@@ -52,14 +51,15 @@ static void descend(cursor_t *c, unsigned level)
         b = ch;
         level = l;
     }
-    const unsigned slot = (c->key[0] & 1u) | ((c->key[1] & 1u) << 1) | ((c->key[2] & 1u) << 2);
     c->lu = 0;
-    c->val = occ_leaf_at(m, b)->value[slot];
+    c->val = c->leaf_base[b].value[(k0 & 1u) | ((k1 & 1u) << 1) | ((k2 & 1u) << 2)];
 }
 
 static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3])
 {
     c->m = m;
+    c->inner_top = occ_inner_at(m, 0u);
+    c->leaf_base = occ_leaf_at(m, 0u);
     c->key[0] = key[0];
     c->key[1] = key[1];
     c->key[2] = key[2];
@@ -464,10 +464,9 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
         entered = true;
     }
     if (!reached_b) {
-        cursor_t cb;
-        cursor_init(&cb, map, kb.k);
-        if (blocks(map, cb.val, policy)) {
-            set_result(&cb, res, tmv, res_out, true, OCC_RAY_HIT);
+        cursor_init(&c, map, kb.k); /* the walk is over: reuse its cursor for b's voxel */
+        if (blocks(map, c.val, policy)) {
+            set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
             return OCC_OK;
         }
     }

@@ -20,7 +20,7 @@
 #define EVICT_SHRINK 0.75f    /* threshold factor per pass */
 #define EVICT_FORGET_MARK 0xFFu /* cursor.coarse_level while forgetting */
 
-enum { PHASE_IDLE = 0, PHASE_RUNNING = 1, PHASE_RESUME = 2 };
+enum { PHASE_IDLE = 0, PHASE_RESUME = 2 };
 
 typedef struct {
     occ_map_t *m;
@@ -274,12 +274,15 @@ static void pop(ctx_t *const x)
     if (cur->dirty[top] != 0u) {
         changed = occ_tree_refresh(m, n, lvl);
     }
-    if (*n.child != OCC_NONE && collapsible_level(x, lvl) && children_childless(m, *n.child)) {
+    if (*n.child != OCC_NONE && collapsible_level(x, lvl)) {
         float dmin, dmax;
         node_distance(x, cur->base[top], lvl, &dmin, &dmax);
-        if (qualifies(x, dmin)) {
+        if (qualifies(x, dmin) && children_childless(m, *n.child)) {
             collapse(x, n, lvl);
             changed = true;
+        } else if (dmax > x->eps) {
+            /* Still holds a block a later pass may take (e.g. all its children are uniform). */
+            cur->farthest_m = maxf(cur->farthest_m, dmax);
         }
     }
     if (changed && top > 0u) {
@@ -372,8 +375,6 @@ static run_end_t run(ctx_t *const x)
             continue;
         }
         if (x->budget != 0u && x->visited >= x->budget) {
-            cur->resume_code = cur->base[top] | ((occ_code_t)cur->next[top] << (3u * (lvl - 1u)));
-            cur->resume_level = (uint8_t)(lvl - 1u);
             return RUN_BUDGET;
         }
         const unsigned slot = cur->next[top]++;
@@ -403,8 +404,36 @@ static run_end_t run(ctx_t *const x)
             continue;
         }
         x->visited++;
+        if (!forgetting(x) && lc == cur->coarse_level + 1u && children_childless(m, *cn.child)) {
+            continue; /* already coarse at this level: nothing below to collapse */
+        }
         push(cur, *cn.child, code);
     }
+}
+
+/* Remember where the walk stands as a Morton code and level (blocks may move between calls).
+ * False when the sweep is over (nothing more to evict at its last level). */
+static bool capture(ctx_t *const x)
+{
+    occ_evict_cursor_t *const cur = x->cur;
+    const unsigned depth = x->m->cfg.depth_levels;
+    while (cur->sp > 0u && cur->next[cur->sp - 1u] >= 8u) {
+        pop(x);
+    }
+    if (cur->sp == 0u) {
+        if (!next_pass(x)) {
+            return false;
+        }
+        cur->farthest_m = 0.0f;
+        cur->resume_code = 0u;
+        cur->resume_level = (uint8_t)(depth - 1u);
+        return true;
+    }
+    const unsigned top = cur->sp - 1u;
+    const unsigned lvl = depth - top;
+    cur->resume_code = cur->base[top] | ((occ_code_t)cur->next[top] << (3u * (lvl - 1u)));
+    cur->resume_level = (uint8_t)(lvl - 1u);
+    return true;
 }
 
 static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
@@ -439,25 +468,39 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
     const uint32_t inner_before = map->inner.used, leaf_before = map->leaf.used;
     occ_evict_cursor_t *const cur = &out->cursor;
     run_end_t end = RUN_TARGET;
+    bool sweep_on = cur->phase == PHASE_RESUME && cur->depth == map->cfg.depth_levels;
     if (!target_ok(&x)) {
         if (map->cfg.depth_levels < 2u) {
             end = RUN_EXHAUSTED; /* the root is a level-1 node: nothing to take apart */
+            sweep_on = false;
         } else {
-            if (cur->phase == PHASE_RESUME && cur->depth == map->cfg.depth_levels) {
-                resume(&x);
-            } else {
-                begin_sweep(&x, first_level(&x));
-                cur->farthest_m = 0.0f;
-                (void)begin_pass(&x);
-                cur->depth = map->cfg.depth_levels;
-                out->sweeps++;
+            /* A sweep continues across calls; one that started in an earlier call may have
+             * passed over content added since, so without a budget "nothing left" is only
+             * believed from a sweep run entirely in this call. */
+            const unsigned attempts = budget == 0u ? 2u : 1u;
+            for (unsigned attempt = 0; attempt < attempts; attempt++) {
+                if (sweep_on) {
+                    resume(&x);
+                } else {
+                    begin_sweep(&x, first_level(&x));
+                    cur->farthest_m = 0.0f;
+                    (void)begin_pass(&x);
+                    cur->depth = map->cfg.depth_levels;
+                    out->sweeps++;
+                }
+                end = run(&x);
+                if (end != RUN_EXHAUSTED || !sweep_on) {
+                    break;
+                }
+                sweep_on = false;
             }
-            cur->phase = PHASE_RUNNING;
-            end = run(&x);
+            /* Reaching the target ends the sweep: the next call starts over from the far end
+             * (farthest first again, around the centre it is given). */
+            sweep_on = end == RUN_BUDGET && capture(&x);
             settle(&x);
         }
     }
-    cur->phase = end == RUN_BUDGET ? PHASE_RESUME : PHASE_IDLE;
+    cur->phase = sweep_on ? PHASE_RESUME : PHASE_IDLE;
     const uint32_t freed_inner = inner_before - map->inner.used;
     const uint32_t freed_leaf = leaf_before - map->leaf.used;
     out->calls++;
@@ -471,6 +514,7 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
     out->target_reached = target_ok(&x);
     out->exhausted = end == RUN_EXHAUSTED;
     out->resumable = end == RUN_BUDGET;
+    out->sweep_active = sweep_on;
     occ_map_stats_t st;
     occ_map_pool_stats(map, &st);
     out->bytes_used = st.bytes_used;

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "occmap/occ_evict.h"
 #include "coarse_internal.h"
 #include "integrate_internal.h"
 
@@ -74,7 +75,10 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_
     if (!occ_raygeo_key(&g, o, ko)) {
         return FIXED_BYTES;
     }
-    size_t codes = 0;
+    const bool fast = params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u &&
+                      params->fast_d < map->cfg.depth_levels;
+    size_t codes = 0, samples = 0;
+    uint32_t lo[3] = {ko[0], ko[1], ko[2]}, hi[3] = {ko[0], ko[1], ko[2]};
     for (size_t i = 0; i < n_points; i++) {
         float p[3] = {points[i].x, points[i].y, points[i].z};
         if (params->max_range_m > 0.0f &&
@@ -85,11 +89,28 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_
         }
         uint32_t k[3];
         if (occ_raygeo_key(&g, p, k)) {
-            codes = sat_add(codes, occ_dda_bound(ko, k) + 1u);
+            const size_t b = occ_dda_bound(ko, k);
+            codes = sat_add(codes, b + 1u);
+            samples = sat_add(samples, (b >> params->fast_d) + 2u);
+            for (unsigned a = 0; a < 3u; a++) {
+                lo[a] = k[a] < lo[a] ? k[a] : lo[a];
+                hi[a] = k[a] > hi[a] ? k[a] : hi[a];
+            }
         }
     }
     size_t bytes = sat_mul(16u, codes);
     bytes = sat_add(bytes, sat_mul(16u, n_points));
+    if (fast) {
+        /* The coarse nodes' set over the scan's box at level d, and their codes. */
+        size_t cbricks = 1;
+        for (unsigned a = 0; a < 3u; a++) {
+            const uint32_t l = ((((lo[a] >= 2u ? lo[a] - 2u : 0u) >> params->fast_d) >> 2) & ~7u);
+            const uint32_t h = ((hi[a] + 2u) >> params->fast_d) >> 2;
+            cbricks = sat_mul(cbricks, (size_t)(((h - l) | 7u) + 1u));
+        }
+        bytes = sat_add(bytes, sat_mul(32u, cbricks));
+        bytes = sat_add(bytes, sat_mul(16u, samples));
+    }
     return sat_add(bytes, FIXED_BYTES);
 }
 
@@ -177,34 +198,57 @@ int occ_ictx_point(occ_ictx_t *const x, const float p[3])
 }
 
 /* ---- DISCRETE: one ray per distinct end voxel, to its centre ------------------------------- */
+/* End voxels are de-duplicated by their index in the scan's box (no Morton order is needed:
+ * rays are independent), which sorts in 2-3 radix passes instead of 5. */
 static size_t discretize(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
                          occ_code_t *const ends)
 {
+    const uint64_t bx = (uint64_t)(x->box_hi[0] - x->box_lo[0]) + 1u;
+    const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         const float p[3] = {points[i].x, points[i].y, points[i].z};
         uint32_t k[3];
         if (occ_raygeo_key(&x->g, p, k)) { /* also rejects NaN / Inf */
-            const occ_key_t key = {{k[0], k[1], k[2]}};
-            ends[m++] = occ_morton_encode(key);
+            if (k[0] < x->box_lo[0] || k[1] < x->box_lo[1] || k[2] < x->box_lo[2] ||
+                k[0] > x->box_hi[0] || k[1] > x->box_hi[1] || k[2] > x->box_hi[2]) {
+                /* beyond max range: its centre's ray is clipped, the box holds the clip */
+                const occ_key_t key = {{k[0], k[1], k[2]}};
+                ends[m++] = OCC_CODE_HIT_BIT | occ_morton_encode(key);
+                continue;
+            }
+            ends[m++] = (uint64_t)(k[0] - x->box_lo[0]) +
+                        bx * ((uint64_t)(k[1] - x->box_lo[1]) + by * (uint64_t)(k[2] - x->box_lo[2]));
         } else {
             x->r->points_skipped++;
         }
     }
     x->r->points_integrated = m;
-    /* a and b are still empty: use them as the sort's buffers. */
+    /* a and b are still empty: use them as the sort's buffers. Keys outside the box carry
+     * bit 63 (ignored by the sort); they are rare and may repeat, which only repeats a ray. */
     occ_code_t *const s = occ_keyset_sort(ends, x->a, m, x->hist);
-    const size_t u = occ_keyset_unique(s, m);
-    if (s != ends) {
-        memcpy(ends, s, u * sizeof *s);
+    size_t u = 0;
+    for (size_t i = 0; i < m; i++) {
+        if (u == 0u || s[i] != ends[u - 1u] || (s[i] >> 63) != 0u) {
+            ends[u++] = s[i];
+        }
     }
     return u;
 }
 
 static int run_discrete(occ_ictx_t *const x, const occ_code_t *const ends, const size_t n)
 {
+    const uint64_t bx = (uint64_t)(x->box_hi[0] - x->box_lo[0]) + 1u;
+    const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
     for (size_t i = 0; i < n; i++) {
-        const occ_key_t k = occ_morton_decode(ends[i]);
+        occ_key_t k;
+        if ((ends[i] >> 63) != 0u) {
+            k = occ_morton_decode(ends[i] & ~OCC_CODE_HIT_BIT);
+        } else {
+            k.k[0] = x->box_lo[0] + (uint32_t)(ends[i] % bx);
+            k.k[1] = x->box_lo[1] + (uint32_t)((ends[i] / bx) % by);
+            k.k[2] = x->box_lo[2] + (uint32_t)(ends[i] / bx / by);
+        }
         const float c[3] = {occ_raygeo_center(&x->g, k.k[0]), occ_raygeo_center(&x->g, k.k[1]),
                             occ_raygeo_center(&x->g, k.k[2])};
         const int rc = occ_ictx_point(x, c);
@@ -329,6 +373,54 @@ static occ_err_t apply_coarse(occ_ictx_t *const x, occ_bitset_t *const cbs,
 }
 
 /* ---- entry point ----------------------------------------------------------------------------- */
+/* Automatic mode: the pools are short for `codes`. Evict around the origin until they can
+ * supply what the batch needs and retry (an eviction can prune a node holding some of the codes
+ * and raise the need, hence the loop); if the whole batch never fits, apply it in Morton-ordered
+ * chunks, each evicted for first. `*applied` counts the codes applied. */
+#define AUTO_CHUNK 4096u
+#define AUTO_TRIES 8u
+static occ_err_t evict_and_apply(occ_map_t *const map, const occ_vec3_t *const origin,
+                                 const occ_insert_params_t *const params,
+                                 const occ_code_t *const codes, const size_t n,
+                                 size_t *const changed, size_t *const applied)
+{
+    *applied = 0;
+    *changed = 0;
+    for (unsigned t = 0; t < AUTO_TRIES; t++) {
+        uint32_t ni, nl;
+        if (occ_map_observe_need(map, codes, n, &ni, &nl) != OCC_OK ||
+            occ_map_evict_for(map, origin, params->auto_evict, ni, nl,
+                              params->auto_evict_state) != OCC_OK) {
+            break;
+        }
+        const occ_err_t e = occ_map_observe_codes(map, codes, n, changed);
+        if (e != OCC_ERR_NOMEM) {
+            *applied = e == OCC_OK ? n : 0u;
+            return e;
+        }
+    }
+    for (size_t i = 0; i < n; i += AUTO_CHUNK) {
+        const size_t k = n - i < AUTO_CHUNK ? n - i : AUTO_CHUNK;
+        size_t ch = 0;
+        occ_err_t e = occ_map_observe_codes(map, codes + i, k, &ch);
+        for (unsigned t = 0; e == OCC_ERR_NOMEM && t < AUTO_TRIES; t++) {
+            uint32_t ni, nl;
+            if (occ_map_observe_need(map, codes + i, k, &ni, &nl) != OCC_OK ||
+                occ_map_evict_for(map, origin, params->auto_evict, ni, nl,
+                                  params->auto_evict_state) != OCC_OK) {
+                break;
+            }
+            e = occ_map_observe_codes(map, codes + i, k, &ch);
+        }
+        if (e != OCC_OK) {
+            return e;
+        }
+        *changed += ch;
+        *applied += k;
+    }
+    return OCC_OK;
+}
+
 static uint8_t *align8(void *const p)
 {
     const uintptr_t u = (uintptr_t)p;
@@ -347,7 +439,8 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         (scratch == NULL && scratch_bytes > 0u)) {
         return OCC_ERR_ARG;
     }
-    if ((unsigned)params->method > (unsigned)OCC_INSERT_SUPER_RAYS ||
+    if ((params->auto_evict != NULL && params->auto_evict_state == NULL) ||
+        (unsigned)params->method > (unsigned)OCC_INSERT_SUPER_RAYS ||
         params->fast_d >= map->cfg.depth_levels || isnan(params->max_range_m)) {
         return OCC_ERR_ARG;
     }
@@ -423,7 +516,7 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
     occ_code_t *codes = NULL;
     int rc = 0;
     for (unsigned attempt = 0; attempt < 2u; attempt++) {
-        const occ_insert_result_t keep = *r;
+        const size_t used0 = r->scratch_used; /* the counters are still zero here */
         x.n = 0;
         if (x.cbs != NULL) {
             memset(cbs.words, 0, cbricks * 8u);
@@ -452,7 +545,8 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         }
         rc = run_method(&x, params, points, n_points, ends);
         if (rc >= 0 && dense && bs.overflow) {
-            *r = keep; /* cannot happen with the padded box; stay exact regardless */
+            memset(r, 0, sizeof *r); /* cannot happen with the padded box; stay exact anyway */
+            r->scratch_used = used0;
             dense = false;
             continue;
         }
@@ -490,7 +584,7 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         m = occ_keyset_unique(codes, x.n);
         spare = codes == x.a ? x.b : x.a;
         spare_cap = x.cap;
-        r->scratch_used += FILTER_N * 0u + 16u * x.cap; /* both halves may have been written */
+        r->scratch_used += 16u * x.cap; /* both halves may have been written */
     }
     size_t hits = 0;
     for (size_t i = 0; i < m; i++) {
@@ -503,9 +597,14 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         }
         r->scratch_used += 16u * cbricks;
     }
-    /* One coherent batch update in Morton order (all or nothing). */
+    /* One coherent batch update in Morton order (all or nothing, except in automatic mode). */
     size_t changed = 0;
-    const occ_err_t e = occ_map_observe_codes(map, codes, m, &changed);
+    occ_err_t e = occ_map_observe_codes(map, codes, m, &changed);
+    if (e == OCC_ERR_NOMEM && params->auto_evict != NULL) {
+        size_t applied = 0;
+        e = evict_and_apply(map, origin, params, codes, m, &changed, &applied);
+        r->voxels_updated = applied;
+    }
     if (e != OCC_OK) {
         return e;
     }

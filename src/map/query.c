@@ -505,7 +505,7 @@ static bool bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3
         int32_t hi_i = (int32_t)h;
         li -= (float)li > l ? 1 : 0;
         hi_i -= (float)hi_i > h ? 1 : 0;
-        li -= 1; /* one voxel of slack: faces exactly on a border touch the next voxel */
+        li -= 1; /* one voxel of slack: faces on a border touch the next voxel, and rounding */
         hi_i += 1;
         lo[i] = li < 0 ? 0u : (uint32_t)li;
         hi[i] = hi_i > (int32_t)top ? (uint32_t)top : (uint32_t)hi_i;
@@ -557,7 +557,7 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
     for (unsigned i = 0; i < 3u; i++) {
         ext = (hi[i] - lo[i]) > ext ? (hi[i] - lo[i]) : ext;
     }
-    unsigned lc = 0;
+    unsigned lc = pred.min_level; /* never start below the level nodes are reported at */
     while (lc < depth && ((uint32_t)1 << lc) <= ext) {
         lc++;
     }
@@ -941,11 +941,35 @@ void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map)
     lk->key.k[0] = lk->key.k[1] = lk->key.k[2] = 0u;
 }
 
+/* occ_map_key's arithmetic for one axis, inline (NaN and Inf fail the range test). */
+static inline bool lookup_key1(const occ_map_t *m, float c, int32_t half, uint32_t *key)
+{
+#if OCC_RAY_DOUBLE
+    const double scaled = (double)c * m->inv_res_d;
+    if (!(scaled >= -(double)half) || !(scaled < (double)half)) {
+        return false;
+    }
+    double fl = (double)(int32_t)scaled;
+    fl -= fl > scaled ? 1.0 : 0.0;
+#else
+    const float scaled = c * m->inv_res;
+    if (!(scaled >= -(float)half) || !(scaled < (float)half)) {
+        return false;
+    }
+    float fl = (float)(int32_t)scaled;
+    fl -= fl > scaled ? 1.0f : 0.0f;
+#endif
+    *key = (uint32_t)((int32_t)fl + half);
+    return true;
+}
+
 occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
 {
     const occ_map_t *const m = lk->map;
+    const int32_t half = (int32_t)1 << (m->cfg.depth_levels - 1u);
     occ_key_t k;
-    if (occ_map_key(m, p, &k) != OCC_OK) {
+    if (!lookup_key1(m, p.x, half, &k.k[0]) || !lookup_key1(m, p.y, half, &k.k[1]) ||
+        !lookup_key1(m, p.z, half, &k.k[2])) {
         return OCC_STATE_UNKNOWN;
     }
     const unsigned depth = m->cfg.depth_levels;
@@ -979,11 +1003,11 @@ occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
         b = m->root_child;
         lk->blk[depth] = b;
     }
-    const occ_code_t code = occ_morton_encode(k);
     while (level > 1u) {
-        const unsigned slot = occ_code_slot(code, level);
-        const occ_inner_block_t *const ib = occ_inner_at(m, b);
         level--;
+        const unsigned slot = ((k.k[0] >> level) & 1u) | (((k.k[1] >> level) & 1u) << 1) |
+                              (((k.k[2] >> level) & 1u) << 2);
+        const occ_inner_block_t *const ib = occ_inner_at(m, b);
         const uint32_t ch = ib->child[slot];
         if (ch == OCC_NONE) {
             lk->lu = (uint8_t)level;
@@ -994,6 +1018,6 @@ occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
         b = ch;
     }
     lk->lu = 0;
-    lk->val = occ_leaf_at(m, b)->value[occ_code_slot(code, 1u)];
+    lk->val = occ_leaf_at(m, b)->value[(k.k[0] & 1u) | ((k.k[1] & 1u) << 1) | ((k.k[2] & 1u) << 2)];
     return occ_q_state(m, lk->val);
 }
