@@ -15,6 +15,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "../tools/cli.c"
 #include "../tools/evict_cli.c"
 #include "occmap/occ_scan.h"
 

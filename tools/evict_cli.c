@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "evict_cli.h"
 
 void evict_cli_init(evict_cli_t *const c)
@@ -13,29 +14,14 @@ void evict_cli_init(evict_cli_t *const c)
     occ_evict_out_init(&c->out);
 }
 
+/* A positive byte count with K/M/G suffixes (cli_parse_size), zero refused. */
 static int parse_bytes(const char *s, size_t *out)
 {
-    char *end = NULL;
-    errno = 0;
-    const unsigned long long v = strtoull(s, &end, 10);
-    if (end == s || errno != 0 || s[0] == '-') {
+    size_t v = 0;
+    if (!cli_parse_size(s, &v) || v == 0u) {
         return 0;
     }
-    unsigned long long mul = 1;
-    if (*end == 'K' || *end == 'k') {
-        mul = 1024ull;
-        end++;
-    } else if (*end == 'M' || *end == 'm') {
-        mul = 1024ull * 1024ull;
-        end++;
-    } else if (*end == 'G' || *end == 'g') {
-        mul = 1024ull * 1024ull * 1024ull;
-        end++;
-    }
-    if (*end != '\0' || v == 0u || v > (unsigned long long)SIZE_MAX / mul) {
-        return 0;
-    }
-    *out = (size_t)(v * mul);
+    *out = v;
     return 1;
 }
 

@@ -2,7 +2,7 @@
 # $(BUILD)/data/scan.dat (OctoMap's real scan, decompressed) is made by tests/integrate.mk.
 SCAN_DAT := $(BUILD)/data/scan.dat
 
-DEMO_STEPS += demo-stats
+# (the demo is the MAVLink feed now; `make demo-stats` still runs the first version)
 demo-stats: $(BUILD)/occmap $(SCAN_DAT)
 	@echo "== occmap stats on OctoMap's real laser scan (88,206 points), endpoints only"
 	$(BUILD)/occmap stats --scan $(SCAN_DAT) --res 0.1
