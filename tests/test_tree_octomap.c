@@ -205,7 +205,11 @@ static void compare_trees(float tol, bool counts, const char *what)
            (unsigned long long)c.state_near_threshold);
     assert_int_equal(c.value_mismatch, 0u);
     assert_int_equal(c.state_mismatch, 0u);
-    assert_int_equal(c.state_near_threshold, 0u);
+    /* A state may differ only for a voxel whose OctoMap value lies within the documented
+     * fixed-point bound (tol) of the threshold: e.g. a voxel at clamp_min (-2.0000279 in float,
+     * -2048/1024 in fixed point) plus a delta of exactly +2.0 reads 0.0 (occupied) here and
+     * -0.0000279 (free) in OctoMap. The float build has tol 0 and must agree exactly. */
+    assert_true(c.state_near_threshold == 0u || c.tol > 0.0f);
     assert_int_equal(occ_map_check(&map), OCC_OK);
     if (!counts) {
         return;
@@ -216,8 +220,9 @@ static void compare_trees(float tol, bool counts, const char *what)
     assert_int_equal(oracle_tree_num_leaf_nodes(oracle), n);
     assert_int_equal(st.nodes, oracle_tree_size(oracle));
     assert_int_equal(st.leaf_nodes, n);
-    assert_int_equal(st.occupied_leaves, o_occ);
-    assert_int_equal(st.free_leaves, o_free);
+    const long long slack = (long long)c.state_near_threshold;
+    assert_true(llabs((long long)st.occupied_leaves - (long long)o_occ) <= slack);
+    assert_true(llabs((long long)st.free_leaves - (long long)o_free) <= slack);
     assert_int_equal(st.unknown_band_leaves, 0u);
 }
 
