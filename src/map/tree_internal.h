@@ -136,7 +136,7 @@ static inline bool occ_value_eq(occ_value_t a, occ_value_t b)
 
 /* Pools (pool.c). Alloc returns OCC_NONE when empty (and does not count an OOM: the caller
  * checked capacity first with occ_pool_can_supply). Free returns false and changes nothing for
- * an index never handed out (>= hwm) or a block already free (inner: O(1) marker; leaf: a walk
+ * an index never handed out (>= hwm) or a block already on the free list (inner: O(1) marker; leaf: a walk
  * of the free list when OCC_POOL_PARANOID, which defaults to OCC_TESTING). */
 uint32_t occ_pool_alloc_inner(occ_map_t *m);
 uint32_t occ_pool_alloc_leaf(occ_map_t *m);
