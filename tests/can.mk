@@ -16,11 +16,11 @@ $(CAN_BUILD)/golden_dump: tests/can/golden_dump.c $(BUILD)/libocc.a include/occm
 	$(CC) $(CAN_HOST_CFLAGS) -o $@ $< $(BUILD)/libocc.a -lm
 
 # Static, so the guest's initramfs needs no libraries for it.
-$(CAN_BUILD)/socketcan_guest: tests/can/socketcan_guest.c port/posix/socketcan.c $(BUILD)/libocc.a \
-                              include/occmap/occ_can.h
+$(CAN_BUILD)/socketcan_guest: tests/can/socketcan_guest.c port/posix/socketcan.c \
+                              port/posix/fd_wait.c $(BUILD)/libocc.a include/occmap/occ_can.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CAN_HOST_CFLAGS) -static -o $@ tests/can/socketcan_guest.c port/posix/socketcan.c \
-	  $(BUILD)/libocc.a -lm
+	  port/posix/fd_wait.c $(BUILD)/libocc.a -lm
 
 $(CAN_BUILD)/make_wall_map: $(BUILD)/relhost/tests/can/make_wall_map.o \
                             $(PORT_SRC:%.c=$(BUILD)/relhost/%.o) $(BUILD)/libocc.a

@@ -144,12 +144,7 @@ occ_err_t occ_map_evict_for(occ_map_t *map, const occ_vec3_t *center,
                             const occ_evict_policy_t *policy, uint32_t n_inner, uint32_t n_leaf,
                             occ_evict_out_t *out);
 
-/* Blocks occ_map_observe_codes(map, codes, n) would allocate now (an upper bound: pruning on
- * the way only frees), so an integrator can ask occ_map_evict_for() for exactly that. Codes as
- * for occ_map_observe_codes (ascending, hit bit 63); OCC_ERR_ARG for NULL or unsorted codes.
- * O(n * depth), read only. */
-occ_err_t occ_map_observe_need(const occ_map_t *map, const occ_code_t *codes, size_t n,
-                               uint32_t *n_inner, uint32_t *n_leaf);
+/* occ_map_observe_need() (occmap.h) tells an integrator how much to ask for. */
 
 #ifdef __cplusplus
 }

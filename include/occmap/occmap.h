@@ -253,6 +253,13 @@ occ_err_t occ_map_forget_key(occ_map_t *map, occ_key_t key, unsigned level);
 occ_err_t occ_map_observe_codes(occ_map_t *map, const occ_code_t *codes, size_t n,
                                 size_t *n_changed);
 
+/* Blocks occ_map_observe_codes(map, codes, n) would allocate now (an upper bound: pruning on
+ * the way only frees), so an integrator can ask occ_map_evict_for() for exactly that. Codes as
+ * for occ_map_observe_codes (ascending, hit bit 63); OCC_ERR_ARG for NULL or unsorted codes.
+ * O(n * depth), read only. */
+occ_err_t occ_map_observe_need(const occ_map_t *map, const occ_code_t *codes, size_t n,
+                               uint32_t *n_inner, uint32_t *n_leaf);
+
 /* ---- Diagnostics -------------------------------------------------------------------------------- */
 typedef struct {
     uint32_t inner_used, inner_peak, leaf_used, leaf_peak;

@@ -10,6 +10,8 @@
 
 #include "occmap/occ_can.h"
 
+#include "fd_wait.h"
+
 #define HDR_LEN 10u
 #define FLAG_CANFD 0x0001u
 
@@ -186,24 +188,13 @@ occ_err_t occ_can_mcast_recv(occ_can_mcast_t *m, occ_can_frame_t *f, int timeout
         socklen_t fl = sizeof from;
         const ssize_t r = recvfrom(m->rx_fd, pkt, sizeof pkt, 0, (struct sockaddr *)&from, &fl);
         if (r < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            if (errno != EAGAIN && errno != EWOULDBLOCK) {
+            const int w = occ_fd_wait_after_failed_read(m->rx_fd, &timeout_ms);
+            if (w < 0) {
                 return OCC_ERR_IO;
             }
-            if (timeout_ms == 0) {
+            if (w == 0) {
                 return OCC_OK;
             }
-            struct pollfd p = {m->rx_fd, POLLIN, 0};
-            const int pr = poll(&p, 1, timeout_ms);
-            if (pr < 0 && errno != EINTR) {
-                return OCC_ERR_IO;
-            }
-            if (pr == 0) {
-                return OCC_OK;
-            }
-            timeout_ms = 0;
             continue;
         }
         if (ntohs(from.sin_port) == m->tx_port) {

@@ -14,6 +14,8 @@
 
 #include "occmap/occ_can.h"
 
+#include "fd_wait.h"
+
 #ifndef CANFD_FDF
 #define CANFD_FDF 0x04
 #endif
@@ -174,24 +176,13 @@ occ_err_t occ_socketcan_recv(occ_socketcan_t *s, occ_can_frame_t *f, int timeout
         struct canfd_frame kf;
         const ssize_t r = read(s->fd, &kf, sizeof kf);
         if (r < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            if (errno != EAGAIN && errno != EWOULDBLOCK) {
+            const int w = occ_fd_wait_after_failed_read(s->fd, &timeout_ms);
+            if (w < 0) {
                 return OCC_ERR_IO;
             }
-            if (timeout_ms == 0) {
+            if (w == 0) {
                 return OCC_OK;
             }
-            struct pollfd p = {s->fd, POLLIN, 0};
-            const int pr = poll(&p, 1, timeout_ms);
-            if (pr < 0 && errno != EINTR) {
-                return OCC_ERR_IO;
-            }
-            if (pr == 0) {
-                return OCC_OK;
-            }
-            timeout_ms = 0; /* one more read, then give up: no busy loop */
             continue;
         }
         if (r != (ssize_t)CAN_MTU && r != (ssize_t)CANFD_MTU) {

@@ -10,12 +10,9 @@
 #define CODE_BITS ((occ_code_t)0x7FFFFFFFFFFFFFFFull)
 #define DIGIT_MASK ((occ_code_t)(OCC_KS_RADIX - 1u))
 
-occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint32_t *const hist)
+/* Every pass's digit histogram in one sweep; returns the bits that differ between codes. */
+static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t *const hist)
 {
-    if (n < 2u) {
-        return a;
-    }
-    /* Which bits vary: digits above them need no pass. */
     const occ_code_t first = a[0] & CODE_BITS;
     occ_code_t diff = 0;
     memset(hist, 0, OCC_KS_HIST_WORDS * sizeof hist[0]);
@@ -28,18 +25,38 @@ occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint
             v >>= OCC_INSERT_RADIX_BITS;
         }
     }
+    return diff;
+}
+
+/* Turn pass p's histogram into start offsets; NULL when every code has the same digit there
+ * (the pass is skipped). */
+static uint32_t *pass_offsets(uint32_t *const hist, const unsigned p, const occ_code_t diff)
+{
+    if (((diff >> (p * OCC_INSERT_RADIX_BITS)) & DIGIT_MASK) == 0u) {
+        return NULL;
+    }
+    uint32_t *const h = &hist[p * OCC_KS_RADIX];
+    uint32_t sum = 0;
+    for (unsigned b = 0; b < OCC_KS_RADIX; b++) {
+        const uint32_t c = h[b];
+        h[b] = sum;
+        sum += c;
+    }
+    return h;
+}
+
+occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint32_t *const hist)
+{
+    if (n < 2u) {
+        return a;
+    }
+    const occ_code_t diff = histograms(a, n, hist);
     for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
+        uint32_t *const h = pass_offsets(hist, p, diff);
+        if (h == NULL) {
+            continue;
+        }
         const unsigned shift = p * OCC_INSERT_RADIX_BITS;
-        if (((diff >> shift) & DIGIT_MASK) == 0u) {
-            continue; /* every code has the same digit here */
-        }
-        uint32_t *const h = &hist[p * OCC_KS_RADIX];
-        uint32_t sum = 0;
-        for (unsigned b = 0; b < OCC_KS_RADIX; b++) {
-            const uint32_t c = h[b];
-            h[b] = sum;
-            sum += c;
-        }
         for (size_t i = 0; i < n; i++) {
             const occ_code_t c = a[i];
             const unsigned b = (unsigned)(((c & CODE_BITS) >> shift) & DIGIT_MASK);
@@ -143,30 +160,13 @@ uint64_t *occ_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t
     if (n < 2u) {
         return k;
     }
-    uint64_t diff = 0;
-    const uint64_t first = k[0] & CODE_BITS;
-    memset(hist, 0, OCC_KS_HIST_WORDS * sizeof hist[0]);
-    for (size_t i = 0; i < n; i++) {
-        const uint64_t c = k[i] & CODE_BITS;
-        diff |= c ^ first;
-        uint64_t x = c;
-        for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
-            hist[p * OCC_KS_RADIX + (unsigned)(x & DIGIT_MASK)]++;
-            x >>= OCC_INSERT_RADIX_BITS;
-        }
-    }
+    const occ_code_t diff = histograms(k, n, hist);
     for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
-        const unsigned shift = p * OCC_INSERT_RADIX_BITS;
-        if (((diff >> shift) & DIGIT_MASK) == 0u) {
+        uint32_t *const h = pass_offsets(hist, p, diff);
+        if (h == NULL) {
             continue;
         }
-        uint32_t *const h = &hist[p * OCC_KS_RADIX];
-        uint32_t sum = 0;
-        for (unsigned b = 0; b < OCC_KS_RADIX; b++) {
-            const uint32_t c = h[b];
-            h[b] = sum;
-            sum += c;
-        }
+        const unsigned shift = p * OCC_INSERT_RADIX_BITS;
         for (size_t i = 0; i < n; i++) {
             const unsigned b = (unsigned)(((k[i] & CODE_BITS) >> shift) & DIGIT_MASK);
             const uint32_t at = h[b]++;

@@ -293,13 +293,19 @@ static bool codes_valid(const occ_map_t *const m, const occ_code_t *const codes,
 }
 
 /* Read-only pass: blocks the batch will allocate if nothing is freed on the way. */
-static void count_blocks(occ_map_t *const m, const occ_code_t *const codes, const size_t n,
+static void count_blocks(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
                          const delta_mode_t mode, const occ_value_t fixed, uint64_t *const n_inner,
                          uint64_t *const n_leaf)
 {
     path_t p;
     const unsigned depth = m->cfg.depth_levels;
-    p.node[depth] = occ_root(m);
+    /* Read only: the path starts at a copy of the root, so the map can stay const. */
+    uint32_t root_child = m->root_child;
+    occ_value_t root_value = m->root_value;
+    uint8_t root_flags = m->root_flags;
+    p.node[depth].child = &root_child;
+    p.node[depth].value = &root_value;
+    p.node[depth].flags = &root_flags;
     occ_code_t prev = 0, last_changing = 0;
     bool have_changing = false;
     *n_inner = 0u;
@@ -429,6 +435,24 @@ occ_err_t occ_map_observe_codes(occ_map_t *const map, const occ_code_t *const co
     }
     return apply_batch(map, codes, n, DELTA_TAGGED, 0, can_supply64(map, bound_inner, bound_leaf),
                        n_changed);
+}
+
+occ_err_t occ_map_observe_need(const occ_map_t *const map, const occ_code_t *const codes,
+                               const size_t n, uint32_t *const n_inner, uint32_t *const n_leaf)
+{
+    if (map == NULL || n_inner == NULL || n_leaf == NULL || (codes == NULL && n != 0u)) {
+        return OCC_ERR_ARG;
+    }
+    *n_inner = 0u;
+    *n_leaf = 0u;
+    uint64_t bound_inner, bound_leaf, inner, leaf;
+    if (!codes_valid(map, codes, n, &bound_inner, &bound_leaf)) {
+        return OCC_ERR_ARG;
+    }
+    count_blocks(map, codes, n, DELTA_TAGGED, 0, &inner, &leaf);
+    *n_inner = inner > OCC_NONE ? OCC_NONE : (uint32_t)inner;
+    *n_leaf = leaf > OCC_NONE ? OCC_NONE : (uint32_t)leaf;
+    return OCC_OK;
 }
 
 static bool finite_f(const float x)
