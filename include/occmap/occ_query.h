@@ -127,7 +127,6 @@ typedef struct {
     uint8_t base;          /* first stack entry of the current start node */
     uint8_t virt_sp;       /* entries >= virt_sp are virtual (split of a uniform node) */
     uint8_t start_level;   /* level of the start nodes */
-    uint8_t want_flags;    /* OCC_NODE_HAS_FREE / HAS_UNKNOWN bits wanted by the predicate */
     uint8_t nstart, istart;
     occ_value_t virt_value;
     occ_key_t path;        /* key bits of the current node at each stack level */

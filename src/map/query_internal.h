@@ -6,6 +6,7 @@
 #define OCC_QUERY_INTERNAL_H_INCLUDED
 
 #include <math.h>
+#include <string.h>
 #include "map/tree_internal.h"
 
 static inline occ_state_t occ_q_state(const occ_map_t *m, occ_value_t v)
@@ -91,6 +92,115 @@ static inline bool occ_q_finite3(occ_vec3_t v)
 {
     return occ_q_finite(v.x) && occ_q_finite(v.y) && occ_q_finite(v.z);
 }
+
+/* Which of the 8 entries of a stored block match `states` (OCC_PRED_* bits): bit s for slot s.
+ * Inner blocks: a uniform child's flags follow from its value (tree invariant), so one formula
+ * serves uniform and mixed children: occupied from the max value, free and unknown from the
+ * indicators. Branch-free: neighbouring states are random. */
+static inline unsigned occ_q_inner_match(const occ_map_t *m, const occ_inner_block_t *b,
+                                         unsigned states)
+{
+    const unsigned wf = ((states & OCC_PRED_FREE) != 0u ? OCC_NODE_HAS_FREE : 0u) |
+                        ((states & OCC_PRED_UNKNOWN) != 0u ? OCC_NODE_HAS_UNKNOWN : 0u);
+    unsigned pm = 0u;
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__)
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define OCC_Q_SWAR_FLAGS 1
+#endif
+#endif
+#ifdef OCC_Q_SWAR_FLAGS
+    /* The 8 flag bytes at once: a byte with a wanted bit (flags < 0x10) gets its top bit, and the
+     * multiply gathers the 8 top bits into bits 56..63. */
+    uint64_t f;
+    memcpy(&f, b->flags, sizeof f);
+    f = ((f & ((uint64_t)wf * 0x0101010101010101ull)) + 0x7F7F7F7F7F7F7F7Full) &
+        0x8080808080808080ull;
+    pm = (unsigned)(((f >> 7) * 0x0102040810204080ull) >> 56);
+#else
+    for (unsigned s = 0; s < 8u; s++) {
+        pm |= (unsigned)((b->flags[s] & wf) != 0u) << s;
+    }
+#endif
+    if ((states & OCC_PRED_OCCUPIED) != 0u) {
+        const occ_value_t occ_min = m->q_occ_min;
+        for (unsigned s = 0; s < 8u; s++) {
+            pm |= (unsigned)(b->value[s] >= occ_min) << s;
+        }
+    }
+    return pm;
+}
+
+static inline unsigned occ_q_leaf_match(const occ_map_t *m, const occ_leaf_block_t *b,
+                                        unsigned states)
+{
+    const occ_value_t occ_min = m->q_occ_min;
+    const occ_value_t free_max = m->q_free_max;
+    unsigned occ = 0u;
+    unsigned fr = 0u;
+    for (unsigned s = 0; s < 8u; s++) {
+        const occ_value_t v = b->value[s];
+        occ |= (unsigned)(v >= occ_min) << s;
+        fr |= ((unsigned)(v < free_max) & (unsigned)occ_is_observed(v)) << s;
+    }
+    const unsigned unk = ~(occ | fr) & 0xFFu;
+    return ((states & OCC_PRED_OCCUPIED) != 0u ? occ : 0u) |
+           ((states & OCC_PRED_FREE) != 0u ? fr : 0u) |
+           ((states & OCC_PRED_UNKNOWN) != 0u ? unk : 0u);
+}
+
+/* max(d, 0) in a form compilers turn into a branch-free max instruction. */
+static inline float occ_q_pos(float d)
+{
+    return d > 0.0f ? d : 0.0f;
+}
+
+/* Which children (half edge h) of a node centred at pc touch a sphere / a box: per axis the
+ * squared distance to the lower and upper half (or their overlap), combined over the 8 slots. */
+static inline unsigned occ_q_sphere_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
+{
+    const occ_vec3_t c = v->u.sphere.c;
+    const float r2 = v->u.sphere.r * v->u.sphere.r;
+    float d;
+    d = occ_q_pos(fabsf(c.x - (pc.x - h)) - h);
+    const float x0 = d * d;
+    d = occ_q_pos(fabsf(c.x - (pc.x + h)) - h);
+    const float x1 = d * d;
+    d = occ_q_pos(fabsf(c.y - (pc.y - h)) - h);
+    const float y0 = d * d;
+    d = occ_q_pos(fabsf(c.y - (pc.y + h)) - h);
+    const float y1 = d * d;
+    d = occ_q_pos(fabsf(c.z - (pc.z - h)) - h);
+    const float z0 = d * d;
+    d = occ_q_pos(fabsf(c.z - (pc.z + h)) - h);
+    const float z1 = d * d;
+    const float xy00 = x0 + y0;
+    const float xy10 = x1 + y0;
+    const float xy01 = x0 + y1;
+    const float xy11 = x1 + y1;
+    return (xy00 + z0 <= r2 ? 0x01u : 0u) | (xy10 + z0 <= r2 ? 0x02u : 0u) |
+           (xy01 + z0 <= r2 ? 0x04u : 0u) | (xy11 + z0 <= r2 ? 0x08u : 0u) |
+           (xy00 + z1 <= r2 ? 0x10u : 0u) | (xy10 + z1 <= r2 ? 0x20u : 0u) |
+           (xy01 + z1 <= r2 ? 0x40u : 0u) | (xy11 + z1 <= r2 ? 0x80u : 0u);
+}
+
+static inline unsigned occ_q_aabb_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
+{
+    const unsigned xm = (pc.x - 2.0f * h <= v->bmax.x && pc.x >= v->bmin.x ? 0x55u : 0u) |
+                        (pc.x <= v->bmax.x && pc.x + 2.0f * h >= v->bmin.x ? 0xAAu : 0u);
+    const unsigned ym = (pc.y - 2.0f * h <= v->bmax.y && pc.y >= v->bmin.y ? 0x33u : 0u) |
+                        (pc.y <= v->bmax.y && pc.y + 2.0f * h >= v->bmin.y ? 0xCCu : 0u);
+    const unsigned zm = (pc.z - 2.0f * h <= v->bmax.z && pc.z >= v->bmin.z ? 0x0Fu : 0u) |
+                        (pc.z <= v->bmax.z && pc.z + 2.0f * h >= v->bmin.z ? 0xF0u : 0u);
+    return xm & ym & zm;
+}
+
+/* volume.c: key range [lo, hi] per axis of the voxels that can touch the volume's closed bounds
+ * (one voxel of slack for faces on a border); false when the bounds miss the map. */
+bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
+/* volume.c: which of the 8 children (at `level`) of the node with first voxel `pkey` touch the
+ * volume (bit s for child slot s; exact tests, as occ_volume_hits_box). */
+unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                          unsigned level);
 
 /* Fill a reported node. */
 void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
