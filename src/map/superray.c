@@ -22,10 +22,16 @@ typedef struct {
     uint32_t point;
 } sr_ray_t;
 
+/* Signatures are numbered l0 + (ne0+1) (l1 + (ne1+1) l2); when that count fits SR_STAMPS, the
+ * first ray of each is found by stamping a table (no sort). */
+#define SR_STAMPS 4096u
+
 typedef struct {
     sr_ray_t *rays;
     occ_rr_t *edges;    /* SR_MAX_EDGES critical slopes per projection, sorted */
     uint64_t *keys, *tkeys;
+    uint32_t *stamp;    /* SR_STAMPS entries: the bundle that last cast this signature */
+    uint32_t bundle;    /* this bundle's stamp (never 0) */
 } sr_ws_t;
 
 static const unsigned PA[3] = {0u, 0u, 1u}, PB[3] = {1u, 2u, 2u};
@@ -84,6 +90,28 @@ static bool list_edges(const occ_rr_t lo, const occ_rr_t hi, const occ_rr_t dxa,
     return true;
 }
 
+/* Number of critical slopes below `sg` (ed[0..ne) sorted) into *l; false when sg lies within
+ * the tie margin of one (then the ray is cast singly). */
+static inline bool rank_of(const occ_rr_t *ed, uint32_t ne, occ_rr_t sg, uint32_t *l)
+{
+    if (ne == 0u) {
+        *l = 0;
+        return true;
+    }
+    uint32_t lo = 0, hi = ne; /* first edge >= sg */
+    while (lo < hi) {
+        const uint32_t mid = (lo + hi) / 2u;
+        if (ed[mid] < sg) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    *l = lo;
+    return !((lo < ne && ed[lo] - sg <= SR_TIE * ed[lo]) ||
+             (lo > 0u && sg - ed[lo - 1u] <= SR_TIE * sg));
+}
+
 /* Rays of one end voxel (point indices idx[0..cnt), cnt <= SR_MAX_GROUP). */
 static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
                        const uint32_t *const idx, const size_t cnt, const uint32_t ke[3],
@@ -118,10 +146,9 @@ static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
                 safe = false;
             }
             /* The end point away from its voxel's faces: the DDA then reaches the end voxel
-             * by its crossings, not by the length test. */
-            const occ_rr_t f = x->g.rf * (occ_rr_t)e[a];
-            const occ_rr_t fl = (occ_rr_t)(int32_t)f - (f < (occ_rr_t)(int32_t)f ? 1 : 0);
-            const occ_rr_t frac = f - fl;
+             * by its crossings, not by the length test. Its key is ke, so the voxel's lower
+             * face is at ke - tmv (key units). */
+            const occ_rr_t frac = x->g.rf * (occ_rr_t)e[a] - (occ_rr_t)((int32_t)ke[a] - x->g.tmv);
             if (frac < margin || frac > (occ_rr_t)1 - margin) {
                 safe = false;
             }
@@ -165,39 +192,37 @@ static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
         return;
     }
     /* Signatures: per projection, how many critical slopes lie below the ray's slope. */
+    const uint32_t dim0 = ne[0] + 1u, dim1 = ne[1] + 1u;
+    const bool stamped = (uint64_t)dim0 * dim1 * (ne[2] + 1u) <= SR_STAMPS;
+    if (stamped) {
+        ws->bundle++;
+    }
     size_t nk = 0;
     for (size_t j = 0; j < nr; j++) {
         const sr_ray_t *const r = &ws->rays[j];
-        uint64_t sig = 0;
+        uint32_t l[3];
         bool safe = true;
         for (unsigned q = 0; q < 3u && safe; q++) {
-            const occ_rr_t *const ed = ws->edges + q * SR_MAX_EDGES;
-            const occ_rr_t sg = r->sigma[q];
-            uint32_t l = 0, h = ne[q]; /* first edge >= sg */
-            while (l < h) {
-                const uint32_t mid = (l + h) / 2u;
-                if (ed[mid] < sg) {
-                    l = mid + 1u;
-                } else {
-                    h = mid;
-                }
-            }
-            if ((l < ne[q] && ed[l] - sg <= SR_TIE * ed[l]) ||
-                (l > 0u && sg - ed[l - 1u] <= SR_TIE * sg)) {
-                safe = false;
-            }
-            sig |= (uint64_t)l << (15u * q);
+            safe = rank_of(ws->edges + q * SR_MAX_EDGES, ne[q], r->sigma[q], &l[q]);
         }
         if (!safe) {
             cast_one(x, points[r->point], ke);
-            continue;
+        } else if (stamped) {
+            const uint32_t sig = l[0] + dim0 * (l[1] + dim1 * l[2]);
+            if (ws->stamp[sig] != ws->bundle) {
+                ws->stamp[sig] = ws->bundle;
+                cast_one(x, points[r->point], ke);
+            }
+        } else {
+            const uint64_t sig = (uint64_t)l[0] | ((uint64_t)l[1] << 15) | ((uint64_t)l[2] << 30);
+            ws->keys[nk++] = (sig << 16) | (uint64_t)j; /* 45 + 16 bits, bit 63 clear */
         }
-        ws->keys[nk++] = (sig << 16) | (uint64_t)j; /* 45 + 16 bits, bit 63 clear */
     }
-    /* One traversal per signature (Shell sort: bundles hold at most SR_MAX_GROUP rays). */
+    /* Many signatures: one traversal per distinct one, found by sorting (Shell sort: bundles
+     * hold at most SR_MAX_GROUP rays). */
     static const uint16_t gaps[] = {1750, 701, 301, 132, 57, 23, 10, 4, 1};
     uint64_t *const sk = ws->keys;
-    for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0]; gi++) {
+    for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0] && nk > 1u; gi++) {
         const size_t gap = gaps[gi];
         for (size_t i = gap; i < nk; i++) {
             const uint64_t v = sk[i];
@@ -209,12 +234,46 @@ static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
             sk[j] = v;
         }
     }
-    const uint64_t *const s = sk;
     for (size_t i = 0; i < nk; i++) {
-        if (i == 0u || (s[i] >> 16) != (s[i - 1u] >> 16)) {
-            cast_one(x, points[ws->rays[s[i] & 0xFFFFu].point], ke);
+        if (i == 0u || (sk[i] >> 16) != (sk[i - 1u] >> 16)) {
+            cast_one(x, points[ws->rays[sk[i] & 0xFFFFu].point], ke);
         }
     }
+}
+
+/* The `cnt` points idx[] ending in the box's cell `cell`: the hit, then their rays - singly when
+ * the bundle is too small or too spread to share traversals. False when scratch ran out. */
+static bool run_voxel(occ_ictx_t *const x, const occ_vec3_t *const points,
+                      const uint32_t *const idx, const size_t cnt, const uint64_t cell,
+                      const uint64_t bx, const uint64_t by, const uint16_t k_min,
+                      sr_ws_t *const ws)
+{
+    const uint32_t ke[3] = {x->box_lo[0] + (uint32_t)(cell % bx),
+                            x->box_lo[1] + (uint32_t)((cell / bx) % by),
+                            x->box_lo[2] + (uint32_t)(cell / bx / by)};
+    const occ_key_t kk = {{ke[0], ke[1], ke[2]}};
+    if (!occ_ictx_reserve(x, 1u)) {
+        return false;
+    }
+    occ_ictx_emit(x, occ_morton_encode(kk) | OCC_CODE_HIT_BIT);
+    if (ke[0] == x->ko[0] && ke[1] == x->ko[1] && ke[2] == x->ko[2]) {
+        return true; /* ends in the origin's voxel: no free voxel */
+    }
+    const size_t span = (size_t)(ke[0] > x->ko[0] ? ke[0] - x->ko[0] : x->ko[0] - ke[0]) +
+                        (ke[1] > x->ko[1] ? ke[1] - x->ko[1] : x->ko[1] - ke[1]) +
+                        (ke[2] > x->ko[2] ? ke[2] - x->ko[2] : x->ko[2] - ke[2]);
+    /* A bundle that spans its voxel has ~ (crossings / 2) edges inside: with fewer points than
+     * that, super rays cannot pay for themselves - cast singly right away. */
+    if (cnt < (size_t)k_min || cnt <= span / 2u) {
+        for (size_t j = 0; j < cnt; j++) {
+            cast_one(x, points[idx[j]], ke);
+        }
+        return true;
+    }
+    for (size_t j = 0; j < cnt; j += SR_MAX_GROUP) {
+        run_bundle(x, points, idx + j, cnt - j < SR_MAX_GROUP ? cnt - j : SR_MAX_GROUP, ke, ws);
+    }
+    return true;
 }
 
 static bool run_single(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n)
@@ -240,7 +299,7 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
     /* Workspace in the dense path's free scratch: end codes and point indices (sorted as
      * pairs), per-bundle rays, edges and signature keys. */
     const size_t need = n * 24u + SR_MAX_GROUP * (sizeof(sr_ray_t) + 16u) +
-                        3u * SR_MAX_EDGES * sizeof(occ_rr_t) + 64u;
+                        3u * SR_MAX_EDGES * sizeof(occ_rr_t) + SR_STAMPS * 4u + 64u;
     if (x->bs == NULL || x->b_cap * 8u < need || n >= UINT32_MAX) {
         return run_single(x, points, n);
     }
@@ -253,6 +312,9 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
     ws.edges = (occ_rr_t *)(void *)(ws.rays + SR_MAX_GROUP);
     ws.keys = (uint64_t *)(void *)(ws.edges + 3u * SR_MAX_EDGES);
     ws.tkeys = ws.keys + SR_MAX_GROUP;
+    ws.stamp = (uint32_t *)(void *)(ws.tkeys + SR_MAX_GROUP);
+    memset(ws.stamp, 0, SR_STAMPS * sizeof *ws.stamp);
+    ws.bundle = 0;
 
     const uint64_t bx = (uint64_t)(x->box_hi[0] - x->box_lo[0]) + 1u;
     const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
@@ -282,39 +344,42 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
         m++;
     }
     x->r->points_integrated += m;
+    const uint64_t cells = bx * by * ((uint64_t)(x->box_hi[2] - x->box_lo[2]) + 1u);
+    if (cells <= 2u * (uint64_t)m) {
+        /* A small box (coarse resolution): counting sort, the histogram in tkeys' room. */
+        uint32_t *const hist = (uint32_t *)(void *)tkeys;
+        memset(hist, 0, (size_t)cells * sizeof *hist);
+        for (size_t i = 0; i < m; i++) {
+            hist[keys[i]]++;
+        }
+        uint32_t sum = 0;
+        for (size_t c = 0; c < (size_t)cells; c++) {
+            const uint32_t h = hist[c];
+            hist[c] = sum;
+            sum += h;
+        }
+        for (size_t i = 0; i < m; i++) {
+            tvals[hist[keys[i]]++] = vals[i]; /* hist[c] ends as the end of cell c's run */
+        }
+        for (size_t c = 0, s0 = 0; c < (size_t)cells; c++) {
+            if (hist[c] > s0 && !run_voxel(x, points, tvals + s0, hist[c] - s0, c, bx, by, k_min, &ws)) {
+                return false;
+            }
+            s0 = hist[c];
+        }
+        return true;
+    }
     const uint64_t *const sk = occ_keyset_sort_pairs(keys, vals, tkeys, tvals, m, x->hist);
     const uint32_t *const sv = sk == keys ? vals : tvals;
-    for (size_t s = 0; s < m;) {
-        size_t e = s + 1u;
-        while (e < m && sk[e] == sk[s]) {
+    for (size_t s0 = 0; s0 < m;) {
+        size_t e = s0 + 1u;
+        while (e < m && sk[e] == sk[s0]) {
             e++;
         }
-        const uint32_t ke[3] = {x->box_lo[0] + (uint32_t)(sk[s] % bx),
-                                x->box_lo[1] + (uint32_t)((sk[s] / bx) % by),
-                                x->box_lo[2] + (uint32_t)(sk[s] / bx / by)};
-        const occ_key_t kk = {{ke[0], ke[1], ke[2]}};
-        if (!occ_ictx_reserve(x, 1u)) {
+        if (!run_voxel(x, points, sv + s0, e - s0, sk[s0], bx, by, k_min, &ws)) {
             return false;
         }
-        occ_ictx_emit(x, occ_morton_encode(kk) | OCC_CODE_HIT_BIT);
-        const bool same = ke[0] == x->ko[0] && ke[1] == x->ko[1] && ke[2] == x->ko[2];
-        const occ_key_t dk = {{ke[0] > x->ko[0] ? ke[0] - x->ko[0] : x->ko[0] - ke[0],
-                               ke[1] > x->ko[1] ? ke[1] - x->ko[1] : x->ko[1] - ke[1],
-                               ke[2] > x->ko[2] ? ke[2] - x->ko[2] : x->ko[2] - ke[2]}};
-        /* A bundle that spans its voxel has ~ (crossings / 2) edges inside: with fewer points
-         * than that, super rays cannot pay for themselves - cast singly right away. */
-        const size_t hopeless = ((size_t)dk.k[0] + dk.k[1] + dk.k[2]) / 2u;
-        if (!same && (e - s < (size_t)k_min || e - s <= hopeless)) {
-            for (size_t j = s; j < e; j++) {
-                cast_one(x, points[sv[j]], ke);
-            }
-        } else if (!same) {
-            for (size_t j = s; j < e; j += SR_MAX_GROUP) {
-                const size_t c = e - j < SR_MAX_GROUP ? e - j : SR_MAX_GROUP;
-                run_bundle(x, points, sv + j, c, ke, &ws);
-            }
-        }
-        s = e;
+        s0 = e;
     }
     return true;
 }
