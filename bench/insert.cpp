@@ -252,6 +252,7 @@ static void bench_dataset(const Dataset &d, float res, int reps, int octo_reps)
     while (res * (float)(1u << (dfast + 1)) <= 0.2f + 1e-6f) dfast++;
     const occ_insert_method_t methods[] = {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE,
                                            OCC_INSERT_FAST_DISCRETE, OCC_INSERT_SUPER_RAYS};
+    double t_simple = 0.0;
     for (occ_insert_method_t meth : methods) {
         occ_insert_params_t p = occ_insert_params_default();
         p.method = meth;
@@ -277,6 +278,14 @@ static void bench_dataset(const Dataset &d, float res, int reps, int octo_reps)
             std::snprintf(buf, sizeof buf, "%s (%zu of %zu leaves differ)",
                           df.bad == 0 ? "yes" : "NO", df.bad, df.checked);
             eq = buf;
+        }
+        if (meth == OCC_INSERT_SIMPLE) t_simple = t;
+        if (meth == OCC_INSERT_SUPER_RAYS && out.rays_cast > 0) {
+            // The super-ray target is a ratio to SIMPLE in the same run; points per traversal
+            // (last scan) says how much the grouping found.
+            std::snprintf(buf, sizeof buf, "; %.2fx SIMPLE, %.1f points per traversal",
+                          t_simple / t, (double)out.points_integrated / (double)out.rays_cast);
+            eq += buf;
         }
         std::string name = method_name(meth);
         if (meth == OCC_INSERT_FAST_DISCRETE) name += "(n=0,d=" + std::to_string(dfast) + ")";

@@ -1,8 +1,9 @@
 /*
  * occ_query.h - reading the map through volumes: iteration with state predicates, voxel counts,
  * nearest-first search, collision checks, ray casts, line of sight, information gain.
- * Included by occmap.h. Implemented in src/map/query.c, nearest.c, collide.c,
- * castray.c, infogain.c (core: no heap, no recursion, float math). Convex shapes through libccd
+ * Included by occmap.h. Implemented in src/map/volume.c (volumes), query.c (iterator, counts),
+ * lookup.c, nearest.c, collide.c, castray.c, infogain.c (core: no heap, no recursion, float
+ * math). Convex shapes through libccd
  * are in occ_collide_ccd.h (host builds only).
  *
  * Geometry: every volume and node is a closed set in the map frame (metres). A node at `level`
