@@ -2,7 +2,8 @@
 // (search() per point, the leaf iterator over a bounding box, castRay).
 // Maps: geb079.bt (OctoMap's example) and the maps in ../shared/data/maps/ when present, each
 // loaded through OctoMap and through occ_file_load (or, if that fails, copied leaf by leaf).
-// Prints a table of medians (ns per operation over >= 9 batches) with ratios and writes
+// Prints a table of medians (ns per operation over 9 batches, occmap and OctoMap batches
+// alternating) and the median of the per-batch ratios as the speedup, and writes
 // build/bench/query.json.   usage: query [--quick] [--json PATH] [MAP...]
 #include <octomap/OcTree.h>
 #include <octomap/AbstractOcTree.h>
@@ -43,25 +44,40 @@ static double now_ns()
         .count();
 }
 
-// Median over batches of the per-operation time of fn(i) for i in [0, n).
-static double median_ns(size_t n, const std::function<void(size_t)> &fn, int batches = 9)
+// occmap (fa over na operations) against OctoMap (fb over nb) in alternating batches, so that the
+// machine's drift hits both alike: per-operation medians of each side and the median of the
+// per-batch time ratios (b / a), which is the speedup reported.
+struct Paired {
+    double a_ns, b_ns, ratio;
+};
+static Paired paired(size_t na, const std::function<void(size_t)> &fa, size_t nb,
+                     const std::function<void(size_t)> &fb, int batches = 9)
 {
-    std::vector<double> t;
-    const size_t per = std::max<size_t>(1, n / (size_t)batches);
+    std::vector<double> ta, tb, r;
+    const size_t pa = std::max<size_t>(1, na / (size_t)batches);
+    const size_t pb = std::max<size_t>(1, nb / (size_t)batches);
     for (int b = 0; b < batches; b++) {
-        const double t0 = now_ns();
-        for (size_t i = (size_t)b * per; i < (size_t)(b + 1) * per && i < n; i++) fn(i);
-        t.push_back((now_ns() - t0) / (double)per);
+        double t0 = now_ns();
+        for (size_t i = (size_t)b * pa; i < (size_t)(b + 1) * pa && i < na; i++) fa(i);
+        const double a = (now_ns() - t0) / (double)pa;
+        t0 = now_ns();
+        for (size_t i = (size_t)b * pb; i < (size_t)(b + 1) * pb && i < nb; i++) fb(i);
+        const double bb = (now_ns() - t0) / (double)pb;
+        ta.push_back(a);
+        tb.push_back(bb);
+        r.push_back(bb / a);
     }
-    std::sort(t.begin(), t.end());
-    return t[t.size() / 2];
+    std::sort(ta.begin(), ta.end());
+    std::sort(tb.begin(), tb.end());
+    std::sort(r.begin(), r.end());
+    return Paired{ta[ta.size() / 2], tb[tb.size() / 2], r[r.size() / 2]};
 }
 
 static volatile size_t sink;
 
 struct Row {
     std::string map, op;
-    double ours_ns, octo_ns;
+    double ours_ns, octo_ns, speedup;
     std::string note;
 };
 
@@ -199,12 +215,13 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
             same += (n == nullptr ? s == OCC_STATE_UNKNOWN
                                   : (t->isNodeOccupied(n) ? s == OCC_STATE_OCCUPIED : s == OCC_STATE_FREE));
         }
-        const double o = median_ns(pts.size(), [&](size_t i) { sink += (size_t)occ_map_state_at(&map, v3(pts[i])); });
-        const double b = median_ns(pts.size(), [&](size_t i) {
-            const octomap::OcTreeNode *n = t->search(pts[i]);
-            sink += n == nullptr ? 0u : (t->isNodeOccupied(n) ? 2u : 1u);
-        });
-        rows.push_back({name, "point lookup random (occ_map_state_at vs search)", o, b,
+        const Paired pl = paired(
+            pts.size(), [&](size_t i) { sink += (size_t)occ_map_state_at(&map, v3(pts[i])); }, pts.size(),
+            [&](size_t i) {
+                const octomap::OcTreeNode *n = t->search(pts[i]);
+                sink += n == nullptr ? 0u : (t->isNodeOccupied(n) ? 2u : 1u);
+            });
+        rows.push_back({name, "point lookup random (occ_map_state_at vs search)", pl.a_ns, pl.b_ns, pl.ratio,
                         std::to_string(same) + "/" + std::to_string(pts.size()) + " same state"});
         // Along trajectories (5 cm steps from free starts), as a vehicle queries: path cache.
         std::vector<point3d> traj(N * 10);
@@ -223,15 +240,20 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
         occ_lookup_init(&lk, &map);
         size_t same_t = 0;
         for (auto &p : traj) same_t += occ_lookup_state(&lk, v3(p)) == occ_map_state_at(&map, v3(p));
-        const double ot = median_ns(traj.size(), [&](size_t i) { sink += (size_t)occ_lookup_state(&lk, v3(traj[i])); });
-        const double bt = median_ns(traj.size(), [&](size_t i) {
+        const std::function<void(size_t)> octo_traj = [&](size_t i) {
             const octomap::OcTreeNode *n = t->search(traj[i]);
             sink += n == nullptr ? 0u : (t->isNodeOccupied(n) ? 2u : 1u);
-        });
-        const double ot2 = median_ns(traj.size(), [&](size_t i) { sink += (size_t)occ_map_state_at(&map, v3(traj[i])); });
-        rows.push_back({name, "point lookup trajectory 5 cm (occ_lookup_state vs search)", ot, bt,
+        };
+        const Paired pt = paired(
+            traj.size(), [&](size_t i) { sink += (size_t)occ_lookup_state(&lk, v3(traj[i])); }, traj.size(),
+            octo_traj);
+        const Paired pt2 = paired(
+            traj.size(), [&](size_t i) { sink += (size_t)occ_map_state_at(&map, v3(traj[i])); }, traj.size(),
+            octo_traj);
+        rows.push_back({name, "point lookup trajectory 5 cm (occ_lookup_state vs search)", pt.a_ns, pt.b_ns, pt.ratio,
                         std::to_string(same_t) + "/" + std::to_string(traj.size()) + " same as occ_map_state_at"});
-        rows.push_back({name, "point lookup trajectory 5 cm (occ_map_state_at vs search)", ot2, bt, ""});
+        rows.push_back({name, "point lookup trajectory 5 cm (occ_map_state_at vs search)", pt2.a_ns, pt2.b_ns,
+                        pt2.ratio, ""});
     }
     // 2. sphere r = 0.25 m at poses whose centre is free
     {
@@ -244,23 +266,29 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
             agree += col.safe == octo_sphere_search(*t, p, 0.25);
             unsafe += !col.safe;
         }
-        const double o = median_ns(N, [&](size_t i) {
+        const std::function<void(size_t)> ours_unsafe = [&](size_t i) {
             occ_collision_t col;
             occ_collide_sphere(&map, v3(c[i]), 0.25f, OCC_UNKNOWN_UNSAFE, &col);
             sink += col.safe;
-        });
-        const double ol = median_ns(N, [&](size_t i) {
-            occ_collision_t col;
-            occ_collide_sphere(&map, v3(c[i]), 0.25f, OCC_UNKNOWN_SAFE, &col);
-            sink += col.safe;
-        });
-        const double bl = median_ns(N, [&](size_t i) { sink += octo_sphere_leafs(*t, c[i], 0.25); });
-        const double bs = median_ns(N / 10, [&](size_t i) { sink += octo_sphere_search(*t, c[i], 0.25); });
-        rows.push_back({name, "sphere r=0.25 unknown-unsafe vs octomap leaf_bbx", o, bl,
+        };
+        const std::function<void(size_t)> octo_leafs = [&](size_t i) {
+            sink += octo_sphere_leafs(*t, c[i], 0.25);
+        };
+        const Paired sl = paired(N, ours_unsafe, N, octo_leafs);
+        const Paired ss = paired(N, ours_unsafe, N / 10, [&](size_t i) { sink += octo_sphere_search(*t, c[i], 0.25); });
+        const Paired so = paired(
+            N,
+            [&](size_t i) {
+                occ_collision_t col;
+                occ_collide_sphere(&map, v3(c[i]), 0.25f, OCC_UNKNOWN_SAFE, &col);
+                sink += col.safe;
+            },
+            N, octo_leafs);
+        rows.push_back({name, "sphere r=0.25 unknown-unsafe vs octomap leaf_bbx", sl.a_ns, sl.b_ns, sl.ratio,
                         std::to_string(unsafe) + "/" + std::to_string(N) + " unsafe"});
-        rows.push_back({name, "sphere r=0.25 unknown-unsafe vs octomap search/voxel", o, bs,
+        rows.push_back({name, "sphere r=0.25 unknown-unsafe vs octomap search/voxel", ss.a_ns, ss.b_ns, ss.ratio,
                         std::to_string(agree) + "/" + std::to_string(N) + " same answer"});
-        rows.push_back({name, "sphere r=0.25 occupied-only vs octomap leaf_bbx", ol, bl, ""});
+        rows.push_back({name, "sphere r=0.25 occupied-only vs octomap leaf_bbx", so.a_ns, so.b_ns, so.ratio, ""});
     }
     // 3. ray cast, 10 m, ignore unknown (OctoMap castRay)
     {
@@ -279,28 +307,34 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
                     std::fabs(r.end.z - end.z()) < 1e-4f;
             hits += h;
         }
-        const double a = median_ns(N, [&](size_t i) {
-            occ_ray_result_t r;
-            occ_cast_ray(&map, v3(o[i]), v3(d[i]), true, 10.0f, &r);
-            sink += r.hit;
-        });
-        const double b = median_ns(N, [&](size_t i) {
-            point3d end;
-            sink += t->castRay(o[i], d[i], end, true, 10.0);
-        });
-        rows.push_back({name, "castRay 10 m ignoreUnknown", a, b,
+        const Paired ri = paired(
+            N,
+            [&](size_t i) {
+                occ_ray_result_t r;
+                occ_cast_ray(&map, v3(o[i]), v3(d[i]), true, 10.0f, &r);
+                sink += r.hit;
+            },
+            N,
+            [&](size_t i) {
+                point3d end;
+                sink += t->castRay(o[i], d[i], end, true, 10.0);
+            });
+        rows.push_back({name, "castRay 10 m ignoreUnknown", ri.a_ns, ri.b_ns, ri.ratio,
                         std::to_string(same) + "/" + std::to_string(N) + " identical, " + std::to_string(hits) + " hits"});
         // and stopping at unknown (OctoMap's default)
-        const double a2 = median_ns(N, [&](size_t i) {
-            occ_ray_result_t r;
-            occ_cast_ray(&map, v3(o[i]), v3(d[i]), false, 10.0f, &r);
-            sink += r.hit;
-        });
-        const double b2 = median_ns(N, [&](size_t i) {
-            point3d end;
-            sink += t->castRay(o[i], d[i], end, false, 10.0);
-        });
-        rows.push_back({name, "castRay 10 m stop at unknown", a2, b2, ""});
+        const Paired ru = paired(
+            N,
+            [&](size_t i) {
+                occ_ray_result_t r;
+                occ_cast_ray(&map, v3(o[i]), v3(d[i]), false, 10.0f, &r);
+                sink += r.hit;
+            },
+            N,
+            [&](size_t i) {
+                point3d end;
+                sink += t->castRay(o[i], d[i], end, false, 10.0);
+            });
+        rows.push_back({name, "castRay 10 m stop at unknown", ru.a_ns, ru.b_ns, ru.ratio, ""});
     }
     // 4. line of sight between two free points (lengths uniform 1..10.8 m, mean 5.9 m)
     {
@@ -332,42 +366,48 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
             vis += v;
             agree += v == !hit;
         }
-        const double o = median_ns(N, [&](size_t i) {
-            bool v = false;
-            occ_line_of_sight(&map, v3(a[i]), v3(b[i]), OCC_UNKNOWN_SAFE, &v, nullptr);
-            sink += v;
-        });
-        const double bo = median_ns(N, [&](size_t i) {
-            point3d end;
-            sink += t->castRay(a[i], b[i] - a[i], end, true, (b[i] - a[i]).norm());
-        });
+        const Paired pv = paired(
+            N,
+            [&](size_t i) {
+                bool v = false;
+                occ_line_of_sight(&map, v3(a[i]), v3(b[i]), OCC_UNKNOWN_SAFE, &v, nullptr);
+                sink += v;
+            },
+            N,
+            [&](size_t i) {
+                point3d end;
+                sink += t->castRay(a[i], b[i] - a[i], end, true, (b[i] - a[i]).norm());
+            });
         char note[128];
         snprintf(note, sizeof note, "mean %.1f m, %zu visible, %zu/%zu agree with castRay", sum_len / (double)N, vis,
                  agree, N);
-        rows.push_back({name, "line of sight (vs castRay to b)", o, bo, note});
+        rows.push_back({name, "line of sight (vs castRay to b)", pv.a_ns, pv.b_ns, pv.ratio, note});
         // 10 m segment, unknown unsafe: occmap segment volume vs OctoMap computeRayKeys + search
         std::vector<point3d> s0(N), s1(N);
         for (size_t i = 0; i < N; i++) {
             s0[i] = free_point();
             s1[i] = s0[i] + rand_dir().normalized() * 10.0f;
         }
-        const double so = median_ns(N, [&](size_t i) {
-            occ_collision_t col;
-            occ_volume_t vol;
-            occ_volume_segment(&vol, v3(s0[i]), v3(s1[i]));
-            occ_collide_volume(&map, &vol, OCC_UNKNOWN_UNSAFE, &col);
-            sink += col.safe;
-        });
         octomap::KeyRay kr;
-        const double sb = median_ns(N, [&](size_t i) {
-            bool ok = t->computeRayKeys(s0[i], s1[i], kr);
-            for (auto it = kr.begin(); ok && it != kr.end(); ++it) {
-                const octomap::OcTreeNode *n = t->search(*it);
-                ok = n != nullptr && !t->isNodeOccupied(n);
-            }
-            sink += ok;
-        });
-        rows.push_back({name, "10 m segment unknown-unsafe (vs computeRayKeys+search)", so, sb, ""});
+        const Paired pg = paired(
+            N,
+            [&](size_t i) {
+                occ_collision_t col;
+                occ_volume_t vol;
+                occ_volume_segment(&vol, v3(s0[i]), v3(s1[i]));
+                occ_collide_volume(&map, &vol, OCC_UNKNOWN_UNSAFE, &col);
+                sink += col.safe;
+            },
+            N,
+            [&](size_t i) {
+                bool ok = t->computeRayKeys(s0[i], s1[i], kr);
+                for (auto it = kr.begin(); ok && it != kr.end(); ++it) {
+                    const octomap::OcTreeNode *n = t->search(*it);
+                    ok = n != nullptr && !t->isNodeOccupied(n);
+                }
+                sink += ok;
+            });
+        rows.push_back({name, "10 m segment unknown-unsafe (vs computeRayKeys+search)", pg.a_ns, pg.b_ns, pg.ratio, ""});
     }
     // 5. frustum information gain (115 x 60 deg, 0..6.5 m), unknown voxels
     {
@@ -380,7 +420,7 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
         }
         const double hf = 115.0 * M_PI / 180, vf = 60.0 * M_PI / 180, far_m = 6.5;
         std::vector<uint64_t> ours(poses), theirs(poses);
-        const double a = median_ns((size_t)poses, [&](size_t i) {
+        const Paired pf = paired((size_t)poses, [&](size_t i) {
             const occ_vec3_t ax[3] = {{(float)std::cos(yaw[i]), (float)std::sin(yaw[i]), 0},
                                       {-(float)std::sin(yaw[i]), (float)std::cos(yaw[i]), 0}, {0, 0, 1}};
             occ_volume_t v;
@@ -388,9 +428,9 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
             occ_info_gain_t g;
             occ_info_gain(&map, &v, 0, 0, &g);
             ours[i] = g.unknown_cells;
-        }, poses);
+        }, (size_t)poses,
         // OctoMap: every voxel of the frustum's box whose centre is inside, search() -> unknown.
-        const double b = median_ns((size_t)poses, [&](size_t i) {
+        [&](size_t i) {
             const double res = t->getResolution();
             const double c = std::cos(yaw[i]), s = std::sin(yaw[i]);
             const double th = std::tan(hf / 2), tv = std::tan(vf / 2);
@@ -412,7 +452,7 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
         char note[160];
         snprintf(note, sizeof note, "unknown voxels pose 0: occmap %llu (touching), octomap %llu (centre inside)",
                  (unsigned long long)ours[0], (unsigned long long)theirs[0]);
-        rows.push_back({name, "frustum info gain 115x60 deg 6.5 m", a, b, note});
+        rows.push_back({name, "frustum info gain 115x60 deg 6.5 m", pf.a_ns, pf.b_ns, pf.ratio, note});
     }
     delete t;
     free(arena);
@@ -434,7 +474,7 @@ int main(int argc, char **argv)
     printf("\n%-22s %-56s %12s %12s %8s  %s\n", "map", "operation", "occmap ns", "octomap ns", "speedup", "check");
     for (auto &r : rows) {
         printf("%-22s %-56s %12.1f %12.1f %7.1fx  %s\n", r.map.c_str(), r.op.c_str(), r.ours_ns, r.octo_ns,
-               r.octo_ns / r.ours_ns, r.note.c_str());
+               r.speedup, r.note.c_str());
     }
     FILE *f = fopen(json.c_str(), "w");
     if (f == nullptr) {
@@ -445,7 +485,7 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < rows.size(); i++) {
         const Row &r = rows[i];
         fprintf(f, "  {\"map\": \"%s\", \"op\": \"%s\", \"occmap_ns\": %.1f, \"octomap_ns\": %.1f, \"speedup\": %.2f, \"check\": \"%s\"}%s\n",
-                r.map.c_str(), r.op.c_str(), r.ours_ns, r.octo_ns, r.octo_ns / r.ours_ns, r.note.c_str(),
+                r.map.c_str(), r.op.c_str(), r.ours_ns, r.octo_ns, r.speedup, r.note.c_str(),
                 i + 1 < rows.size() ? "," : "");
     }
     fprintf(f, "]}\n");
