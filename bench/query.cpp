@@ -307,33 +307,25 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
                     std::fabs(r.end.z - end.z()) < 1e-4f;
             hits += h;
         }
-        const Paired ri = paired(
-            N,
-            [&](size_t i) {
-                occ_ray_result_t r;
-                occ_cast_ray(&map, v3(o[i]), v3(d[i]), true, 10.0f, &r);
-                sink += r.hit;
-            },
-            N,
-            [&](size_t i) {
-                point3d end;
-                sink += t->castRay(o[i], d[i], end, true, 10.0);
-            });
+        // ignoreUnknown, then stopping at unknown (OctoMap's default)
+        const auto cast_pair = [&](bool ignore) {
+            return paired(
+                N,
+                [&, ignore](size_t i) {
+                    occ_ray_result_t r;
+                    occ_cast_ray(&map, v3(o[i]), v3(d[i]), ignore, 10.0f, &r);
+                    sink += r.hit;
+                },
+                N,
+                [&, ignore](size_t i) {
+                    point3d end;
+                    sink += t->castRay(o[i], d[i], end, ignore, 10.0);
+                });
+        };
+        const Paired ri = cast_pair(true);
         rows.push_back({name, "castRay 10 m ignoreUnknown", ri.a_ns, ri.b_ns, ri.ratio,
                         std::to_string(same) + "/" + std::to_string(N) + " identical, " + std::to_string(hits) + " hits"});
-        // and stopping at unknown (OctoMap's default)
-        const Paired ru = paired(
-            N,
-            [&](size_t i) {
-                occ_ray_result_t r;
-                occ_cast_ray(&map, v3(o[i]), v3(d[i]), false, 10.0f, &r);
-                sink += r.hit;
-            },
-            N,
-            [&](size_t i) {
-                point3d end;
-                sink += t->castRay(o[i], d[i], end, false, 10.0);
-            });
+        const Paired ru = cast_pair(false);
         rows.push_back({name, "castRay 10 m stop at unknown", ru.a_ns, ru.b_ns, ru.ratio, ""});
     }
     // 4. line of sight between two free points (lengths uniform 1..10.8 m, mean 5.9 m)

@@ -296,8 +296,8 @@ static bool run_single(occ_ictx_t *const x, const occ_vec3_t *const points, cons
 bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
                       const uint16_t k_min)
 {
-    /* Workspace in the dense path's free scratch: end codes and point indices (sorted as
-     * pairs), per-bundle rays, edges and signature keys. */
+    /* Workspace in the dense path's free scratch: end cells and point indices (sorted as
+     * pairs), per-bundle rays, edges, signature keys and the signature stamps. */
     const size_t need = n * 24u + SR_MAX_GROUP * (sizeof(sr_ray_t) + 16u) +
                         3u * SR_MAX_EDGES * sizeof(occ_rr_t) + SR_STAMPS * 4u + 64u;
     if (x->bs == NULL || x->b_cap * 8u < need || n >= UINT32_MAX) {
@@ -362,7 +362,8 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
             tvals[hist[keys[i]]++] = vals[i]; /* hist[c] ends as the end of cell c's run */
         }
         for (size_t c = 0, s0 = 0; c < (size_t)cells; c++) {
-            if (hist[c] > s0 && !run_voxel(x, points, tvals + s0, hist[c] - s0, c, bx, by, k_min, &ws)) {
+            if (hist[c] > s0 &&
+                !run_voxel(x, points, tvals + s0, hist[c] - s0, c, bx, by, k_min, &ws)) {
                 return false;
             }
             s0 = hist[c];
