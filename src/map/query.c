@@ -154,15 +154,7 @@ static inline void push(occ_query_iter_t *it, occ_key_t pkey, unsigned level, ui
     }
     it->block[i] = block;
     if (pm != 0u) {
-        /* Spheres and boxes inline: they are the common collision volumes. */
-        const occ_volume_t *const vol = it->vol;
-        if (vol->kind == OCC_VOL_SPHERE) {
-            pm &= occ_q_sphere_touch(vol, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
-        } else if (vol->kind == OCC_VOL_AABB) {
-            pm &= occ_q_aabb_touch(vol, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
-        } else {
-            pm &= occ_q_touch_mask(m, vol, pkey, level);
-        }
+        pm &= occ_q_touch_mask(m, it->vol, pkey, level);
     }
     it->mask[i] = (uint8_t)pm;
     it->sp = (uint8_t)(i + 1u);

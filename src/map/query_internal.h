@@ -93,6 +93,13 @@ static inline bool occ_q_finite3(occ_vec3_t v)
     return occ_q_finite(v.x) && occ_q_finite(v.y) && occ_q_finite(v.z);
 }
 
+/* Little-endian targets test the 8 flag bytes of a block as one 64-bit word. */
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__)
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define OCC_Q_SWAR_FLAGS 1
+#endif
+#endif
+
 /* Which of the 8 entries of a stored block match `states` (OCC_PRED_* bits): bit s for slot s.
  * Inner blocks: a uniform child's flags follow from its value (tree invariant), so one formula
  * serves uniform and mixed children: occupied from the max value, free and unknown from the
@@ -103,11 +110,6 @@ static inline unsigned occ_q_inner_match(const occ_map_t *m, const occ_inner_blo
     const unsigned wf = ((states & OCC_PRED_FREE) != 0u ? OCC_NODE_HAS_FREE : 0u) |
                         ((states & OCC_PRED_UNKNOWN) != 0u ? OCC_NODE_HAS_UNKNOWN : 0u);
     unsigned pm = 0u;
-#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__)
-#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-#define OCC_Q_SWAR_FLAGS 1
-#endif
-#endif
 #ifdef OCC_Q_SWAR_FLAGS
     /* The 8 flag bytes at once: a byte with a wanted bit (flags < 0x10) gets its top bit, and the
      * multiply gathers the 8 top bits into bits 56..63. */
@@ -148,7 +150,7 @@ static inline unsigned occ_q_leaf_match(const occ_map_t *m, const occ_leaf_block
            ((states & OCC_PRED_UNKNOWN) != 0u ? unk : 0u);
 }
 
-/* max(d, 0) in a form compilers turn into a branch-free max instruction. */
+/* max(d, 0) */
 static inline float occ_q_pos(float d)
 {
     return d > 0.0f ? d : 0.0f;
@@ -197,10 +199,24 @@ static inline unsigned occ_q_aabb_touch(const occ_volume_t *v, occ_vec3_t pc, fl
 /* volume.c: key range [lo, hi] per axis of the voxels that can touch the volume's closed bounds
  * (one voxel of slack for faces on a border); false when the bounds miss the map. */
 bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
-/* volume.c: which of the 8 children (at `level`) of the node with first voxel `pkey` touch the
- * volume (bit s for child slot s; exact tests, as occ_volume_hits_box). */
-unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                          unsigned level);
+/* volume.c: occ_q_touch_mask for the other kinds, child by child with the exact cube tests. */
+unsigned occ_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                unsigned level);
+
+/* Which of the 8 children (at `level`) of the node with first voxel `pkey` touch the volume
+ * (bit s for child slot s; exact, as occ_volume_hits_box). Spheres and boxes inline: they are
+ * the common collision volumes. */
+static inline unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                        unsigned level)
+{
+    if (v->kind == OCC_VOL_SPHERE) {
+        return occ_q_sphere_touch(v, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
+    }
+    if (v->kind == OCC_VOL_AABB) {
+        return occ_q_aabb_touch(v, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
+    }
+    return occ_q_touch_mask_cubes(m, v, pkey, level);
+}
 
 /* Fill a reported node. */
 void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,

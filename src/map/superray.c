@@ -29,7 +29,7 @@ typedef struct {
 typedef struct {
     sr_ray_t *rays;
     occ_rr_t *edges;    /* SR_MAX_EDGES critical slopes per projection, sorted */
-    uint64_t *keys, *tkeys;
+    uint64_t *keys;     /* signature keys when the stamps do not fit */
     uint32_t *stamp;    /* SR_STAMPS entries: the bundle that last cast this signature */
     uint32_t bundle;    /* this bundle's stamp (never 0) */
 } sr_ws_t;
@@ -298,7 +298,7 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
 {
     /* Workspace in the dense path's free scratch: end cells and point indices (sorted as
      * pairs), per-bundle rays, edges, signature keys and the signature stamps. */
-    const size_t need = n * 24u + SR_MAX_GROUP * (sizeof(sr_ray_t) + 16u) +
+    const size_t need = n * 24u + SR_MAX_GROUP * (sizeof(sr_ray_t) + 8u) +
                         3u * SR_MAX_EDGES * sizeof(occ_rr_t) + SR_STAMPS * 4u + 64u;
     if (x->bs == NULL || x->b_cap * 8u < need || n >= UINT32_MAX) {
         return run_single(x, points, n);
@@ -311,8 +311,7 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
     ws.rays = (sr_ray_t *)(void *)(keys + 3u * n);
     ws.edges = (occ_rr_t *)(void *)(ws.rays + SR_MAX_GROUP);
     ws.keys = (uint64_t *)(void *)(ws.edges + 3u * SR_MAX_EDGES);
-    ws.tkeys = ws.keys + SR_MAX_GROUP;
-    ws.stamp = (uint32_t *)(void *)(ws.tkeys + SR_MAX_GROUP);
+    ws.stamp = (uint32_t *)(void *)(ws.keys + SR_MAX_GROUP);
     memset(ws.stamp, 0, SR_STAMPS * sizeof *ws.stamp);
     ws.bundle = 0;
 

@@ -498,17 +498,11 @@ bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3]
     return true;
 }
 
-/* Spheres and boxes per axis (two halves each), the rest child by child. */
-unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey, unsigned level)
+unsigned occ_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                unsigned level)
 {
     const float h = occ_q_half(m, level);
     const occ_vec3_t pc = occ_q_center(m, pkey, level + 1u);
-    if (v->kind == OCC_VOL_SPHERE) {
-        return occ_q_sphere_touch(v, pc, h);
-    }
-    if (v->kind == OCC_VOL_AABB) {
-        return occ_q_aabb_touch(v, pc, h);
-    }
     unsigned mask = 0u;
     for (unsigned s = 0; s < 8u; s++) {
         occ_vec3_t c;
