@@ -3,7 +3,8 @@
  * The voxel sequence, the tie rule and the arithmetic are OctoMap's (double on hosts when
  * OCC_RAY_DOUBLE); what differs is the lookup: instead of a search from the root per voxel, a
  * cursor keeps the path to the current voxel and re-descends only below the highest key bit that
- * changed, and not at all while the ray stays inside a uniform (pruned) node.
+ * changed, and not at all while the ray stays inside a node it can pass whole: a uniform (pruned)
+ * one, or one whose indicators say nothing below stops the ray (UFOMap's use of the inner nodes).
  */
 #include <float.h>
 #include "map/query_internal.h"
@@ -18,14 +19,17 @@ typedef float real_t;
 #define RSQRT sqrtf
 #endif
 
-/* The path from the root to the node holding the current voxel. */
+/* The path from the root to the node holding the current voxel. The descent ends early at a
+ * passable node (no voxel below has a state in `stop`, read from the indicators): the walk can
+ * then step through all of it without looking anything up, as through a uniform node. */
 typedef struct {
     const occ_map_t *m;
     const occ_inner_block_t *inner_top; /* inner block 0 (blocks grow down from the arena end) */
     const occ_leaf_block_t *leaf_base;  /* leaf block 0 */
     uint32_t key[3];
-    unsigned lu;      /* level of the deepest node on the path (uniform, or 0) */
-    occ_value_t val;  /* its value */
+    uint8_t stop;     /* OCC_NODE_HAS_* flags of the states the walk stops at */
+    unsigned lu;      /* level of the deepest node on the path: passable, uniform, or a voxel */
+    occ_value_t val;  /* its value (a passable node's max: passable too) */
     uint32_t blk[OCC_MAX_DEPTH + 1u]; /* blk[L]: child block of the path node at level L > lu */
 } cursor_t;
 
@@ -36,13 +40,14 @@ static void descend(cursor_t *c, unsigned level)
     const uint32_t k1 = c->key[1];
     const uint32_t k2 = c->key[2];
     const occ_inner_block_t *const top = c->inner_top;
+    const unsigned stop = c->stop;
     uint32_t b = c->blk[level];
     while (level > 1u) {
         const unsigned l = level - 1u;
         const unsigned slot = ((k0 >> l) & 1u) | (((k1 >> l) & 1u) << 1) | (((k2 >> l) & 1u) << 2);
         const occ_inner_block_t *const ib = top - b; /* occ_inner_at(m, b) */
         const uint32_t ch = ib->child[slot];
-        if (ch == OCC_NONE) {
+        if (ch == OCC_NONE || (ib->flags[slot] & stop) == 0u) {
             c->lu = l;
             c->val = ib->value[slot];
             return;
@@ -55,16 +60,17 @@ static void descend(cursor_t *c, unsigned level)
     c->val = c->leaf_base[b].value[(k0 & 1u) | ((k1 & 1u) << 1) | ((k2 & 1u) << 2)];
 }
 
-static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3])
+static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3], uint8_t stop)
 {
     c->m = m;
+    c->stop = stop;
     c->inner_top = occ_inner_at(m, 0u);
     c->leaf_base = occ_leaf_at(m, 0u);
     c->key[0] = key[0];
     c->key[1] = key[1];
     c->key[2] = key[2];
     const unsigned d = m->cfg.depth_levels;
-    if (m->root_child == OCC_NONE) {
+    if (m->root_child == OCC_NONE || (m->root_flags & stop) == 0u) {
         c->lu = d;
         c->val = m->root_value;
         return;
@@ -78,17 +84,9 @@ static inline void cursor_moved(cursor_t *c, unsigned dim, uint32_t old)
 {
     const uint32_t x = old ^ c->key[dim];
     if ((x >> c->lu) == 0u) {
-        return; /* still inside the same uniform node */
+        return; /* still inside the same passable or uniform node */
     }
-#if defined(__GNUC__)
-    const unsigned hb = 31u - (unsigned)__builtin_clz(x);
-#else
-    unsigned hb = 0;
-    for (uint32_t y = x >> 1; y != 0u; y >>= 1) {
-        hb++;
-    }
-#endif
-    descend(c, hb + 1u);
+    descend(c, occ_bit_length32(x)); /* from the node above the highest changed bit */
 }
 
 /* The resolution as OctoMap holds it: a double. A float resolution read from a file or typed as
@@ -193,7 +191,7 @@ static inline void dda_init(dda_t *d, const cursor_t *c, real_t res, int32_t tmv
 }
 
 
-/* The ray is in a uniform node of level lu >= 1 that it passes through: step on without
+/* The ray is in a node of level lu >= 1 that it passes through (passable or uniform): step on without
  * looking anything up while the next voxel is still in the node and (when the range is bounded)
  * entered before `safe_t`, where the centre distance test cannot fail. Same events, same order,
  * same arithmetic as stepping. */
@@ -280,7 +278,8 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
     const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
     const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
     cursor_t c;
-    cursor_init(&c, map, k0.k);
+    cursor_init(&c, map, k0.k,
+                (uint8_t)(OCC_NODE_HAS_OCCUPIED | (ignore_unknown ? 0u : OCC_NODE_HAS_UNKNOWN)));
     {
         const occ_state_t s = occ_q_state(map, c.val);
         if (s == OCC_STATE_OCCUPIED) {
@@ -346,7 +345,7 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
             }
         }
         if (((old ^ c.key[dim]) >> c.lu) == 0u) {
-            continue; /* same uniform node: same value, already let through */
+            continue; /* same node, already let through */
         }
         cursor_moved(&c, dim, old);
         const occ_value_t v = c.val;
@@ -389,8 +388,10 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
     occ_ray_result_t scratch;
     occ_ray_result_t *const res_out = blocker != NULL ? blocker : &scratch;
+    const uint8_t stop = (uint8_t)(OCC_NODE_HAS_OCCUPIED |
+                                   (policy == OCC_UNKNOWN_UNSAFE ? OCC_NODE_HAS_UNKNOWN : 0u));
     cursor_t c;
-    cursor_init(&c, map, ka.k);
+    cursor_init(&c, map, ka.k, stop);
     *visible = false;
     if (blocks(map, c.val, policy)) {
         set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
@@ -448,7 +449,7 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
                 reached_b = true;
                 break;
             }
-            continue; /* same uniform node */
+            continue; /* same node, already let through */
         }
         cursor_moved(&c, dim, old);
         const occ_value_t v = c.val;
@@ -464,7 +465,7 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
         entered = true;
     }
     if (!reached_b) {
-        cursor_init(&c, map, kb.k); /* the walk is over: reuse its cursor for b's voxel */
+        cursor_init(&c, map, kb.k, stop); /* the walk is over: reuse its cursor for b's voxel */
         if (blocks(map, c.val, policy)) {
             set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
             return OCC_OK;

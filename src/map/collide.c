@@ -1,8 +1,148 @@
 /*
- * collide.c - "is this volume safe?": the volume iterator asked for blocking states only, so
- * branches holding neither occupied nor (policy) unknown voxels are never opened.
+ * collide.c - "is this volume safe?": a depth-first walk in Morton order that opens only the
+ * blocks whose entries hold a blocking state (occupied, and unknown under OCC_UNKNOWN_UNSAFE) and
+ * touch the volume, and stops at the first blocking node. The same nodes in the same order as the
+ * volume iterator (query.c) asked for those states, without its generality (splitting, min
+ * level, resuming), which is most of its cost on a check this small.
  */
 #include "map/query_internal.h"
+
+/* One open block: the children of the node whose first voxel is `key`. */
+typedef struct {
+    uint32_t block;
+    occ_key_t key;
+    uint8_t level; /* the children's level */
+    uint8_t mask;  /* children still to visit: blocking and touching the volume */
+} frame_t;
+
+static inline unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsigned states,
+                                 uint32_t block, occ_key_t key, unsigned level)
+{
+    const unsigned pm = level == 0u ? occ_q_leaf_match(m, occ_leaf_at(m, block), states)
+                                    : occ_q_inner_match(m, occ_inner_at(m, block), states);
+    return pm != 0u ? pm & occ_q_touch_mask(m, v, key, level) : 0u;
+}
+
+/* Below a start node (first voxel `key`, children in `block` at `level`): the first child
+ * voxel or uniform node that blocks and touches, into *out. */
+static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_key_t key,
+                       unsigned level, uint32_t block, occ_query_node_t *out)
+{
+    frame_t st[OCC_MAX_DEPTH];
+    unsigned sp = 1;
+    st[0].block = block;
+    st[0].key = key;
+    st[0].level = (uint8_t)level;
+    st[0].mask = (uint8_t)open_mask(m, v, states, block, key, level);
+    while (sp > 0u) {
+        frame_t *const f = &st[sp - 1u];
+        const unsigned mk = f->mask;
+        if (mk == 0u) {
+            sp--;
+            continue;
+        }
+#if defined(__GNUC__)
+        const unsigned slot = (unsigned)__builtin_ctz(mk);
+#else
+        unsigned slot = 0;
+        while (((mk >> slot) & 1u) == 0u) {
+            slot++;
+        }
+#endif
+        f->mask = (uint8_t)(mk & (mk - 1u));
+        const unsigned l = f->level;
+        occ_key_t ck = f->key;
+        ck.k[0] |= (slot & 1u) << l;
+        ck.k[1] |= ((slot >> 1) & 1u) << l;
+        ck.k[2] |= ((slot >> 2) & 1u) << l;
+        if (l == 0u) {
+            occ_q_fill_node(m, ck, 0u, occ_leaf_at(m, f->block)->value[slot], 0u, true, out);
+            return true;
+        }
+        const occ_inner_block_t *const b = occ_inner_at(m, f->block);
+        const uint32_t ch = b->child[slot];
+        if (ch == OCC_NONE) {
+            occ_q_fill_node(m, ck, l, b->value[slot], b->flags[slot], true, out);
+            return true;
+        }
+        frame_t *const nf = &st[sp++];
+        nf->block = ch;
+        nf->key = ck;
+        nf->level = (uint8_t)(l - 1u);
+        nf->mask = (uint8_t)open_mask(m, v, states, ch, ck, l - 1u);
+    }
+    return false;
+}
+
+/* The start cells (query.c) in Morton order, each reached from the root along the path of the
+ * previous one (only the levels below their highest differing key bit are walked again). */
+static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_query_node_t *out)
+{
+    occ_key_t start[8];
+    unsigned lc;
+    const unsigned n = occ_q_start_cells(m, v, 0u, start, &lc);
+    const unsigned depth = m->cfg.depth_levels;
+    uint32_t blk[OCC_MAX_DEPTH + 1u]; /* blk[L]: children block of the path node at level L */
+    unsigned stopped = depth + 1u;     /* level where the previous descent ended */
+    for (unsigned t = 0; t < n; t++) {
+        const occ_key_t key = start[t];
+        unsigned level = depth;
+        uint32_t child = m->root_child;
+        occ_value_t val = m->root_value;
+        uint8_t flags = m->root_flags;
+        bool check = true;
+        if (t > 0u) {
+            const uint32_t x = (key.k[0] ^ start[t - 1u].k[0]) | (key.k[1] ^ start[t - 1u].k[1]) |
+                               (key.k[2] ^ start[t - 1u].k[2]);
+            const unsigned hb = occ_bit_length32(x) - 1u; /* x != 0: distinct cells */
+            if (hb < stopped) {
+                continue; /* inside the node the previous descent ended at: done with it */
+            }
+            if (hb + 1u < depth) {
+                level = hb + 1u; /* the common ancestor: passed, so it has wanted children */
+                child = blk[level];
+                check = false;
+            }
+        }
+        while (level > lc && child != OCC_NONE) {
+            if (check && !occ_q_contains(m, val, flags, states)) {
+                break;
+            }
+            check = true;
+            blk[level] = child;
+            level--;
+            const unsigned slot = ((key.k[0] >> level) & 1u) | (((key.k[1] >> level) & 1u) << 1) |
+                                  (((key.k[2] >> level) & 1u) << 2);
+            if (level == 0u) {
+                val = occ_leaf_at(m, child)->value[slot];
+                flags = 0u;
+                child = OCC_NONE;
+            } else {
+                const occ_inner_block_t *const b = occ_inner_at(m, child);
+                val = b->value[slot];
+                flags = b->flags[slot];
+                child = b->child[slot];
+            }
+        }
+        stopped = level;
+        const bool uniform = child == OCC_NONE;
+        const bool wanted = uniform ? (states & occ_q_state_bit(occ_q_state(m, val))) != 0u
+                                    : occ_q_contains(m, val, flags, states);
+        const occ_key_t nk = occ_key_at_level(key, level);
+        if (!wanted ||
+            !occ_volume_hits_box(v, occ_q_center(m, nk, level), occ_q_half(m, level))) {
+            continue;
+        }
+        if (uniform) {
+            occ_q_fill_node(m, nk, level, val, flags, true, out);
+            return true;
+        }
+        if (walk_below(m, v, states, nk, level - 1u, child, out)) {
+            return true;
+        }
+    }
+    return false;
+}
 
 static bool leaves_map(const occ_map_t *map, const occ_volume_t *vol)
 {
@@ -25,16 +165,9 @@ occ_err_t occ_collide_volume(const occ_map_t *map, const occ_volume_t *vol,
         out->outside = true;
         return OCC_OK;
     }
-    occ_pred_t pred;
-    pred.states = (uint8_t)(OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u));
-    pred.min_level = 0;
-    pred.options = 0;
-    occ_query_iter_t it;
-    const occ_err_t e = occ_query_begin(&it, map, vol, pred);
-    if (e != OCC_OK) {
-        return e;
-    }
-    if (occ_query_next(&it, &out->node)) {
+    const unsigned states =
+        OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u);
+    if (walk(map, vol, states, &out->node)) {
         out->safe = false;
     }
     return OCC_OK;

@@ -54,14 +54,7 @@ occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
         if ((x >> lk->lu) == 0u) {
             return occ_q_state(m, lk->val); /* same uniform node (or voxel) */
         }
-#if defined(__GNUC__)
-        level = 32u - (unsigned)__builtin_clz(x); /* highest changed bit + 1 */
-#else
-        level = 0;
-        for (uint32_t y = x; y != 0u; y >>= 1) {
-            level++;
-        }
-#endif
+        level = occ_bit_length32(x); /* highest changed bit + 1 */
         b = lk->blk[level];
     } else {
         lk->key = k;

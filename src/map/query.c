@@ -29,6 +29,68 @@ static bool same_above(occ_key_t a, occ_key_t b, unsigned level)
            ((a.k[2] ^ b.k[2]) >> level) == 0u;
 }
 
+unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                           occ_key_t start[8], unsigned *level)
+{
+    const unsigned depth = map->cfg.depth_levels;
+    *level = depth;
+    uint32_t lo[3];
+    uint32_t hi[3];
+    if (!occ_q_bounds_keys(map, vol, lo, hi)) {
+        return 0u; /* nothing of the map is near the volume */
+    }
+    /* Smallest level whose cells are at least as wide as the key range: the range then spans
+     * at most two cells per axis. */
+    uint32_t ext = 0;
+    for (unsigned i = 0; i < 3u; i++) {
+        ext = (hi[i] - lo[i]) > ext ? (hi[i] - lo[i]) : ext;
+    }
+    unsigned lc = occ_bit_length32(ext); /* 2^lc > ext */
+    lc = lc < min_level ? min_level : lc; /* never start below the level nodes are reported at */
+    if (lc >= depth) {
+        start[0].k[0] = start[0].k[1] = start[0].k[2] = 0u;
+        return 1u;
+    }
+    *level = lc;
+    /* The cells c0 or c0 + 1 per axis. In Morton order the axis whose +1 flips the highest bit
+     * (z before y before x on ties) is the most significant, so count in that bit order. */
+    uint32_t c0[3];
+    unsigned ax[3];
+    unsigned na = 0;
+    for (unsigned i = 0; i < 3u; i++) {
+        c0[i] = lo[i] >> lc;
+        if ((hi[i] >> lc) != c0[i]) {
+            ax[na++] = i;
+        }
+    }
+    unsigned rank[3] = {0u, 0u, 0u};
+    for (unsigned j = 0; j < na; j++) {
+        const uint32_t x = c0[ax[j]] ^ (c0[ax[j]] + 1u);
+        rank[j] = (occ_bit_length32(x) - 1u) * 3u + ax[j];
+    }
+    for (unsigned j = 1; j < na; j++) { /* most significant first */
+        for (unsigned q = j; q > 0u && rank[q] > rank[q - 1u]; q--) {
+            const unsigned tr = rank[q];
+            const unsigned ta = ax[q];
+            rank[q] = rank[q - 1u];
+            ax[q] = ax[q - 1u];
+            rank[q - 1u] = tr;
+            ax[q - 1u] = ta;
+        }
+    }
+    const unsigned n = 1u << na;
+    for (unsigned t = 0; t < n; t++) {
+        uint32_t c[3] = {c0[0], c0[1], c0[2]};
+        for (unsigned j = 0; j < na; j++) {
+            c[ax[j]] += (t >> (na - 1u - j)) & 1u;
+        }
+        start[t].k[0] = c[0] << lc;
+        start[t].k[1] = c[1] << lc;
+        start[t].k[2] = c[2] << lc;
+    }
+    return n;
+}
+
 occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_volume_t *vol,
                           occ_pred_t pred)
 {
@@ -48,71 +110,10 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
     it->virt_sp = OCC_MAX_DEPTH;
     it->virt_value = OCC_VALUE_UNOBSERVED;
     it->path.k[0] = it->path.k[1] = it->path.k[2] = 0u;
-    it->nstart = 0;
     it->istart = 0;
-    it->start_level = (uint8_t)depth;
-    uint32_t lo[3];
-    uint32_t hi[3];
-    if (!occ_q_bounds_keys(map, vol, lo, hi)) {
-        return OCC_OK; /* nothing of the map is near the volume */
-    }
-    /* Smallest level whose cells are at least as wide as the key range: the range then spans
-     * at most two cells per axis. */
-    uint32_t ext = 0;
-    for (unsigned i = 0; i < 3u; i++) {
-        ext = (hi[i] - lo[i]) > ext ? (hi[i] - lo[i]) : ext;
-    }
-    unsigned lc = pred.min_level; /* never start below the level nodes are reported at */
-    while (lc < depth && ((uint32_t)1 << lc) <= ext) {
-        lc++;
-    }
-    if (lc >= depth) {
-        it->start[0].k[0] = it->start[0].k[1] = it->start[0].k[2] = 0u;
-        it->nstart = 1;
-        return OCC_OK;
-    }
+    unsigned lc = depth;
+    it->nstart = (uint8_t)occ_q_start_cells(map, vol, pred.min_level, it->start, &lc);
     it->start_level = (uint8_t)lc;
-    /* The cells c0 or c0 + 1 per axis. In Morton order the axis whose +1 flips the highest bit
-     * (z before y before x on ties) is the most significant, so count in that bit order. */
-    uint32_t c0[3];
-    unsigned ax[3];
-    unsigned na = 0;
-    for (unsigned i = 0; i < 3u; i++) {
-        c0[i] = lo[i] >> lc;
-        if ((hi[i] >> lc) != c0[i]) {
-            ax[na++] = i;
-        }
-    }
-    unsigned rank[3] = {0u, 0u, 0u};
-    for (unsigned j = 0; j < na; j++) {
-        const uint32_t x = c0[ax[j]] ^ (c0[ax[j]] + 1u);
-        unsigned hb = 0;
-        for (uint32_t y = x >> 1; y != 0u; y >>= 1) {
-            hb++;
-        }
-        rank[j] = hb * 3u + ax[j];
-    }
-    for (unsigned j = 1; j < na; j++) { /* most significant first */
-        for (unsigned q = j; q > 0u && rank[q] > rank[q - 1u]; q--) {
-            const unsigned tr = rank[q];
-            const unsigned ta = ax[q];
-            rank[q] = rank[q - 1u];
-            ax[q] = ax[q - 1u];
-            rank[q - 1u] = tr;
-            ax[q - 1u] = ta;
-        }
-    }
-    const unsigned n = 1u << na;
-    for (unsigned t = 0; t < n; t++) {
-        uint32_t c[3] = {c0[0], c0[1], c0[2]};
-        for (unsigned j = 0; j < na; j++) {
-            c[ax[j]] += (t >> (na - 1u - j)) & 1u;
-        }
-        it->start[t].k[0] = c[0] << lc;
-        it->start[t].k[1] = c[1] << lc;
-        it->start[t].k[2] = c[2] << lc;
-    }
-    it->nstart = (uint8_t)n;
     return OCC_OK;
 }
 
@@ -212,10 +213,7 @@ static bool next_start(occ_query_iter_t *it, occ_query_node_t *out)
     if (it->istart > 0u) {
         const uint32_t x = (key.k[0] ^ it->path.k[0]) | (key.k[1] ^ it->path.k[1]) |
                            (key.k[2] ^ it->path.k[2]);
-        unsigned hb = 0;
-        for (uint32_t y = x >> 1; y != 0u; y >>= 1) {
-            hb++;
-        }
+        const unsigned hb = occ_bit_length32(x) - 1u; /* x != 0: distinct starts */
         if (hb + 1u < depth) {
             level = hb + 1u; /* the common ancestor, already checked */
             child = it->block[depth - level];

@@ -101,35 +101,31 @@ static inline bool occ_q_finite3(occ_vec3_t v)
 #endif
 
 /* Which of the 8 entries of a stored block match `states` (OCC_PRED_* bits): bit s for slot s.
- * Inner blocks: a uniform child's flags follow from its value (tree invariant), so one formula
- * serves uniform and mixed children: occupied from the max value, free and unknown from the
- * indicators. Branch-free: neighbouring states are random. */
+ * Inner blocks: the indicators say it (a uniform child's flags follow from its value, a mixed
+ * child's are the OR of its children's: tree invariants), so one formula serves both kinds.
+ * Branch-free: neighbouring states are random. */
 static inline unsigned occ_q_inner_match(const occ_map_t *m, const occ_inner_block_t *b,
                                          unsigned states)
 {
+    (void)m;
     const unsigned wf = ((states & OCC_PRED_FREE) != 0u ? OCC_NODE_HAS_FREE : 0u) |
-                        ((states & OCC_PRED_UNKNOWN) != 0u ? OCC_NODE_HAS_UNKNOWN : 0u);
-    unsigned pm = 0u;
+                        ((states & OCC_PRED_UNKNOWN) != 0u ? OCC_NODE_HAS_UNKNOWN : 0u) |
+                        ((states & OCC_PRED_OCCUPIED) != 0u ? OCC_NODE_HAS_OCCUPIED : 0u);
 #ifdef OCC_Q_SWAR_FLAGS
-    /* The 8 flag bytes at once: a byte with a wanted bit (flags < 0x10) gets its top bit, and the
+    /* The 8 flag bytes at once: a byte with a wanted bit (wf < 0x10) gets its top bit, and the
      * multiply gathers the 8 top bits into bits 56..63. */
     uint64_t f;
     memcpy(&f, b->flags, sizeof f);
     f = ((f & ((uint64_t)wf * 0x0101010101010101ull)) + 0x7F7F7F7F7F7F7F7Full) &
         0x8080808080808080ull;
-    pm = (unsigned)(((f >> 7) * 0x0102040810204080ull) >> 56);
+    return (unsigned)(((f >> 7) * 0x0102040810204080ull) >> 56);
 #else
+    unsigned pm = 0u;
     for (unsigned s = 0; s < 8u; s++) {
         pm |= (unsigned)((b->flags[s] & wf) != 0u) << s;
     }
-#endif
-    if ((states & OCC_PRED_OCCUPIED) != 0u) {
-        const occ_value_t occ_min = m->q_occ_min;
-        for (unsigned s = 0; s < 8u; s++) {
-            pm |= (unsigned)(b->value[s] >= occ_min) << s;
-        }
-    }
     return pm;
+#endif
 }
 
 static inline unsigned occ_q_leaf_match(const occ_map_t *m, const occ_leaf_block_t *b,
@@ -217,6 +213,12 @@ static inline unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *
     }
     return occ_q_touch_mask_cubes(m, v, pkey, level);
 }
+
+/* query.c: the cells a walk over the volume starts from: at most 8, at the smallest level
+ * (>= min_level) whose cells are as wide as the volume's key range, in Morton order; *level gets
+ * that level (depth_levels with the root as the one start). 0 when the volume misses the map. */
+unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                           occ_key_t start[8], unsigned *level);
 
 /* Fill a reported node. */
 void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,

@@ -77,6 +77,20 @@ static inline bool occ_is_observed(occ_value_t v)
     return v > OCC_VALUE_UNOBSERVED;
 }
 
+/* Number of significant bits of x (0 for 0): 1 + the highest set bit. */
+static inline unsigned occ_bit_length32(uint32_t x)
+{
+#if defined(__GNUC__)
+    return x == 0u ? 0u : 32u - (unsigned)__builtin_clz(x);
+#else
+    unsigned n = 0;
+    for (; x != 0u; x >>= 1) {
+        n++;
+    }
+    return n;
+#endif
+}
+
 /* Child slot (0..7) of voxel `code` inside its ancestor at `level` (>= 1). */
 static inline unsigned occ_code_slot(occ_code_t code, unsigned level)
 {
