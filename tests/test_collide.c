@@ -99,6 +99,15 @@ static void test_against_oracle(void **state)
                 assert_true(c.node.state == OCC_STATE_OCCUPIED ||
                             (pol == OCC_UNKNOWN_UNSAFE && c.node.state == OCC_STATE_UNKNOWN));
                 assert_int_not_equal(oracle_q_cell(s.oracle, &map, c.node.key, c.node.level), 0);
+                /* ... and the first one in Morton order: the volume iterator's first node. */
+                occ_query_iter_t it;
+                occ_pred_t pred = {(uint8_t)states, 0u, 0u};
+                occ_query_node_t first;
+                assert_int_equal(occ_query_begin(&it, &map, &s.vol, pred), OCC_OK);
+                assert_true(occ_query_next(&it, &first));
+                assert_memory_equal(&first.key, &c.node.key, sizeof first.key);
+                assert_int_equal(first.level, c.node.level);
+                assert_int_equal(first.state, c.node.state);
                 unsafe_n++;
             } else if (n == 0u) {
                 if (!c.safe) {
