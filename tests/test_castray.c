@@ -120,27 +120,13 @@ static void test_hand_cases(void **state)
     assert_int_equal(r.key.k[0], 15u);
 }
 
-static void test_octomap_geb079(void **state)
+/* n_rays random rays from inside [mn, mx] (both unknown modes, bounded and unbounded ranges)
+ * cast in `map` and in OctoMap's tree `o` holding the same voxels: same hit, same end voxel. */
+static void compare_casts(oracle_q_octo_t *o, const double mn[3], const double mx[3],
+                          unsigned n_rays, const char *label)
 {
-    (void)state;
-    if (access(GEB, R_OK) != 0) {
-        printf("SKIP: %s not found (liboctomap-dev examples)\n", GEB);
-        skip();
-    }
-    oracle_q_octo_t *o = oracle_q_octo_load(GEB);
-    assert_non_null(o);
-    occ_map_config_t cfg = occ_map_config_default();
-    cfg.resolution_m = (float)oracle_q_octo_resolution(o);
-    cfg.depth_levels = 16;
-    assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
-    size_t mismatch = 99;
-    assert_int_equal(oracle_q_octo_copy(o, &map, &mismatch), OCC_OK);
-    assert_int_equal(mismatch, 0);
-    assert_int_equal(occ_map_check(&map), OCC_OK);
-    double mn[3], mx[3];
-    oracle_q_octo_bbox(o, mn, mx);
     unsigned hits = 0, same = 0, bad = 0;
-    for (unsigned i = 0; i < N_RAYS; i++) {
+    for (unsigned i = 0; i < n_rays; i++) {
         float org[3], dir[3];
         for (int k = 0; k < 3; k++) {
             org[k] = (float)qs_uniform(&rng, mn[k], mx[k]);
@@ -175,9 +161,32 @@ static void test_octomap_geb079(void **state)
         }
         hits += ohit ? 1u : 0u;
     }
-    printf("geb079: %u rays, %u hits, %u identical, %u differ\n", N_RAYS, hits, same, bad);
+    printf("%s: %u rays, %u hits, %u identical, %u differ\n", label, n_rays, hits, same, bad);
     assert_int_equal(bad, 0);
-    assert_true(hits > N_RAYS / 10u);
+    assert_true(hits > n_rays / 10u);
+    assert_true(hits < n_rays - n_rays / 10u);
+}
+
+static void test_octomap_geb079(void **state)
+{
+    (void)state;
+    if (access(GEB, R_OK) != 0) {
+        printf("SKIP: %s not found (liboctomap-dev examples)\n", GEB);
+        skip();
+    }
+    oracle_q_octo_t *o = oracle_q_octo_load(GEB);
+    assert_non_null(o);
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.resolution_m = (float)oracle_q_octo_resolution(o);
+    cfg.depth_levels = 16;
+    assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+    size_t mismatch = 99;
+    assert_int_equal(oracle_q_octo_copy(o, &map, &mismatch), OCC_OK);
+    assert_int_equal(mismatch, 0);
+    assert_int_equal(occ_map_check(&map), OCC_OK);
+    double mn[3], mx[3];
+    oracle_q_octo_bbox(o, mn, mx);
+    compare_casts(o, mn, mx, N_RAYS, "geb079");
     /* search() agrees on random points too. */
     for (unsigned i = 0; i < 20000u; i++) {
         float p[3];
@@ -201,6 +210,30 @@ static void test_octomap_geb079(void **state)
         assert_int_equal(s, os < 0 ? OCC_STATE_UNKNOWN : (os ? OCC_STATE_OCCUPIED : OCC_STATE_FREE));
     }
     oracle_q_octo_free(o);
+}
+
+/* Random scenes built in OctoMap (large pruned free nodes, unknown gaps, occupied boxes): the
+ * walk passes whole nodes without occupied (or unknown) voxels below; the voxels it stops at must
+ * still be OctoMap's. */
+static void test_octomap_random_scenes(void **state)
+{
+    (void)state;
+    for (uint64_t seed = 1; seed <= 4u; seed++) {
+        oracle_q_octo_t *o = oracle_q_octo_random(seed, 0.1);
+        assert_non_null(o);
+        occ_map_config_t cfg = occ_map_config_default();
+        cfg.resolution_m = 0.1f;
+        cfg.depth_levels = 16;
+        assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+        size_t mismatch = 99;
+        assert_int_equal(oracle_q_octo_copy(o, &map, &mismatch), OCC_OK);
+        assert_int_equal(mismatch, 0);
+        const double mn[3] = {-3.2, -3.2, -3.2}, mx[3] = {3.2, 3.2, 3.2};
+        char label[32];
+        snprintf(label, sizeof label, "random scene %u", (unsigned)seed);
+        compare_casts(o, mn, mx, 3000u, label);
+        oracle_q_octo_free(o);
+    }
 }
 
 /* Line of sight against the voxels the segment crosses (brute force, Eigen). */
@@ -258,6 +291,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hand_cases),
+        cmocka_unit_test(test_octomap_random_scenes),
         cmocka_unit_test(test_line_of_sight_random),
         cmocka_unit_test(test_octomap_geb079),
     };

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -463,6 +464,32 @@ extern "C" oracle_q_octo_t *oracle_q_octo_load(const char *path)
             return nullptr;
         }
     }
+    auto *o = new oracle_q_octo;
+    o->tree = t;
+    return o;
+}
+
+extern "C" oracle_q_octo_t *oracle_q_octo_random(uint64_t seed, double res_m)
+{
+    std::mt19937_64 rng(seed);
+    auto r = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    auto *t = new octomap::OcTree(res_m);
+    const int half = 32; /* voxels: the scene spans [-32, 32) per axis */
+    auto box = [&](int size, bool occupied) {
+        const int x0 = r(-half, half - size), y0 = r(-half, half - size), z0 = r(-half, half - size);
+        for (int x = x0; x < x0 + size; x++)
+            for (int y = y0; y < y0 + size; y++)
+                for (int z = z0; z < z0 + size; z++) {
+                    const octomap::OcTreeKey k((octomap::key_type)(32768 + x), (octomap::key_type)(32768 + y),
+                                               (octomap::key_type)(32768 + z));
+                    t->updateNode(k, occupied, true);
+                }
+    };
+    for (int i = 0; i < 40; i++) box(r(4, 20), false);
+    for (int i = 0; i < 150; i++) box(r(2, 5), true);
+    for (int i = 0; i < 2000; i++) box(1, true);
+    t->updateInnerOccupancy();
+    t->prune();
     auto *o = new oracle_q_octo;
     o->tree = t;
     return o;

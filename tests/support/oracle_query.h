@@ -72,6 +72,9 @@ typedef struct oracle_q_octo oracle_q_octo_t;
 /* Load a .bt/.ot through liboctomap; NULL if the file cannot be read. */
 oracle_q_octo_t *oracle_q_octo_load(const char *path);
 void oracle_q_octo_free(oracle_q_octo_t *o);
+/* A random OcTree (resolution res_m, depth 16) around the origin: free boxes (pruned into large
+ * nodes), unknown gaps between them, occupied boxes and scattered occupied voxels inside. */
+oracle_q_octo_t *oracle_q_octo_random(uint64_t seed, double res_m);
 double oracle_q_octo_resolution(const oracle_q_octo_t *o);
 size_t oracle_q_octo_leaves(const oracle_q_octo_t *o);
 /* Metric bounding box of the known space. */
