@@ -105,7 +105,7 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
             }
         }
         while (level > lc && child != OCC_NONE) {
-            if (check && !occ_q_contains(m, val, flags, states)) {
+            if (check && !occ_q_contains(flags, states)) {
                 break;
             }
             check = true;
@@ -127,7 +127,7 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
         stopped = level;
         const bool uniform = child == OCC_NONE;
         const bool wanted = uniform ? (states & occ_q_state_bit(occ_q_state(m, val))) != 0u
-                                    : occ_q_contains(m, val, flags, states);
+                                    : occ_q_contains(flags, states);
         const occ_key_t nk = occ_key_at_level(key, level);
         if (!wanted ||
             !occ_volume_hits_box(v, occ_q_center(m, nk, level), occ_q_half(m, level))) {

@@ -21,7 +21,7 @@ static bool matches(const occ_nearest_t *it, occ_value_t v, uint8_t flags, bool 
     if (uniform) {
         return (it->pred.states & occ_q_state_bit(occ_q_state(it->map, v))) != 0u;
     }
-    return occ_q_contains(it->map, v, flags, it->pred.states);
+    return occ_q_contains(flags, it->pred.states);
 }
 
 static occ_err_t push(occ_nearest_t *it, const occ_nearest_entry_t *e)

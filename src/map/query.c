@@ -132,7 +132,7 @@ static bool pred_match(const occ_query_iter_t *it, occ_value_t v, uint8_t flags,
     if (uniform) {
         return (it->pred.states & occ_q_state_bit(occ_q_state(it->map, v))) != 0u;
     }
-    return occ_q_contains(it->map, v, flags, it->pred.states);
+    return occ_q_contains(flags, it->pred.states);
 }
 
 /* Push the children of the node with first voxel `pkey` (children at `level`, in stack entry i):
@@ -223,7 +223,7 @@ static bool next_start(occ_query_iter_t *it, occ_query_node_t *out)
     it->istart++;
     const occ_code_t code = occ_morton_encode(key);
     while (level > it->start_level && child != OCC_NONE) {
-        if (check && !occ_q_contains(m, v, flags, it->pred.states)) {
+        if (check && !occ_q_contains(flags, it->pred.states)) {
             break; /* nothing wanted below: skip this node */
         }
         check = true;

@@ -48,16 +48,19 @@ static inline uint8_t occ_q_uniform_flags(const occ_map_t *m, occ_value_t v)
     }
 }
 
-/* Does a node with children (max `v`, indicator `flags`) contain a state in `mask`? */
-static inline bool occ_q_contains(const occ_map_t *m, occ_value_t v, uint8_t flags, unsigned mask)
+/* The OCC_NODE_HAS_* indicator bits of the states in `states` (OCC_PRED_* bits). */
+static inline unsigned occ_q_has_bits(unsigned states)
 {
-    if ((mask & OCC_PRED_OCCUPIED) != 0u && occ_is_observed(v) && v >= m->q_occ_min) {
-        return true;
-    }
-    if ((mask & OCC_PRED_FREE) != 0u && (flags & OCC_NODE_HAS_FREE) != 0u) {
-        return true;
-    }
-    return (mask & OCC_PRED_UNKNOWN) != 0u && (flags & OCC_NODE_HAS_UNKNOWN) != 0u;
+    return ((states & OCC_PRED_FREE) != 0u ? OCC_NODE_HAS_FREE : 0u) |
+           ((states & OCC_PRED_UNKNOWN) != 0u ? OCC_NODE_HAS_UNKNOWN : 0u) |
+           ((states & OCC_PRED_OCCUPIED) != 0u ? OCC_NODE_HAS_OCCUPIED : 0u);
+}
+
+/* Does a node with children (indicators `flags`) contain a state in `states`? The indicators
+ * say it: they are the OR of the children's, HAS_OCCUPIED included (tree invariants). */
+static inline bool occ_q_contains(uint8_t flags, unsigned states)
+{
+    return (flags & occ_q_has_bits(states)) != 0u;
 }
 
 /* Centre coordinate (metres) of the node at `level` whose first voxel key on an axis is `k`
@@ -108,9 +111,7 @@ static inline unsigned occ_q_inner_match(const occ_map_t *m, const occ_inner_blo
                                          unsigned states)
 {
     (void)m;
-    const unsigned wf = ((states & OCC_PRED_FREE) != 0u ? OCC_NODE_HAS_FREE : 0u) |
-                        ((states & OCC_PRED_UNKNOWN) != 0u ? OCC_NODE_HAS_UNKNOWN : 0u) |
-                        ((states & OCC_PRED_OCCUPIED) != 0u ? OCC_NODE_HAS_OCCUPIED : 0u);
+    const unsigned wf = occ_q_has_bits(states);
 #ifdef OCC_Q_SWAR_FLAGS
     /* The 8 flag bytes at once: a byte with a wanted bit (wf < 0x10) gets its top bit, and the
      * multiply gathers the 8 top bits into bits 56..63. */
@@ -146,10 +147,11 @@ static inline unsigned occ_q_leaf_match(const occ_map_t *m, const occ_leaf_block
            ((states & OCC_PRED_UNKNOWN) != 0u ? unk : 0u);
 }
 
-/* max(d, 0) */
+/* max(d, 0) for finite d, without a branch: compilers turn `d > 0 ? d : 0` into a jump here,
+ * and the sign of a neighbour's distance is a coin toss for the predictor. */
 static inline float occ_q_pos(float d)
 {
-    return d > 0.0f ? d : 0.0f;
+    return (d + fabsf(d)) * 0.5f;
 }
 
 /* Which children (half edge h) of a node centred at pc touch a sphere / a box: per axis the
@@ -181,14 +183,22 @@ static inline unsigned occ_q_sphere_touch(const occ_volume_t *v, occ_vec3_t pc, 
            (xy01 + z1 <= r2 ? 0x40u : 0u) | (xy11 + z1 <= r2 ? 0x80u : 0u);
 }
 
+/* 1 when the closed intervals [a0, a1] and [b0, b1] overlap; & rather than && so that it
+ * compiles without a jump (see occ_q_pos). */
+static inline unsigned occ_q_overlap(float a0, float a1, float b0, float b1)
+{
+    return (unsigned)(a0 <= b1) & (unsigned)(a1 >= b0);
+}
+
 static inline unsigned occ_q_aabb_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
 {
-    const unsigned xm = (pc.x - 2.0f * h <= v->bmax.x && pc.x >= v->bmin.x ? 0x55u : 0u) |
-                        (pc.x <= v->bmax.x && pc.x + 2.0f * h >= v->bmin.x ? 0xAAu : 0u);
-    const unsigned ym = (pc.y - 2.0f * h <= v->bmax.y && pc.y >= v->bmin.y ? 0x33u : 0u) |
-                        (pc.y <= v->bmax.y && pc.y + 2.0f * h >= v->bmin.y ? 0xCCu : 0u);
-    const unsigned zm = (pc.z - 2.0f * h <= v->bmax.z && pc.z >= v->bmin.z ? 0x0Fu : 0u) |
-                        (pc.z <= v->bmax.z && pc.z + 2.0f * h >= v->bmin.z ? 0xF0u : 0u);
+    const float e = 2.0f * h;
+    const unsigned xm = 0x55u * occ_q_overlap(pc.x - e, pc.x, v->bmin.x, v->bmax.x) |
+                        0xAAu * occ_q_overlap(pc.x, pc.x + e, v->bmin.x, v->bmax.x);
+    const unsigned ym = 0x33u * occ_q_overlap(pc.y - e, pc.y, v->bmin.y, v->bmax.y) |
+                        0xCCu * occ_q_overlap(pc.y, pc.y + e, v->bmin.y, v->bmax.y);
+    const unsigned zm = 0x0Fu * occ_q_overlap(pc.z - e, pc.z, v->bmin.z, v->bmax.z) |
+                        0xF0u * occ_q_overlap(pc.z, pc.z + e, v->bmin.z, v->bmax.z);
     return xm & ym & zm;
 }
 
