@@ -198,9 +198,9 @@ occ_err_t occ_volume_frustum(occ_volume_t *v, occ_vec3_t origin, const occ_vec3_
 /* ---- exact node tests ------------------------------------------------------------------------- */
 static inline float point_box_d2(occ_vec3_t p, occ_vec3_t c, float h)
 {
-    const float dx = maxf(fabsf(p.x - c.x) - h, 0.0f);
-    const float dy = maxf(fabsf(p.y - c.y) - h, 0.0f);
-    const float dz = maxf(fabsf(p.z - c.z) - h, 0.0f);
+    const float dx = occ_q_pos(fabsf(p.x - c.x) - h);
+    const float dy = occ_q_pos(fabsf(p.y - c.y) - h);
+    const float dz = occ_q_pos(fabsf(p.z - c.z) - h);
     return dx * dx + dy * dy + dz * dz;
 }
 
