@@ -78,15 +78,18 @@ unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsign
             ax[q - 1u] = ta;
         }
     }
-    const unsigned n = 1u << na;
-    for (unsigned t = 0; t < n; t++) {
-        uint32_t c[3] = {c0[0], c0[1], c0[2]};
-        for (unsigned j = 0; j < na; j++) {
-            c[ax[j]] += (t >> (na - 1u - j)) & 1u;
+    /* Doubling from the least significant axis: cell t has bit (na - 1 - j) of t set when it
+     * is one further on axis ax[j], so the list comes out in Morton order. */
+    start[0].k[0] = c0[0] << lc;
+    start[0].k[1] = c0[1] << lc;
+    start[0].k[2] = c0[2] << lc;
+    unsigned n = 1u;
+    for (unsigned j = na; j-- > 0u;) {
+        for (unsigned t = 0; t < n; t++) {
+            start[n + t] = start[t];
+            start[n + t].k[ax[j]] += (uint32_t)1 << lc;
         }
-        start[t].k[0] = c[0] << lc;
-        start[t].k[1] = c[1] << lc;
-        start[t].k[2] = c[2] << lc;
+        n *= 2u;
     }
     return n;
 }
