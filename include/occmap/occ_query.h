@@ -257,14 +257,15 @@ typedef struct {
  * origin (<= 0: unbounded, up to the map border). The origin's own voxel is tested first.
  * Same voxels, same ties and the same double arithmetic as OctoMap when OCC_RAY_DOUBLE.
  * OCC_ERR_ARG: NULL, NaN/Inf, zero direction; OCC_ERR_RANGE: origin outside the map.
- * O(voxels crossed), O(1) per voxel inside uniform (pruned) nodes. */
+ * O(voxels crossed); no lookup while the ray is inside a node whose indicators say nothing below
+ * can stop it (no OCCUPIED voxel, nor UNKNOWN one unless ignore_unknown), pruned or not. */
 occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
                        bool ignore_unknown, float max_range_m, occ_ray_result_t *out);
 
 /* Line of sight from a to b: the voxels the segment crosses (3D-DDA from a's voxel to b's, both
  * included) hold nothing OCCUPIED (nor UNKNOWN under OCC_UNKNOWN_UNSAFE). `blocker` (may be NULL)
  * gets the first blocking voxel. OCC_ERR_ARG (NULL, NaN, bad policy), OCC_ERR_RANGE (a or b
- * outside the map). O(voxels crossed). */
+ * outside the map). O(voxels crossed), passing whole nodes that hold nothing blocking. */
 occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
                             occ_unknown_policy_t policy, bool *visible,
                             occ_ray_result_t *blocker);
