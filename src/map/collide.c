@@ -41,35 +41,23 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
             sp--;
             continue;
         }
-#if defined(__GNUC__)
-        const unsigned slot = (unsigned)__builtin_ctz(mk);
-#else
-        unsigned slot = 0;
-        while (((mk >> slot) & 1u) == 0u) {
-            slot++;
-        }
-#endif
+        const unsigned slot = occ_first_slot(mk);
         f->mask = (uint8_t)(mk & (mk - 1u));
         const unsigned l = f->level;
         occ_key_t ck = f->key;
         ck.k[0] |= (slot & 1u) << l;
         ck.k[1] |= ((slot >> 1) & 1u) << l;
         ck.k[2] |= ((slot >> 2) & 1u) << l;
-        if (l == 0u) {
-            occ_q_fill_node(m, ck, 0u, occ_leaf_at(m, f->block)->value[slot], 0u, true, out);
-            return true;
-        }
-        const occ_inner_block_t *const b = occ_inner_at(m, f->block);
-        const uint32_t ch = b->child[slot];
-        if (ch == OCC_NONE) {
-            occ_q_fill_node(m, ck, l, b->value[slot], b->flags[slot], true, out);
+        const occ_entry_t e = occ_entry_at(m, f->block, l, slot);
+        if (e.child == OCC_NONE) { /* a voxel, or a uniform node: it blocks and touches */
+            occ_q_fill_node(m, ck, l, e.value, e.flags, true, out);
             return true;
         }
         frame_t *const nf = &st[sp++];
-        nf->block = ch;
+        nf->block = e.child;
         nf->key = ck;
         nf->level = (uint8_t)(l - 1u);
-        nf->mask = (uint8_t)open_mask(m, v, states, ch, ck, l - 1u);
+        nf->mask = (uint8_t)open_mask(m, v, states, e.child, ck, l - 1u);
     }
     return false;
 }
@@ -113,16 +101,10 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
             level--;
             const unsigned slot = ((key.k[0] >> level) & 1u) | (((key.k[1] >> level) & 1u) << 1) |
                                   (((key.k[2] >> level) & 1u) << 2);
-            if (level == 0u) {
-                val = occ_leaf_at(m, child)->value[slot];
-                flags = 0u;
-                child = OCC_NONE;
-            } else {
-                const occ_inner_block_t *const b = occ_inner_at(m, child);
-                val = b->value[slot];
-                flags = b->flags[slot];
-                child = b->child[slot];
-            }
+            const occ_entry_t e = occ_entry_at(m, child, level, slot);
+            val = e.value;
+            flags = e.flags;
+            child = e.child;
         }
         stopped = level;
         const bool uniform = child == OCC_NONE;

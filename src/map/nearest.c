@@ -129,16 +129,10 @@ occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist
             e.key.k[0] |= (s & 1u) ? bit : 0u;
             e.key.k[1] |= (s & 2u) ? bit : 0u;
             e.key.k[2] |= (s & 4u) ? bit : 0u;
-            if (level == 0u) {
-                e.value = occ_leaf_at(m, top.child)->value[s];
-                e.flags = 0u;
-                e.child = OCC_NONE;
-            } else {
-                const occ_inner_block_t *const b = occ_inner_at(m, top.child);
-                e.value = b->value[s];
-                e.flags = b->flags[s];
-                e.child = b->child[s];
-            }
+            const occ_entry_t en = occ_entry_at(m, top.child, level, s);
+            e.value = en.value;
+            e.flags = en.flags;
+            e.child = en.child;
             if (!matches(it, e.value, e.flags, e.child == OCC_NONE)) {
                 continue;
             }

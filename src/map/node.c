@@ -39,12 +39,7 @@ occ_err_t occ_map_node_child(const occ_map_t *const map, const occ_node_t *const
     }
     out->key = key;
     out->level = (uint8_t)level;
-    if (level == 0u) {
-        const occ_value_t v = occ_leaf_at(map, parent->children)->value[slot];
-        fill(map, out, v, occ_value_flags(map, v), OCC_NONE);
-    } else {
-        const occ_inner_block_t *const b = occ_inner_at(map, parent->children);
-        fill(map, out, b->value[slot], b->flags[slot], b->child[slot]);
-    }
+    const occ_entry_t e = occ_entry_at(map, parent->children, level, slot);
+    fill(map, out, e.value, level == 0u ? occ_value_flags(map, e.value) : e.flags, e.child);
     return OCC_OK;
 }

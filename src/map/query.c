@@ -233,16 +233,10 @@ static bool next_start(occ_query_iter_t *it, occ_query_node_t *out)
         it->block[depth - level] = child;
         const unsigned slot = occ_code_slot(code, level);
         level--;
-        if (level == 0u) {
-            v = occ_leaf_at(m, child)->value[slot];
-            flags = 0u;
-            child = OCC_NONE;
-        } else {
-            const occ_inner_block_t *const b = occ_inner_at(m, child);
-            v = b->value[slot];
-            flags = b->flags[slot];
-            child = b->child[slot];
-        }
+        const occ_entry_t e = occ_entry_at(m, child, level, slot);
+        v = e.value;
+        flags = e.flags;
+        child = e.child;
     }
     /* Later starts inside the node reached (uniform, or without anything wanted) are this node. */
     while (it->istart < it->nstart && same_above(it->start[it->istart], key, level)) {
@@ -270,34 +264,22 @@ bool occ_query_next(occ_query_iter_t *it, occ_query_node_t *out)
                 }
                 continue;
             }
-#if defined(__GNUC__)
-            const unsigned slot = (unsigned)__builtin_ctz(mk);
-#else
-            unsigned slot = 0;
-            while (((mk >> slot) & 1u) == 0u) {
-                slot++;
-            }
-#endif
+            const unsigned slot = occ_first_slot(mk);
             it->mask[i] = (uint8_t)(mk & (mk - 1u));
             const unsigned level = depth - 1u - i;
             const uint32_t bit = 1u << level;
             it->path.k[0] = (it->path.k[0] & ~bit) | ((slot & 1u) ? bit : 0u);
             it->path.k[1] = (it->path.k[1] & ~bit) | ((slot & 2u) ? bit : 0u);
             it->path.k[2] = (it->path.k[2] & ~bit) | ((slot & 4u) ? bit : 0u);
-            occ_value_t v;
-            uint8_t flags = 0u;
-            uint32_t child = OCC_NONE;
+            occ_entry_t e;
             if (i >= it->virt_sp) {
-                v = it->virt_value;
-            } else if (level == 0u) {
-                v = occ_leaf_at(m, it->block[i])->value[slot];
+                e.value = it->virt_value;
+                e.flags = 0u;
+                e.child = OCC_NONE;
             } else {
-                const occ_inner_block_t *const b = occ_inner_at(m, it->block[i]);
-                v = b->value[slot];
-                flags = b->flags[slot];
-                child = b->child[slot];
+                e = occ_entry_at(m, it->block[i], level, slot);
             }
-            if (take(it, mask_key(it->path, level), level, v, flags, child, i + 1u, out)) {
+            if (take(it, mask_key(it->path, level), level, e.value, e.flags, e.child, i + 1u, out)) {
                 return true;
             }
         }

@@ -158,16 +158,10 @@ occ_err_t occ_map_read_key(const occ_map_t *const map, const occ_key_t key, cons
     while (l > level && child != OCC_NONE) {
         const unsigned slot = occ_code_slot(code, l);
         l--;
-        if (l == 0u) {
-            v = occ_leaf_at(map, child)->value[slot];
-            f = occ_value_flags(map, v);
-            child = OCC_NONE;
-        } else {
-            const occ_inner_block_t *const b = occ_inner_at(map, child);
-            v = b->value[slot];
-            f = b->flags[slot];
-            child = b->child[slot];
-        }
+        const occ_entry_t e = occ_entry_at(map, child, l, slot);
+        v = e.value;
+        f = l == 0u ? occ_value_flags(map, v) : e.flags;
+        child = e.child;
     }
     out->observed = occ_is_observed(v);
     out->logodds = occ_value_to_logodds(v);

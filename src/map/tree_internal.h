@@ -77,6 +77,45 @@ static inline bool occ_is_observed(occ_value_t v)
     return v > OCC_VALUE_UNOBSERVED;
 }
 
+/* Entry `slot` of the block `block` whose nodes are at `level`: value, indicator flags (0 for
+ * a voxel: they follow from its value) and child block (OCC_NONE for a voxel). */
+typedef struct {
+    occ_value_t value;
+    uint8_t flags;
+    uint32_t child;
+} occ_entry_t;
+
+static inline occ_entry_t occ_entry_at(const occ_map_t *m, uint32_t block, unsigned level,
+                                       unsigned slot)
+{
+    occ_entry_t e;
+    if (level == 0u) {
+        e.value = occ_leaf_at(m, block)->value[slot];
+        e.flags = 0u;
+        e.child = OCC_NONE;
+    } else {
+        const occ_inner_block_t *const b = occ_inner_at(m, block);
+        e.value = b->value[slot];
+        e.flags = b->flags[slot];
+        e.child = b->child[slot];
+    }
+    return e;
+}
+
+/* The lowest set bit of a non-zero child mask: the next slot in Morton order. */
+static inline unsigned occ_first_slot(unsigned mask)
+{
+#if defined(__GNUC__)
+    return (unsigned)__builtin_ctz(mask);
+#else
+    unsigned slot = 0;
+    while (((mask >> slot) & 1u) == 0u) {
+        slot++;
+    }
+    return slot;
+#endif
+}
+
 /* Number of significant bits of x (0 for 0): 1 + the highest set bit. */
 static inline unsigned occ_bit_length32(uint32_t x)
 {

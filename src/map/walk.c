@@ -57,18 +57,10 @@ bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
         const unsigned slot = w->stack[top].next++;
         const unsigned level = w->stack[top].level;
         const occ_code_t code = child_code(w->code, slot, level);
-        occ_value_t v;
-        uint32_t child = OCC_NONE;
-        uint8_t flags;
-        if (level == 0u) {
-            v = occ_leaf_at(m, w->stack[top].block)->value[slot];
-            flags = occ_value_flags(m, v);
-        } else {
-            const occ_inner_block_t *const b = occ_inner_at(m, w->stack[top].block);
-            v = b->value[slot];
-            flags = b->flags[slot];
-            child = b->child[slot];
-        }
+        const occ_entry_t e = occ_entry_at(m, w->stack[top].block, level, slot);
+        const occ_value_t v = e.value;
+        const uint32_t child = e.child;
+        const uint8_t flags = level == 0u ? occ_value_flags(m, v) : e.flags;
         if (!occ_is_observed(v)) {
             continue; /* nothing observed below */
         }
