@@ -191,10 +191,10 @@ static inline void dda_init(dda_t *d, const cursor_t *c, real_t res, int32_t tmv
 }
 
 
-/* The ray is in a node of level lu >= 1 that it passes through (passable or uniform): step on without
- * looking anything up while the next voxel is still in the node and (when the range is bounded)
- * entered before `safe_t`, where the centre distance test cannot fail. Same events, same order,
- * same arithmetic as stepping. */
+/* The ray is in a node of level lu >= 1 that it passes through (passable or uniform): step on
+ * without looking anything up while the next voxel is still in the node and (when the range is
+ * bounded) entered before `safe_t`, where the centre distance test cannot fail. Same events, same
+ * order, same arithmetic as stepping. */
 static inline void dda_coast(dda_t *d, uint32_t key[3], unsigned lu, bool bounded, real_t safe_t)
 {
     const uint32_t size = (uint32_t)1 << lu;

@@ -279,7 +279,8 @@ bool occ_query_next(occ_query_iter_t *it, occ_query_node_t *out)
             } else {
                 e = occ_entry_at(m, it->block[i], level, slot);
             }
-            if (take(it, mask_key(it->path, level), level, e.value, e.flags, e.child, i + 1u, out)) {
+            const occ_key_t key = mask_key(it->path, level);
+            if (take(it, key, level, e.value, e.flags, e.child, i + 1u, out)) {
                 return true;
             }
         }
