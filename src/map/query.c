@@ -15,9 +15,6 @@ void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_valu
     out->observed = occ_is_observed(v);
     out->state = occ_q_state(m, v);
     out->flags = uniform ? occ_q_uniform_flags(m, v) : flags;
-    if (!uniform && out->observed && v >= m->q_occ_min) {
-        out->flags = (uint8_t)(out->flags | OCC_NODE_HAS_OCCUPIED);
-    }
     out->logodds = out->observed ? occ_value_to_logodds(v) : 0.0f;
     out->center = occ_q_center(m, out->key, level);
     out->size_m = occ_map_node_size(m, level);
@@ -154,7 +151,7 @@ static inline void push(occ_query_iter_t *it, occ_key_t pkey, unsigned level, ui
     } else if (level == 0u) {
         pm = occ_q_leaf_match(m, occ_leaf_at(m, block), it->pred.states);
     } else {
-        pm = occ_q_inner_match(m, occ_inner_at(m, block), it->pred.states);
+        pm = occ_q_inner_match(occ_inner_at(m, block), it->pred.states);
     }
     it->block[i] = block;
     if (pm != 0u) {

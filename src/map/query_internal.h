@@ -107,10 +107,8 @@ static inline bool occ_q_finite3(occ_vec3_t v)
  * Inner blocks: the indicators say it (a uniform child's flags follow from its value, a mixed
  * child's are the OR of its children's: tree invariants), so one formula serves both kinds.
  * Branch-free: neighbouring states are random. */
-static inline unsigned occ_q_inner_match(const occ_map_t *m, const occ_inner_block_t *b,
-                                         unsigned states)
+static inline unsigned occ_q_inner_match(const occ_inner_block_t *b, unsigned states)
 {
-    (void)m;
     const unsigned wf = occ_q_has_bits(states);
 #ifdef OCC_Q_SWAR_FLAGS
     /* The 8 flag bytes at once: a byte with a wanted bit (wf < 0x10) gets its top bit, and the
