@@ -246,6 +246,50 @@ static void test_ccd_vs_analytic(void **state)
     assert_int_equal(occ_collide_convex(&map, &bad, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, &out), OCC_ERR_ARG);
 }
 
+/* Closed volumes: a face or a sphere exactly on a voxel's face touches it, a hair away does not.
+ * Hand-built: one occupied voxel [-0.25, 0)^3 at 0.25 m (everything else unknown, safe here), so
+ * that its upper faces lie on the borders of nodes of every level. */
+static void test_faces_touch(void **state)
+{
+    (void)state;
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.resolution_m = 0.25f;
+    cfg.depth_levels = 6;
+    static uint8_t small[1 << 16];
+    occ_map_t m2;
+    assert_int_equal(occ_map_init(&m2, &cfg, small, sizeof small), OCC_OK);
+    const occ_vec3_t v = {-0.1f, -0.1f, -0.1f};
+    assert_int_equal(occ_map_update(&m2, v, cfg.clamp_max), OCC_OK);
+    assert_int_equal(occ_map_state_at(&m2, v), OCC_STATE_OCCUPIED);
+    const float up = nextafterf(0.0f, 1.0f), in = -0.05f;
+    occ_collision_t c;
+    const struct {
+        occ_vec3_t mn, mx;
+        bool safe;
+    } boxes[] = {
+        {{0.0f, -0.2f, -0.2f}, {1.0f, in, in}, false}, /* lower x face on the voxel's upper */
+        {{up, -0.2f, -0.2f}, {1.0f, in, in}, true},
+        {{-1.0f, -0.2f, -0.2f}, {-0.25f, in, in}, false}, /* upper x face on its lower face */
+        {{-1.0f, -0.2f, -0.2f}, {nextafterf(-0.25f, -1.0f), in, in}, true},
+        {{-0.2f, 0.0f, 0.0f}, {in, 1.0f, 1.0f}, false}, /* along an edge */
+        {{-0.2f, 0.0f, up}, {in, 1.0f, 1.0f}, true},
+        {{0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}, false}, /* at a corner */
+        {{up, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}, true},
+    };
+    for (size_t i = 0; i < sizeof boxes / sizeof boxes[0]; i++) {
+        assert_int_equal(occ_collide_aabb(&m2, boxes[i].mn, boxes[i].mx, OCC_UNKNOWN_SAFE, &c), OCC_OK);
+        if (c.safe != boxes[i].safe) {
+            fail_msg("box %zu: safe %d, expected %d", i, c.safe, boxes[i].safe);
+        }
+    }
+    /* A sphere 0.25 m beyond the middle of the voxel's upper x face. */
+    const occ_vec3_t sc = {0.25f, -0.125f, -0.125f};
+    assert_int_equal(occ_collide_sphere(&m2, sc, 0.25f, OCC_UNKNOWN_SAFE, &c), OCC_OK);
+    assert_false(c.safe);
+    assert_int_equal(occ_collide_sphere(&m2, sc, nextafterf(0.25f, 0.0f), OCC_UNKNOWN_SAFE, &c), OCC_OK);
+    assert_true(c.safe);
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -274,6 +318,7 @@ static void test_bad_input(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_faces_touch),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_against_oracle),
         cmocka_unit_test(test_ccd_vs_analytic),

@@ -472,26 +472,28 @@ bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3]
     const float inv = 1.0f / m->cfg.resolution_m;
     const float half = (float)(1u << (m->cfg.depth_levels - 1u));
     const float top = 2.0f * half - 1.0f;
+    /* Slack for rounding, in voxels: the exact tests and this conversion work in float, whose
+     * step at the map's far corners is half * 2^-23 voxels; four of those, and a lower face on a
+     * border (bmin an integer) still takes in the voxel below, whose upper face it touches. */
+    const float eps = 4.0f * half * (1.0f / 8388608.0f) + 1e-3f;
     const float bmin[3] = {v->bmin.x, v->bmin.y, v->bmin.z};
     const float bmax[3] = {v->bmax.x, v->bmax.y, v->bmax.z};
     for (unsigned i = 0; i < 3u; i++) {
         /* Clamp first (keeps the integer conversion in range), then floor by truncation. */
-        float l = bmin[i] * inv + half;
-        float h = bmax[i] * inv + half;
-        if (!(h >= -1.0f) || !(l <= top + 1.0f)) {
+        float l = bmin[i] * inv + half - eps;
+        float h = bmax[i] * inv + half + eps;
+        if (!(h >= 0.0f) || !(l < top + 1.0f)) {
             return false;
         }
-        l = l < -1.0f ? -1.0f : l;
-        h = h > top + 1.0f ? top + 1.0f : h;
+        l = l < 0.0f ? 0.0f : l;
+        h = h > top ? top : h;
         int32_t li = (int32_t)l;
         int32_t hi_i = (int32_t)h;
         li -= (float)li > l ? 1 : 0;
         hi_i -= (float)hi_i > h ? 1 : 0;
-        li -= 1; /* one voxel of slack: faces on a border touch the next voxel, and rounding */
-        hi_i += 1;
-        lo[i] = li < 0 ? 0u : (uint32_t)li;
-        hi[i] = hi_i > (int32_t)top ? (uint32_t)top : (uint32_t)hi_i;
-        if (lo[i] > hi[i] || hi_i < 0) {
+        lo[i] = (uint32_t)li;
+        hi[i] = (uint32_t)hi_i;
+        if (lo[i] > hi[i]) {
             return false;
         }
     }
