@@ -278,8 +278,8 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
     const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
     const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
     cursor_t c;
-    cursor_init(&c, map, k0.k,
-                (uint8_t)(OCC_NODE_HAS_OCCUPIED | (ignore_unknown ? 0u : OCC_NODE_HAS_UNKNOWN)));
+    const unsigned states = OCC_PRED_OCCUPIED | (ignore_unknown ? 0u : OCC_PRED_UNKNOWN);
+    cursor_init(&c, map, k0.k, (uint8_t)occ_q_has_bits(states));
     {
         const occ_state_t s = occ_q_state(map, c.val);
         if (s == OCC_STATE_OCCUPIED) {
@@ -363,8 +363,7 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
 
 static bool blocks(const occ_map_t *map, occ_value_t v, occ_unknown_policy_t policy)
 {
-    const occ_state_t s = occ_q_state(map, v);
-    return s == OCC_STATE_OCCUPIED || (s == OCC_STATE_UNKNOWN && policy == OCC_UNKNOWN_UNSAFE);
+    return (occ_q_state_bit(occ_q_state(map, v)) & occ_q_blocking_states(policy)) != 0u;
 }
 
 occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
@@ -388,8 +387,7 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
     occ_ray_result_t scratch;
     occ_ray_result_t *const res_out = blocker != NULL ? blocker : &scratch;
-    const uint8_t stop = (uint8_t)(OCC_NODE_HAS_OCCUPIED |
-                                   (policy == OCC_UNKNOWN_UNSAFE ? OCC_NODE_HAS_UNKNOWN : 0u));
+    const uint8_t stop = (uint8_t)occ_q_has_bits(occ_q_blocking_states(policy));
     cursor_t c;
     cursor_init(&c, map, ka.k, stop);
     *visible = false;

@@ -108,8 +108,7 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
         }
         stopped = level;
         const bool uniform = child == OCC_NONE;
-        const bool wanted = uniform ? (states & occ_q_state_bit(occ_q_state(m, val))) != 0u
-                                    : occ_q_contains(flags, states);
+        const bool wanted = occ_q_node_wanted(m, val, flags, uniform, states);
         const occ_key_t nk = occ_key_at_level(key, level);
         if (!wanted ||
             !occ_volume_hits_box(v, occ_q_center(m, nk, level), occ_q_half(m, level))) {
@@ -147,8 +146,7 @@ occ_err_t occ_collide_volume(const occ_map_t *map, const occ_volume_t *vol,
         out->outside = true;
         return OCC_OK;
     }
-    const unsigned states =
-        OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u);
+    const unsigned states = occ_q_blocking_states(policy);
     if (walk(map, vol, states, &out->node)) {
         out->safe = false;
     }
@@ -197,7 +195,7 @@ occ_err_t occ_distance_to_obstacle(const occ_map_t *map, occ_vec3_t p, float max
         return OCC_ERR_ARG;
     }
     occ_pred_t pred;
-    pred.states = (uint8_t)(OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u));
+    pred.states = (uint8_t)occ_q_blocking_states(policy);
     pred.min_level = 0;
     pred.options = 0;
     occ_nearest_t it;

@@ -81,7 +81,7 @@ occ_err_t occ_collide_convex(const occ_map_t *map, const occ_convex_t *shape,
         }
     }
     occ_pred_t pred;
-    pred.states = (uint8_t)(OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u));
+    pred.states = (uint8_t)occ_q_blocking_states(policy);
     pred.min_level = 0;
     pred.options = 0;
     occ_query_iter_t it;

@@ -18,10 +18,7 @@ static float box_d2(occ_vec3_t p, occ_vec3_t c, float h)
 
 static bool matches(const occ_nearest_t *it, occ_value_t v, uint8_t flags, bool uniform)
 {
-    if (uniform) {
-        return (it->pred.states & occ_q_state_bit(occ_q_state(it->map, v))) != 0u;
-    }
-    return occ_q_contains(flags, it->pred.states);
+    return occ_q_node_wanted(it->map, v, flags, uniform, it->pred.states);
 }
 
 static occ_err_t push(occ_nearest_t *it, const occ_nearest_entry_t *e)

@@ -129,10 +129,7 @@ static occ_key_t mask_key(occ_key_t k, unsigned level)
 /* Does one node match the predicate (uniform: its state; with children: contains)? */
 static bool pred_match(const occ_query_iter_t *it, occ_value_t v, uint8_t flags, bool uniform)
 {
-    if (uniform) {
-        return (it->pred.states & occ_q_state_bit(occ_q_state(it->map, v))) != 0u;
-    }
-    return occ_q_contains(flags, it->pred.states);
+    return occ_q_node_wanted(it->map, v, flags, uniform, it->pred.states);
 }
 
 /* Push the children of the node with first voxel `pkey` (children at `level`, in stack entry i):

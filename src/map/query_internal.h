@@ -63,6 +63,21 @@ static inline bool occ_q_contains(uint8_t flags, unsigned states)
     return (flags & occ_q_has_bits(states)) != 0u;
 }
 
+/* Does a node hold a state in `states`: a node without children (voxel or uniform) by its own
+ * state, one with children by its indicators? */
+static inline bool occ_q_node_wanted(const occ_map_t *m, occ_value_t v, uint8_t flags,
+                                     bool uniform, unsigned states)
+{
+    return uniform ? (states & occ_q_state_bit(occ_q_state(m, v))) != 0u
+                   : occ_q_contains(flags, states);
+}
+
+/* The states (OCC_PRED_*) that make a volume or a line unsafe under `policy`. */
+static inline unsigned occ_q_blocking_states(occ_unknown_policy_t policy)
+{
+    return OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u);
+}
+
 /* Centre coordinate (metres) of the node at `level` whose first voxel key on an axis is `k`
  * (the same arithmetic as occ_map_key_center). */
 static inline float occ_q_center1(const occ_map_t *m, uint32_t k, unsigned level)
