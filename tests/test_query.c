@@ -402,7 +402,8 @@ static void test_nearest(void **state)
     assert_int_equal(occ_nearest_next(&it, &n, NULL, &found), OCC_ERR_NOMEM);
 }
 
-/* The cached lookup answers exactly as occ_map_state_at, for jumps and for small steps. */
+/* The cached lookup answers exactly as occ_map_state_at, for jumps and for small steps; both
+ * share their descent, so occ_map_state_at is held to occ_map_read (Morton codes, full entries). */
 static void test_lookup_cursor(void **state)
 {
     (void)state;
@@ -422,6 +423,13 @@ static void test_lookup_cursor(void **state)
             p.z += (float)qs_uniform(&rng, -0.07, 0.07);
         }
         const occ_state_t want = occ_map_state_at(&map, p);
+        occ_node_info_t info;
+        const occ_state_t read = occ_map_read(&map, p, 0u, &info) == OCC_OK ? info.state
+                                                                            : OCC_STATE_UNKNOWN;
+        if (read != want) {
+            fail_msg("lookup %u at %f,%f,%f: occ_map_read %d, occ_map_state_at %d", i,
+                     (double)p.x, (double)p.y, (double)p.z, read, want);
+        }
         const occ_state_t got = occ_lookup_state(&lk, p);
         if (got != want) {
             fail_msg("lookup %u at %f,%f,%f: cursor %d, occ_map_state_at %d", i, (double)p.x,

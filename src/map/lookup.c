@@ -1,8 +1,58 @@
 /*
- * lookup.c - point lookups with a path cache for streams of nearby points (a trajectory, a sensor
- * footprint): only the levels below the highest key bit that changed are walked again.
+ * lookup.c - point lookups: occ_map_state_at (one descent from the root) and the cursor with a
+ * path cache for streams of nearby points (a trajectory, a sensor footprint), which walks again
+ * only the levels below the highest key bit that changed.
  */
 #include "map/query_internal.h"
+
+static inline bool point_key(const occ_map_t *m, occ_vec3_t p, occ_key_t *k)
+{
+    return occ_coord_to_key(m, p.x, &k->k[0]) && occ_coord_to_key(m, p.y, &k->k[1]) &&
+           occ_coord_to_key(m, p.z, &k->k[2]);
+}
+
+static inline unsigned key_slot(const occ_key_t *k, unsigned level)
+{
+    return ((k->k[0] >> level) & 1u) | (((k->k[1] >> level) & 1u) << 1) |
+           (((k->k[2] >> level) & 1u) << 2);
+}
+
+/* Down from block `b`, whose nodes sit at level - 1, to the node without children that holds
+ * `k`: its value, and its level in *lu. Only the child index is read on the way (no value, no
+ * flags), so a level costs one dependent load. With `path`, path[L] = the block entered at L. */
+static inline occ_value_t descend(const occ_map_t *m, const occ_key_t *k, unsigned level,
+                                  uint32_t b, uint32_t *path, unsigned *lu)
+{
+    while (level > 1u) {
+        level--;
+        const occ_inner_block_t *const ib = occ_inner_at(m, b);
+        const unsigned slot = key_slot(k, level);
+        const uint32_t ch = ib->child[slot];
+        if (ch == OCC_NONE) {
+            *lu = level;
+            return ib->value[slot];
+        }
+        if (path != NULL) {
+            path[level] = ch;
+        }
+        b = ch;
+    }
+    *lu = 0u;
+    return occ_leaf_at(m, b)->value[key_slot(k, 0u)];
+}
+
+occ_state_t occ_map_state_at(const occ_map_t *const map, const occ_vec3_t p)
+{
+    occ_key_t k;
+    if (map == NULL || !point_key(map, p, &k)) {
+        return OCC_STATE_UNKNOWN;
+    }
+    if (map->root_child == OCC_NONE) {
+        return occ_q_state(map, map->root_value);
+    }
+    unsigned lu;
+    return occ_q_state(map, descend(map, &k, map->cfg.depth_levels, map->root_child, NULL, &lu));
+}
 
 void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map)
 {
@@ -13,35 +63,11 @@ void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map)
     lk->key.k[0] = lk->key.k[1] = lk->key.k[2] = 0u;
 }
 
-/* occ_map_key's arithmetic for one axis, inline (NaN and Inf fail the range test). */
-static inline bool lookup_key1(const occ_map_t *m, float c, int32_t half, uint32_t *key)
-{
-#if OCC_RAY_DOUBLE
-    const double scaled = (double)c * m->inv_res_d;
-    if (!(scaled >= -(double)half) || !(scaled < (double)half)) {
-        return false;
-    }
-    double fl = (double)(int32_t)scaled;
-    fl -= fl > scaled ? 1.0 : 0.0;
-#else
-    const float scaled = c * m->inv_res;
-    if (!(scaled >= -(float)half) || !(scaled < (float)half)) {
-        return false;
-    }
-    float fl = (float)(int32_t)scaled;
-    fl -= fl > scaled ? 1.0f : 0.0f;
-#endif
-    *key = (uint32_t)((int32_t)fl + half);
-    return true;
-}
-
 occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
 {
     const occ_map_t *const m = lk->map;
-    const int32_t half = (int32_t)1 << (m->cfg.depth_levels - 1u);
     occ_key_t k;
-    if (!lookup_key1(m, p.x, half, &k.k[0]) || !lookup_key1(m, p.y, half, &k.k[1]) ||
-        !lookup_key1(m, p.z, half, &k.k[2])) {
+    if (!point_key(m, p, &k)) {
         return OCC_STATE_UNKNOWN;
     }
     const unsigned depth = m->cfg.depth_levels;
@@ -68,21 +94,8 @@ occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
         b = m->root_child;
         lk->blk[depth] = b;
     }
-    while (level > 1u) {
-        level--;
-        const unsigned slot = ((k.k[0] >> level) & 1u) | (((k.k[1] >> level) & 1u) << 1) |
-                              (((k.k[2] >> level) & 1u) << 2);
-        const occ_inner_block_t *const ib = occ_inner_at(m, b);
-        const uint32_t ch = ib->child[slot];
-        if (ch == OCC_NONE) {
-            lk->lu = (uint8_t)level;
-            lk->val = ib->value[slot];
-            return occ_q_state(m, lk->val);
-        }
-        lk->blk[level] = ch;
-        b = ch;
-    }
-    lk->lu = 0;
-    lk->val = occ_leaf_at(m, b)->value[(k.k[0] & 1u) | ((k.k[1] & 1u) << 1) | ((k.k[2] & 1u) << 2)];
+    unsigned lu;
+    lk->val = descend(m, &k, level, b, lk->blk, &lu);
+    lk->lu = (uint8_t)lu;
     return occ_q_state(m, lk->val);
 }

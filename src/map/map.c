@@ -90,43 +90,14 @@ static bool finite_v(const occ_vec3_t p)
     return finite_f(p.x) && finite_f(p.y) && finite_f(p.z);
 }
 
-/* OctoMap's coordToKeyChecked: floor(coordinate / res) + 2^(D-1), in OctoMap's arithmetic. */
-static bool coord_to_key(const occ_map_t *const m, const float c, uint32_t *const key)
-{
-    const int32_t half = (int32_t)1 << (m->cfg.depth_levels - 1u);
-#if OCC_RAY_DOUBLE
-    const double scaled = (double)c * m->inv_res_d;
-    const double lo = -(double)half, hi = (double)half;
-    if (!(scaled >= lo) || !(scaled < hi)) {
-        return false;
-    }
-    double fl = (double)(int32_t)scaled;
-    if (fl > scaled) {
-        fl -= 1.0;
-    }
-#else
-    const float scaled = c * m->inv_res;
-    const float lo = -(float)half, hi = (float)half;
-    if (!(scaled >= lo) || !(scaled < hi)) {
-        return false;
-    }
-    float fl = (float)(int32_t)scaled;
-    if (fl > scaled) {
-        fl -= 1.0f;
-    }
-#endif
-    *key = (uint32_t)((int32_t)fl + half);
-    return true;
-}
-
 occ_err_t occ_map_key(const occ_map_t *const map, const occ_vec3_t p, occ_key_t *const key)
 {
     if (map == NULL || key == NULL || !finite_v(p)) {
         return OCC_ERR_ARG;
     }
     occ_key_t k;
-    if (!coord_to_key(map, p.x, &k.k[0]) || !coord_to_key(map, p.y, &k.k[1]) ||
-        !coord_to_key(map, p.z, &k.k[2])) {
+    if (!occ_coord_to_key(map, p.x, &k.k[0]) || !occ_coord_to_key(map, p.y, &k.k[1]) ||
+        !occ_coord_to_key(map, p.z, &k.k[2])) {
         return OCC_ERR_RANGE;
     }
     *key = k;

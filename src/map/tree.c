@@ -179,12 +179,6 @@ occ_err_t occ_map_read(const occ_map_t *const map, const occ_vec3_t p, const uns
     return e != OCC_OK ? e : occ_map_read_key(map, key, level, out);
 }
 
-occ_state_t occ_map_state_at(const occ_map_t *const map, const occ_vec3_t p)
-{
-    occ_node_info_t info;
-    return occ_map_read(map, p, 0u, &info) == OCC_OK ? info.state : OCC_STATE_UNKNOWN;
-}
-
 /* ---- batch updates ---------------------------------------------------------------------------- */
 
 /* The path of the current code: node[l] for l in [low, D]; node[D] is the root. */
