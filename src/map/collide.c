@@ -19,7 +19,7 @@ static inline unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsi
                                  uint32_t block, occ_key_t key, unsigned level)
 {
     const unsigned pm = level == 0u ? occ_q_leaf_match(m, occ_leaf_at(m, block), states)
-                                    : occ_q_inner_match(occ_inner_at(m, block), states);
+                                    : occ_q_open_inner(m, block, states);
     return pm != 0u ? pm & occ_q_touch_mask(m, v, key, level) : 0u;
 }
 

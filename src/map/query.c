@@ -148,7 +148,7 @@ static inline void push(occ_query_iter_t *it, occ_key_t pkey, unsigned level, ui
     } else if (level == 0u) {
         pm = occ_q_leaf_match(m, occ_leaf_at(m, block), it->pred.states);
     } else {
-        pm = occ_q_inner_match(occ_inner_at(m, block), it->pred.states);
+        pm = occ_q_open_inner(m, block, it->pred.states);
     }
     it->block[i] = block;
     if (pm != 0u) {

@@ -42,6 +42,13 @@ typedef struct {
     uint8_t *flags;
 } occ_nodep_t;
 
+/* A hint that a cache line will be read soon; nothing where the compiler has no such hint. */
+#if defined(__GNUC__)
+#define OCC_PREFETCH(addr) __builtin_prefetch(addr)
+#else
+#define OCC_PREFETCH(addr) ((void)(addr))
+#endif
+
 static inline occ_inner_block_t *occ_inner_at(const occ_map_t *m, uint32_t idx)
 {
     return (occ_inner_block_t *)(void *)(m->arena + m->arena_bytes -
