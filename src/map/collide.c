@@ -99,9 +99,7 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
             check = true;
             blk[level] = child;
             level--;
-            const unsigned slot = ((key.k[0] >> level) & 1u) | (((key.k[1] >> level) & 1u) << 1) |
-                                  (((key.k[2] >> level) & 1u) << 2);
-            const occ_entry_t e = occ_entry_at(m, child, level, slot);
+            const occ_entry_t e = occ_entry_at(m, child, level, occ_key_slot(&key, level));
             val = e.value;
             flags = e.flags;
             child = e.child;

@@ -11,12 +11,6 @@ static inline bool point_key(const occ_map_t *m, occ_vec3_t p, occ_key_t *k)
            occ_coord_to_key(m, p.z, &k->k[2]);
 }
 
-static inline unsigned key_slot(const occ_key_t *k, unsigned level)
-{
-    return ((k->k[0] >> level) & 1u) | (((k->k[1] >> level) & 1u) << 1) |
-           (((k->k[2] >> level) & 1u) << 2);
-}
-
 /* Down from block `b`, whose nodes sit at level - 1, to the node without children that holds
  * `k`: its value, and its level in *lu. Only the child index is read on the way (no value, no
  * flags), so a level costs one dependent load. With `path`, path[L] = the block entered at L. */
@@ -26,7 +20,7 @@ static inline occ_value_t descend(const occ_map_t *m, const occ_key_t *k, unsign
     while (level > 1u) {
         level--;
         const occ_inner_block_t *const ib = occ_inner_at(m, b);
-        const unsigned slot = key_slot(k, level);
+        const unsigned slot = occ_key_slot(k, level);
         const uint32_t ch = ib->child[slot];
         if (ch == OCC_NONE) {
             *lu = level;
@@ -38,7 +32,7 @@ static inline occ_value_t descend(const occ_map_t *m, const occ_key_t *k, unsign
         b = ch;
     }
     *lu = 0u;
-    return occ_leaf_at(m, b)->value[key_slot(k, 0u)];
+    return occ_leaf_at(m, b)->value[occ_key_slot(k, 0u)];
 }
 
 occ_state_t occ_map_state_at(const occ_map_t *const map, const occ_vec3_t p)

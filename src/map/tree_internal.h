@@ -133,6 +133,13 @@ static inline occ_entry_t occ_entry_at(const occ_map_t *m, uint32_t block, unsig
     return e;
 }
 
+/* Slot (0..7) of the child at `level` - 1 that holds key `k`: bit `level` of x, y, z. */
+static inline unsigned occ_key_slot(const occ_key_t *k, unsigned level)
+{
+    return ((k->k[0] >> level) & 1u) | (((k->k[1] >> level) & 1u) << 1) |
+           (((k->k[2] >> level) & 1u) << 2);
+}
+
 /* The lowest set bit of a non-zero child mask: the next slot in Morton order. */
 static inline unsigned occ_first_slot(unsigned mask)
 {
