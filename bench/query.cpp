@@ -486,8 +486,12 @@ static std::vector<Target> targets(const std::vector<Row> &rows)
         snprintf(buf, sizeof buf, "%.1fx (%s)", r->speedup, op);
         out.push_back({what, buf, r->speedup >= want});
     };
-    ratio("sphere r=0.25 unknown-unsafe >= 8x", "sphere r=0.25 unknown-unsafe vs octomap leaf_bbx", 8.0);
-    ratio("sphere r=0.25 unknown-unsafe >= 8x", "sphere r=0.25 unknown-unsafe vs octomap search/voxel", 8.0);
+    // Three readings of "the OctoMap way": the one that gives the same answer (search per voxel:
+    // OctoMap's leaf iterator never visits unknown space), leaf_bbx on the question it can answer
+    // (occupied only), and leaf_bbx against our unknown-unsafe check (more work on our side).
+    ratio("sphere r=0.25 unknown-unsafe >= 8x, same answer", "sphere r=0.25 unknown-unsafe vs octomap search/voxel", 8.0);
+    ratio("sphere r=0.25 >= 8x vs leaf_bbx, same question", "sphere r=0.25 occupied-only vs octomap leaf_bbx", 8.0);
+    ratio("sphere r=0.25 unknown-unsafe >= 8x vs leaf_bbx", "sphere r=0.25 unknown-unsafe vs octomap leaf_bbx", 8.0);
     ratio("ray cast >= 5x", "castRay 10 m ignoreUnknown", 5.0);
     ratio("line of sight >= 5x", "line of sight (vs castRay to b)", 5.0);
     const Row *rnd = find_row(rows, m, "point lookup random (occ_map_state_at vs search)");
