@@ -460,7 +460,6 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
     free(arena);
 }
 
-
 // Issue 5's targets, judged on geb079.bt as the issue sets them. The ratios come from this run.
 // The 30 ns lookup is an absolute figure set on a machine where OctoMap's search took 250-350 ns,
 // so it is also given at that machine's speed: our time scaled by (250..350) / OctoMap's search
