@@ -385,12 +385,19 @@ static void test_nearest(void **state)
             assert_true(od2 < 0);
         }
         /* Bounded: nothing beyond max distance. */
-        bool f2 = false;
-        float dd = 0;
+        occ_obstacle_t res = OCC_OBSTACLE_UNDECIDED;
+        float dd = -1.f;
         assert_int_equal(occ_distance_to_obstacle(&map, pf, 0.3f,
                                                   t % 2u ? OCC_UNKNOWN_SAFE : OCC_UNKNOWN_UNSAFE,
-                                                  buf, 4096, &dd, &f2), OCC_OK);
+                                                  buf, 4096, &dd, &res), OCC_OK);
+        assert_true(res == OCC_OBSTACLE_FOUND || res == OCC_OBSTACLE_NONE);
+        const bool f2 = res == OCC_OBSTACLE_FOUND;
         assert_true(f2 == (od2 >= 0 && sqrt(od2) <= 0.3 + 1e-5) || fabs(sqrt(od2) - 0.3) < 1e-4);
+        if (f2) { /* the same distance as the nearest-first walk with the same predicate */
+            assert_true(fabs((double)dd - sqrt(od2)) < 1e-4);
+        } else {
+            assert_true(!(dd < 0.3f) && !(dd > 0.3f)); /* max_dist: nothing nearer */
+        }
     }
     /* A buffer of 1 overflows at the first expansion. */
     occ_nearest_t it;

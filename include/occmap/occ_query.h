@@ -114,7 +114,8 @@ typedef struct {
     float size_m;        /* edge */
 } occ_query_node_t;
 
-/* The iterator: caller-owned, fixed-size (no heap), valid while `map` and `vol` are unchanged.
+/* The iterator: caller-owned, fixed-size (no heap), valid while `map` and `vol` are unchanged
+ * (a write to the map is detected: see occ_query_status).
  * Visits nodes depth first in Morton order (children 0..7), so reported nodes come sorted by
  * Morton code of their first voxel. It does not start at the root: the volume's bounds fall in
  * at most 2x2x2 nodes of the smallest level that can hold them, and the walk starts at those
@@ -134,14 +135,20 @@ typedef struct {
     occ_key_t start[8];    /* the start nodes, in Morton order */
     uint32_t block[OCC_MAX_DEPTH]; /* block[D-L]: child block of the path node at level L */
     uint8_t mask[OCC_MAX_DEPTH];  /* children of block[i] still to visit (match and touch) */
+    uint32_t gen;          /* map->write_gen at occ_query_begin() */
 } occ_query_iter_t;
 
 /* Start iterating the nodes of `map` that intersect `vol` and match `pred`. OCC_ERR_ARG for
  * NULL, bad states bits, min_level > depth_levels. O(1). */
 occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_volume_t *vol,
                           occ_pred_t pred);
-/* Next node; false when done. Amortized O(depth) per node touched. */
+/* Next node; false when done. Amortized O(depth) per node touched. Also false, without reading
+ * the tree, when the map was written (or cleared) since occ_query_begin(): a caller that draws a
+ * safety answer from the nodes seen must then check occ_query_status(). */
 bool occ_query_next(occ_query_iter_t *it, occ_query_node_t *out);
+/* OCC_OK while the iterator is valid, OCC_ERR_STATE once the map was written since
+ * occ_query_begin() (the nodes reported may then be incomplete), OCC_ERR_ARG for NULL. O(1). */
+occ_err_t occ_query_status(const occ_query_iter_t *it);
 
 /* Voxels (level 0) of the map inside `vol`, by state. Whole nodes inside the volume count
  * 8^level voxels without being split. `outside` is true when the volume reaches beyond the map. */
@@ -155,7 +162,8 @@ occ_err_t occ_query_count(const occ_map_t *map, const occ_volume_t *vol, occ_que
  * For streams of nearby points (a trajectory, a sensor footprint): the cursor keeps the path of
  * the last voxel and re-descends only below the highest key bit that changed, so a lookup next to
  * the previous one touches one or two blocks instead of depth_levels. Caller-owned, no heap;
- * valid while the map is not modified (re-init after any write). */
+ * valid while the map is not modified (re-init after any write: a write or occ_map_clear() is
+ * detected through occ_map_t.write_gen, and the cursor then answers UNKNOWN). */
 typedef struct {
     const occ_map_t *map;
     occ_key_t key;        /* last voxel looked up */
@@ -163,13 +171,22 @@ typedef struct {
     bool valid;
     occ_value_t val;
     uint32_t blk[OCC_MAX_DEPTH + 1u]; /* blk[L]: child block of the path node at level L > lu */
+    uint32_t gen;         /* map->write_gen at occ_lookup_init() */
 } occ_lookup_t;
 
 /* Start a cursor on `map`. O(1). */
 void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map);
 /* State of the voxel at `p`: exactly occ_map_state_at(map, p) (UNKNOWN for NaN or off-map).
+ * UNKNOWN, without reading the tree, when the map was written (or cleared) since
+ * occ_lookup_init() (occ_lookup_status() then says OCC_ERR_STATE) or lk is NULL.
  * O(levels below the highest key bit that differs from the previous lookup). */
 occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p);
+/* Same answer, with its error: OCC_OK, OCC_ERR_STATE (stale cursor), OCC_ERR_ARG (NULL, NaN or
+ * Inf), OCC_ERR_RANGE (off the map); *state (when non-NULL) is UNKNOWN on every error. */
+occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state);
+/* OCC_OK while the cursor is valid, OCC_ERR_STATE once the map was written since
+ * occ_lookup_init(), OCC_ERR_ARG for NULL. O(1). */
+occ_err_t occ_lookup_status(const occ_lookup_t *lk);
 
 /* ---- Nearest-first iteration -------------------------------------------------------------------- */
 typedef struct {
@@ -188,6 +205,7 @@ typedef struct {
     occ_pred_t pred;
     occ_nearest_entry_t *heap; /* caller buffer: a binary min-heap on dist2 */
     size_t cap, n;
+    uint32_t gen;              /* map->write_gen at occ_nearest_begin() */
 } occ_nearest_t;
 
 /* Start a nearest-first search from `p` over nodes within `max_dist_m` (>= 0) that match `pred`
@@ -198,7 +216,9 @@ occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t 
                             float max_dist_m, occ_pred_t pred, occ_nearest_entry_t *buf,
                             size_t cap);
 /* Next node by increasing distance (ties in any order): *found false when none is left.
- * OCC_ERR_NOMEM when `buf` overflowed (the search stops; results so far were exact).
+ * OCC_ERR_NOMEM when `buf` overflowed (the search stops; results so far were exact);
+ * OCC_ERR_STATE when the map was written (or cleared) since occ_nearest_begin() (nothing is
+ * read from the tree); *found is false on every error.
  * O(log cap) per heap operation. `dist_m` (may be NULL) gets the point-to-cube distance. */
 occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist_m, bool *found);
 
@@ -208,10 +228,13 @@ typedef enum {
     OCC_UNKNOWN_SAFE = 1    /* unknown counts as free */
 } occ_unknown_policy_t;
 
+/* Every collision check below sets `safe` false (and `outside` false) on entry, before any
+ * argument check when `out` is non-NULL, so that a caller ignoring an error reads "unsafe". */
 typedef struct {
     bool safe;             /* no blocking node intersects the volume */
     bool outside;          /* blocked (policy unsafe) because the volume leaves the map */
-    occ_query_node_t node; /* first blocking node in Morton order when !safe && !outside */
+    occ_query_node_t node; /* first blocking node in Morton order when !safe && !outside and the
+                            * call returned OCC_OK; an unobserved, UNKNOWN node on error */
 } occ_collision_t;
 
 /* Is the volume free of OCCUPIED voxels (and of UNKNOWN ones and off-map space under
@@ -229,11 +252,24 @@ occ_err_t occ_collide_obb(const occ_map_t *map, occ_vec3_t center, const float h
 /* A sphere of radius_m swept from a to b. */
 occ_err_t occ_collide_capsule(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b, float radius_m,
                               occ_unknown_policy_t policy, occ_collision_t *out);
-/* Distance from p to the nearest blocking node (policy as above, off-map space excluded),
- * searched up to max_dist_m: *found false when none is that close. Buffer as occ_nearest_begin. */
+/* The three answers of occ_distance_to_obstacle. */
+typedef enum {
+    OCC_OBSTACLE_UNDECIDED = 0, /* the search failed (see the error code): treat as an obstacle
+                                 * at distance 0, never as clear */
+    OCC_OBSTACLE_FOUND = 1,     /* *dist_m is the distance to the nearest blocking node */
+    OCC_OBSTACLE_NONE = 2       /* nothing blocks within max_dist_m (*dist_m = max_dist_m) */
+} occ_obstacle_t;
+
+/* Distance from p (metres, map frame) to the nearest blocking node (policy as above, off-map
+ * space excluded), searched up to max_dist_m (>= 0). *result says which of the three answers
+ * holds. On every error *result is OCC_OBSTACLE_UNDECIDED and *dist_m is 0 (for each that is
+ * non-NULL): OCC_ERR_ARG (NULL, NaN/Inf, negative distance, cap 0, bad policy), OCC_ERR_NOMEM
+ * when `buf` (cap entries, as occ_nearest_begin) cannot hold the search: nothing nearer than the
+ * nodes searched so far blocks, but what lies beyond is not known. No writes; O(nodes opened *
+ * log cap). */
 occ_err_t occ_distance_to_obstacle(const occ_map_t *map, occ_vec3_t p, float max_dist_m,
                                    occ_unknown_policy_t policy, occ_nearest_entry_t *buf,
-                                   size_t cap, float *dist_m, bool *found);
+                                   size_t cap, float *dist_m, occ_obstacle_t *result);
 
 /* ---- Ray casts ---------------------------------------------------------------------------------- */
 typedef enum {
@@ -282,7 +318,8 @@ typedef struct {
 
 /* Information gain of a sensor volume (typically a frustum or a sphere; any kind works) at cells
  * of `level` (0 = voxels). A cell's state is the state of its max value, as occ_map_read_key.
- * Cells outside the map are not counted. OCC_ERR_ARG for NULL, level > depth_levels, bad options.
+ * Cells outside the map are not counted. OCC_ERR_ARG for NULL, level > depth_levels, bad options;
+ * on every error `out` (when non-NULL) reads 0 cells and 0 bits (nothing to gain there).
  * O(cells reported) (with OCC_GAIN_OCCLUSION times the ray length in voxels). */
 occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned level,
                         unsigned options, occ_info_gain_t *out);

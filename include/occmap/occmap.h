@@ -170,6 +170,12 @@ typedef struct {
     uint32_t root_child;
     occ_value_t root_value;
     uint8_t root_flags;
+    /* Write generation: +1 (mod 2^32) on every call that may change the tree (update, observe,
+     * insert and integrate, set, forget, evict, clear, read into the map). Handles that keep
+     * block indices between calls (occ_lookup_t, occ_query_iter_t, occ_nearest_t, occ_walk_t,
+     * occ_node_t) record it when made and answer OCC_ERR_STATE once it moved. occ_map_init()
+     * starts it at 0: handles taken before a re-init of the same struct are not detected. */
+    uint32_t write_gen;
 } occ_map_t;
 
 /* Initialize `map` on the caller's arena (any alignment; the map uses the aligned part).
@@ -183,18 +189,21 @@ occ_err_t occ_map_init(occ_map_t *map, const occ_map_config_t *cfg, void *arena,
                        size_t arena_bytes);
 
 /* Forget all content: every voxel is unobserved again, pools empty, peaks and oom_count reset.
- * O(1). */
+ * Bumps write_gen (handles on the old content answer OCC_ERR_STATE). O(1). */
 void occ_map_clear(occ_map_t *map);
 
 /* ---- Coordinates and keys --------------------------------------------------------------------- */
 /* Voxel key of a point. OCC_ERR_ARG for NaN/Inf, OCC_ERR_RANGE outside the map volume
  * [-2^(D-1) res, 2^(D-1) res) per axis. */
 occ_err_t occ_map_key(const occ_map_t *map, occ_vec3_t p, occ_key_t *key);
-/* Centre (metres) of the node at `level` that contains voxel `key`. */
+/* Centre (metres) of the node at `level` that contains voxel `key`. A level above depth_levels
+ * saturates to depth_levels: the root's centre, the map origin (0, 0, 0). */
 occ_vec3_t occ_map_key_center(const occ_map_t *map, occ_key_t key, unsigned level);
-/* Edge length (metres) of a node at `level`: resolution * 2^level. */
+/* Edge length (metres) of a node at `level`: resolution * 2^level. A level above depth_levels
+ * saturates to depth_levels (the root's edge, the whole map); NULL map: 0. */
 float occ_map_node_size(const occ_map_t *map, unsigned level);
-/* The key with its lowest `level` bits cleared: the first voxel of the level-`level` node. */
+/* The key with its lowest `level` bits cleared: the first voxel of the level-`level` node.
+ * Any level is valid: 32 and above clear every bit (key 0, 0, 0). */
 occ_key_t occ_key_at_level(occ_key_t key, unsigned level);
 
 /* ---- Reading ----------------------------------------------------------------------------------- */
@@ -308,18 +317,26 @@ typedef struct {
     struct { uint32_t block; uint8_t level; uint8_t next; } stack[OCC_MAX_DEPTH + 1];
     bool started;
     bool pushed;  /* the node last returned pushed its children's frame */
+    uint32_t gen; /* map->write_gen at occ_walk_begin() */
 } occ_walk_t;
 
-/* Start a walk over the observed nodes (unobserved subtrees are never reported). */
+/* Start a walk over the observed nodes (unobserved subtrees are never reported). The walk is
+ * valid until the next write to the map (see occ_map_t.write_gen). */
 void occ_walk_begin(occ_walk_t *w, const occ_map_t *map);
-/* Next node, true while there is one. Complexity O(1) amortized per node. */
+/* Next node, true while there is one. Complexity O(1) amortized per node. False without
+ * reading the tree when the map was written (or cleared) since occ_walk_begin():
+ * occ_walk_status() then says OCC_ERR_STATE. */
 bool occ_walk_next(occ_walk_t *w, occ_walk_node_t *node);
+/* OCC_OK while the walk is valid, OCC_ERR_STATE once the map was written since
+ * occ_walk_begin() (a walk that ended early for that reason did not visit every node),
+ * OCC_ERR_ARG for NULL. O(1). */
+occ_err_t occ_walk_status(const occ_walk_t *w);
 /* Do not descend into the children of the node last returned. */
 void occ_walk_skip_children(occ_walk_t *w);
 
 /* ---- Top-down node access (for walkers that pick their own order: sector scans, custom queries) --
  * A node handle holds what a reader needs and where its children are; it stays valid until the
- * next write to the map. Each call reads one block: O(1). */
+ * next write to the map (it records occ_map_t.write_gen). Each call reads one block: O(1). */
 typedef struct {
     occ_key_t key;      /* first voxel of the node (lowest `level` bits clear) */
     uint8_t level;      /* 0 = voxel */
@@ -328,13 +345,16 @@ typedef struct {
     occ_state_t state;  /* state of the node's value (the max below) */
     float logodds;      /* max of observed voxels below (0 when unobserved) */
     uint32_t children;  /* internal: the child block, OCC_NONE when uniform */
+    uint32_t gen;       /* internal: map->write_gen when the handle was made */
 } occ_node_t;
 
 /* The root (level depth_levels). */
 void occ_map_node_root(const occ_map_t *map, occ_node_t *out);
 /* Child `slot` (0..7: bit 0 = +x half, bit 1 = +y, bit 2 = +z) of `parent`. A uniform parent's
- * children are reported with the parent's value (as if expanded). OCC_ERR_ARG for level 0 or a
- * slot > 7. */
+ * children are reported with the parent's value (as if expanded). OCC_ERR_ARG for NULL, level 0
+ * or a slot > 7; OCC_ERR_STATE when the map was written (or cleared) since `parent` was made:
+ * nothing is read from the tree and `out` (when non-NULL) gets an unobserved, UNKNOWN node
+ * without children, still stale. */
 occ_err_t occ_map_node_child(const occ_map_t *map, const occ_node_t *parent, unsigned slot,
                              occ_node_t *out);
 

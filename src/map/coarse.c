@@ -112,6 +112,9 @@ size_t occ_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, const
                         const unsigned level, const occ_value_t delta)
 {
     const unsigned depth = m->cfg.depth_levels;
+    if (n > 0u) {
+        m->write_gen++; /* the coarse pass writes the tree directly: handles on it are stale */
+    }
     /* blk[l]: the block holding the path's node at level l (OCC_NONE: the root). Sorted codes
      * share the path above their split; nodes below it are finished and refreshed (and maybe
      * pruned) before the next code descends, as the core's batch update does. */

@@ -123,6 +123,20 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
     return false;
 }
 
+void occ_q_collision_unsafe(occ_collision_t *out)
+{
+    if (out == NULL) {
+        return;
+    }
+    memset(out, 0, sizeof *out);
+    out->safe = false;
+    out->outside = false;
+    out->node.uniform = true;
+    out->node.observed = false;
+    out->node.state = OCC_STATE_UNKNOWN;
+    out->node.flags = (uint8_t)(OCC_NODE_HAS_UNKNOWN | OCC_NODE_UNIFORM);
+}
+
 static bool leaves_map(const occ_map_t *map, const occ_volume_t *vol)
 {
     const float half = occ_map_node_size(map, map->cfg.depth_levels) * 0.5f;
@@ -133,21 +147,17 @@ static bool leaves_map(const occ_map_t *map, const occ_volume_t *vol)
 occ_err_t occ_collide_volume(const occ_map_t *map, const occ_volume_t *vol,
                              occ_unknown_policy_t policy, occ_collision_t *out)
 {
+    occ_q_collision_unsafe(out); /* until the walk proves otherwise */
     if (map == NULL || vol == NULL || out == NULL ||
         (policy != OCC_UNKNOWN_UNSAFE && policy != OCC_UNKNOWN_SAFE)) {
         return OCC_ERR_ARG;
     }
-    out->safe = true;
-    out->outside = false;
     if (policy == OCC_UNKNOWN_UNSAFE && leaves_map(map, vol)) {
-        out->safe = false;
         out->outside = true;
         return OCC_OK;
     }
     const unsigned states = occ_q_blocking_states(policy);
-    if (walk(map, vol, states, &out->node)) {
-        out->safe = false;
-    }
+    out->safe = !walk(map, vol, states, &out->node);
     return OCC_OK;
 }
 
@@ -155,6 +165,7 @@ occ_err_t occ_collide_sphere(const occ_map_t *map, occ_vec3_t center, float radi
                              occ_unknown_policy_t policy, occ_collision_t *out)
 {
     occ_volume_t v;
+    occ_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_sphere(&v, center, radius_m);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }
@@ -163,6 +174,7 @@ occ_err_t occ_collide_aabb(const occ_map_t *map, occ_vec3_t min, occ_vec3_t max,
                            occ_unknown_policy_t policy, occ_collision_t *out)
 {
     occ_volume_t v;
+    occ_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_aabb(&v, min, max);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }
@@ -172,6 +184,7 @@ occ_err_t occ_collide_obb(const occ_map_t *map, occ_vec3_t center, const float h
                           occ_collision_t *out)
 {
     occ_volume_t v;
+    occ_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_obb(&v, center, half_m, axes);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }
@@ -180,15 +193,23 @@ occ_err_t occ_collide_capsule(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b, 
                               occ_unknown_policy_t policy, occ_collision_t *out)
 {
     occ_volume_t v;
+    occ_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_capsule(&v, a, b, radius_m);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }
 
 occ_err_t occ_distance_to_obstacle(const occ_map_t *map, occ_vec3_t p, float max_dist_m,
                                    occ_unknown_policy_t policy, occ_nearest_entry_t *buf,
-                                   size_t cap, float *dist_m, bool *found)
+                                   size_t cap, float *dist_m, occ_obstacle_t *result)
 {
-    if (dist_m == NULL || found == NULL ||
+    /* Undecided (an obstacle right here) until the search decides. */
+    if (dist_m != NULL) {
+        *dist_m = 0.0f;
+    }
+    if (result != NULL) {
+        *result = OCC_OBSTACLE_UNDECIDED;
+    }
+    if (dist_m == NULL || result == NULL ||
         (policy != OCC_UNKNOWN_UNSAFE && policy != OCC_UNKNOWN_SAFE)) {
         return OCC_ERR_ARG;
     }
@@ -202,7 +223,13 @@ occ_err_t occ_distance_to_obstacle(const occ_map_t *map, occ_vec3_t p, float max
         return e;
     }
     occ_query_node_t node;
-    *found = false;
-    e = occ_nearest_next(&it, &node, dist_m, found);
-    return e;
+    bool found = false;
+    float dist = 0.0f;
+    e = occ_nearest_next(&it, &node, &dist, &found);
+    if (e != OCC_OK) {
+        return e; /* heap overflow: what lies beyond the nodes searched is not known */
+    }
+    *dist_m = found ? dist : max_dist_m;
+    *result = found ? OCC_OBSTACLE_FOUND : OCC_OBSTACLE_NONE;
+    return OCC_OK;
 }

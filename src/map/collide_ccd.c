@@ -47,6 +47,7 @@ occ_err_t occ_collide_convex(const occ_map_t *map, const occ_convex_t *shape,
                              occ_unknown_policy_t policy, occ_ccd_algo_t algo,
                              occ_collision_t *out)
 {
+    occ_q_collision_unsafe(out); /* until the walk proves otherwise */
     if (map == NULL || shape == NULL || out == NULL || shape->support == NULL ||
         !occ_q_finite3(shape->center) || (policy != OCC_UNKNOWN_UNSAFE && policy != OCC_UNKNOWN_SAFE) ||
         (algo != OCC_CCD_GJK && algo != OCC_CCD_MPR)) {
@@ -57,8 +58,6 @@ occ_err_t occ_collide_convex(const occ_map_t *map, const occ_convex_t *shape,
     if (e != OCC_OK) {
         return e;
     }
-    out->safe = true;
-    out->outside = false;
     const float half = occ_map_node_size(map, map->cfg.depth_levels) * 0.5f;
     if (policy == OCC_UNKNOWN_UNSAFE &&
         (box.bmin.x < -half || box.bmin.y < -half || box.bmin.z < -half ||
@@ -74,7 +73,6 @@ occ_err_t occ_collide_convex(const occ_map_t *map, const occ_convex_t *shape,
             shape->support(shape->shape, &d, &p);
             if (p.x < -half || p.y < -half || p.z < -half || p.x >= half || p.y >= half ||
                 p.z >= half) {
-                out->safe = false;
                 out->outside = true;
                 return OCC_OK;
             }
@@ -104,10 +102,13 @@ occ_err_t occ_collide_convex(const occ_map_t *map, const occ_convex_t *shape,
         const int hit = algo == OCC_CCD_GJK ? ccdGJKIntersect(shape, &cube, &ccd)
                                             : ccdMPRIntersect(shape, &cube, &ccd);
         if (hit) {
-            out->safe = false;
             out->node = n;
             return OCC_OK;
         }
     }
+    if (occ_query_status(&it) != OCC_OK) {
+        return OCC_ERR_STATE; /* the support function wrote the map: the walk did not finish */
+    }
+    out->safe = true; /* every blocking node in the box was tested against the shape */
     return OCC_OK;
 }

@@ -500,6 +500,9 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
             settle(&x);
         }
     }
+    if (x.evictions != 0u) {
+        map->write_gen++; /* collapses are this path's only writes: handles on the map are stale */
+    }
     cur->phase = sweep_on ? PHASE_RESUME : PHASE_IDLE;
     const uint32_t freed_inner = inner_before - map->inner.used;
     const uint32_t freed_leaf = leaf_before - map->leaf.used;

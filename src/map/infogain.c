@@ -59,6 +59,10 @@ static bool visible(const occ_map_t *m, occ_vec3_t from, occ_key_t cell, unsigne
 occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned level,
                         unsigned options, occ_info_gain_t *out)
 {
+    if (out != NULL) { /* on any error: nothing to gain, never a stale count */
+        out->unknown_cells = 0u;
+        out->entropy_bits = 0.0f;
+    }
     if (map == NULL || vol == NULL || out == NULL || level > map->cfg.depth_levels ||
         (options & ~OCC_GAIN_OCCLUSION) != 0u) {
         return OCC_ERR_ARG;
@@ -74,8 +78,6 @@ occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned 
     }
     const bool occl = (options & OCC_GAIN_OCCLUSION) != 0u;
     const occ_vec3_t from = sensor_origin(vol);
-    out->unknown_cells = 0u;
-    out->entropy_bits = 0.0f;
     occ_query_node_t n;
     while (occ_query_next(&it, &n)) {
         if (n.state != OCC_STATE_UNKNOWN) {

@@ -55,15 +55,21 @@ void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map)
     lk->lu = 0;
     lk->val = OCC_VALUE_UNOBSERVED;
     lk->key.k[0] = lk->key.k[1] = lk->key.k[2] = 0u;
+    lk->gen = map != NULL ? map->write_gen : 0u;
 }
 
-occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
+occ_err_t occ_lookup_status(const occ_lookup_t *const lk)
+{
+    if (lk == NULL || lk->map == NULL) {
+        return OCC_ERR_ARG;
+    }
+    return lk->gen == lk->map->write_gen ? OCC_OK : OCC_ERR_STATE;
+}
+
+/* The cursor's answer for a valid cursor and a point on the map (key k). */
+static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
 {
     const occ_map_t *const m = lk->map;
-    occ_key_t k;
-    if (!point_key(m, p, &k)) {
-        return OCC_STATE_UNKNOWN;
-    }
     const unsigned depth = m->cfg.depth_levels;
     unsigned level;
     uint32_t b;
@@ -92,4 +98,29 @@ occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
     lk->val = descend(m, &k, level, b, lk->blk, &lu);
     lk->lu = (uint8_t)lu;
     return occ_q_state(m, lk->val);
+}
+
+occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
+{
+    occ_state_t s = OCC_STATE_UNKNOWN;
+    occ_err_t e = occ_lookup_status(lk);
+    if (e == OCC_OK) {
+        occ_key_t k;
+        if (point_key(lk->map, p, &k)) {
+            s = cached_state(lk, k);
+        } else {
+            e = occ_q_finite3(p) ? OCC_ERR_RANGE : OCC_ERR_ARG;
+        }
+    }
+    if (state != NULL) {
+        *state = s;
+    }
+    return e;
+}
+
+occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
+{
+    occ_state_t s;
+    (void)occ_lookup_read(lk, p, &s); /* every error answers UNKNOWN */
+    return s;
 }

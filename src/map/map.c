@@ -67,6 +67,7 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
     map->arena = (uint8_t *)start;
     map->arena_bytes = bytes - bytes % OCC_ARENA_ALIGN;
     map->block_budget = (uint32_t)(map->arena_bytes / OCC_LEAF_BLOCK_BYTES);
+    map->write_gen = 0u; /* occ_map_clear() makes it 1 */
     occ_map_clear(map);
     return OCC_OK;
 }
@@ -83,6 +84,7 @@ void occ_map_clear(occ_map_t *const map)
     map->root_child = OCC_NONE;
     map->root_value = OCC_VALUE_UNOBSERVED;
     map->root_flags = (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    map->write_gen++; /* every handle on the old content is stale */
 }
 
 static bool finite_v(const occ_vec3_t p)
@@ -113,13 +115,23 @@ occ_key_t occ_key_at_level(occ_key_t key, const unsigned level)
     return key;
 }
 
+/* Levels above the root saturate to the root's: no shift by a caller value reaches 32. */
+static unsigned node_level(const occ_map_t *const map, const unsigned level)
+{
+    return level > map->cfg.depth_levels ? map->cfg.depth_levels : level;
+}
+
 float occ_map_node_size(const occ_map_t *const map, const unsigned level)
 {
-    return map->cfg.resolution_m * (float)((uint32_t)1 << level);
+    if (map == NULL) {
+        return 0.0f;
+    }
+    return map->cfg.resolution_m * (float)((uint32_t)1 << node_level(map, level));
 }
 
 occ_vec3_t occ_map_key_center(const occ_map_t *const map, const occ_key_t key, const unsigned level)
 {
+    /* Above depth_levels both the key mask and occ_map_node_size saturate: the root's centre. */
     const occ_key_t base = occ_key_at_level(key, level);
     const int32_t half = (int32_t)1 << (map->cfg.depth_levels - 1u);
     const float res = map->cfg.resolution_m;

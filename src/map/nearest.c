@@ -82,6 +82,7 @@ occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t 
     it->heap = buf;
     it->cap = cap;
     it->n = 0;
+    it->gen = map->write_gen;
     occ_nearest_entry_t e;
     e.key.k[0] = e.key.k[1] = e.key.k[2] = 0u;
     e.level = map->cfg.depth_levels;
@@ -99,11 +100,17 @@ occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t 
 
 occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist_m, bool *found)
 {
+    if (found != NULL) {
+        *found = false;
+    }
     if (it == NULL || out == NULL || found == NULL) {
         return OCC_ERR_ARG;
     }
     const occ_map_t *const m = it->map;
-    *found = false;
+    if (it->gen != m->write_gen) { /* the heap's child indices may name freed or reused blocks */
+        it->n = 0;
+        return OCC_ERR_STATE;
+    }
     while (it->n > 0u) {
         occ_nearest_entry_t top;
         pop(it, &top);

@@ -16,14 +16,38 @@ void occ_map_node_root(const occ_map_t *const map, occ_node_t *const out)
     const occ_key_t zero = {{0u, 0u, 0u}};
     out->key = zero;
     out->level = map->cfg.depth_levels;
+    out->gen = map->write_gen;
     fill(map, out, map->root_value, map->root_flags, map->root_child);
+}
+
+/* What a failed child call leaves: nothing observed, no children to follow. */
+static void fill_unknown(occ_node_t *const out, const occ_key_t key, const unsigned level,
+                         const uint32_t gen)
+{
+    out->key = key;
+    out->level = (uint8_t)level;
+    out->observed = false;
+    out->flags = (uint8_t)(OCC_NODE_HAS_UNKNOWN | OCC_NODE_UNIFORM);
+    out->state = OCC_STATE_UNKNOWN;
+    out->logodds = 0.0f;
+    out->children = OCC_NONE;
+    out->gen = gen;
 }
 
 occ_err_t occ_map_node_child(const occ_map_t *const map, const occ_node_t *const parent,
                              const unsigned slot, occ_node_t *const out)
 {
     if (map == NULL || parent == NULL || out == NULL || parent->level == 0u || slot > 7u) {
+        if (out != NULL) {
+            const occ_key_t zero = {{0u, 0u, 0u}};
+            fill_unknown(out, zero, 0u, map != NULL ? map->write_gen - 1u : 0u);
+        }
         return OCC_ERR_ARG;
+    }
+    if (parent->gen != map->write_gen) { /* its child index may name a freed or reused block */
+        const occ_node_t stale = *parent; /* out may alias parent */
+        fill_unknown(out, stale.key, stale.level, stale.gen);
+        return OCC_ERR_STATE;
     }
     const unsigned level = parent->level - 1u;
     occ_key_t key = parent->key;

@@ -111,6 +111,7 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
     it->virt_value = OCC_VALUE_UNOBSERVED;
     it->path.k[0] = it->path.k[1] = it->path.k[2] = 0u;
     it->istart = 0;
+    it->gen = map->write_gen;
     unsigned lc = depth;
     it->nstart = (uint8_t)occ_q_start_cells(map, vol, pred.min_level, it->start, &lc);
     it->start_level = (uint8_t)lc;
@@ -243,8 +244,19 @@ static bool next_start(occ_query_iter_t *it, occ_query_node_t *out)
     return enter(it, it->path, level, v, flags, child, depth - level, out);
 }
 
+occ_err_t occ_query_status(const occ_query_iter_t *it)
+{
+    if (it == NULL || it->map == NULL) {
+        return OCC_ERR_ARG;
+    }
+    return it->gen == it->map->write_gen ? OCC_OK : OCC_ERR_STATE;
+}
+
 bool occ_query_next(occ_query_iter_t *it, occ_query_node_t *out)
 {
+    if (occ_query_status(it) != OCC_OK) {
+        return false; /* the stacked block indices may name freed or reused blocks */
+    }
     const occ_map_t *const m = it->map;
     const unsigned depth = m->cfg.depth_levels;
     for (;;) {

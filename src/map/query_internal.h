@@ -254,6 +254,10 @@ static inline unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *
 unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
                            occ_key_t start[8], unsigned *level);
 
+/* collide.c: the answer of a collision check that has not decided yet or failed: not safe,
+ * not outside, an unobserved UNKNOWN node. Every collision entry point starts with it. */
+void occ_q_collision_unsafe(occ_collision_t *out);
+
 /* Fill a reported node. */
 void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
                      uint8_t flags, bool uniform, occ_query_node_t *out);

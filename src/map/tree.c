@@ -360,6 +360,7 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
             return OCC_ERR_NOMEM;
         }
     }
+    m->write_gen++; /* every update path writes here: handles on the old tree are stale */
     path_t p;
     const unsigned depth = m->cfg.depth_levels;
     for (unsigned l = 0; l <= depth + 1u; l++) {
@@ -529,6 +530,7 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
             leaf = occ_leaf_at(m, *p.node[1].child);
         }
     }
+    m->write_gen++; /* set and forget write from here (the expansion above, too) */
     unsigned first_dirty;
     if (level == 0u) {
         leaf->value[occ_code_slot(code, 1u)] = v;

@@ -7,6 +7,15 @@ void occ_walk_begin(occ_walk_t *const w, const occ_map_t *const map)
     w->sp = 0u;
     w->started = false;
     w->pushed = false;
+    w->gen = map != NULL ? map->write_gen : 0u;
+}
+
+occ_err_t occ_walk_status(const occ_walk_t *const w)
+{
+    if (w == NULL || w->map == NULL) {
+        return OCC_ERR_ARG;
+    }
+    return w->gen == w->map->write_gen ? OCC_OK : OCC_ERR_STATE;
 }
 
 /* The code of child `slot` at `level` under the node whose code is `code`: the bits of the
@@ -30,6 +39,10 @@ bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
 {
     const occ_map_t *const m = w->map;
     w->pushed = false;
+    if (occ_walk_status(w) != OCC_OK) {
+        w->sp = 0u; /* the stacked block indices may name freed or reused blocks */
+        return false;
+    }
     if (!w->started) {
         w->started = true;
         if (!occ_is_observed(m->root_value)) {
