@@ -1,4 +1,5 @@
-/* cmd_query.c - occmap query: collision checks and ray casts on a map file, one query or a batch. */
+/* cmd_query.c - occmap query: collision checks, ray casts and obstacle distances on a map file,
+ * one query or a batch. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,22 +8,29 @@
 #include "cli.h"
 #include "occmap/occ_file.h"
 
+#define DEFAULT_HEAP 65536u /* --distance: nearest-search heap entries */
+
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: occmap query MAP (--sphere x,y,z,r | --aabb x0,y0,z0,x1,y1,z1 |\n"
-            "                         --capsule x0,y0,z0,x1,y1,z1,r | --ray x,y,z,dx,dy,dz,max_m)\n"
+            "                         --capsule x0,y0,z0,x1,y1,z1,r | --ray x,y,z,dx,dy,dz,max_m |\n"
+            "                         --distance x,y,z,max_m [--heap N])\n"
             "                        [--unknown safe|unsafe] [--json]\n"
             "       occmap query MAP --batch FILE --json   (one query per line, same syntax)\n"
             "Answers whether the volume is free of occupied voxels (and of unknown ones with\n"
             "--unknown unsafe, the default), with counts of occupied and unknown voxels inside it.\n"
             "A ray is OctoMap's castRay (unknown voxels stop it unless --unknown safe); its counts\n"
-            "are over the segment from the origin to max_m along the direction.\n");
+            "are over the segment from the origin to max_m along the direction.\n"
+            "A distance is to the nearest blocking voxel within max_m: \"found\" with the distance,\n"
+            "\"none\" (nothing within max_m), or \"undecided\" (the search's heap of N entries,\n"
+            "default %u, overflowed: exit 1, treat as an obstacle at 0).\n", DEFAULT_HEAP);
 }
 
 typedef struct {
-    enum { Q_NONE, Q_SPHERE, Q_AABB, Q_CAPSULE, Q_RAY } kind;
+    enum { Q_NONE, Q_SPHERE, Q_AABB, Q_CAPSULE, Q_RAY, Q_DISTANCE } kind;
     float v[7];
+    unsigned heap; /* --distance: nearest-search heap entries */
     occ_unknown_policy_t policy;
     bool json;
 } query_t;
@@ -57,15 +65,27 @@ static const char *parse(int argc, char **argv, query_t *q)
         } else if (strcmp(a, "--ray") == 0) {
             kind = Q_RAY;
             n = 7;
+        } else if (strcmp(a, "--distance") == 0) {
+            kind = Q_DISTANCE;
+            n = 4;
+        } else if (strcmp(a, "--heap") == 0) {
+            char *end = NULL;
+            const unsigned long h = val != NULL ? strtoul(val, &end, 10) : 0ul;
+            if (val == NULL || end == val || *end != '\0' || h == 0ul || h > (1ul << 24)) {
+                return "--heap takes a count 1..16777216";
+            }
+            q->heap = (unsigned)h;
+            i++;
+            continue;
         } else {
             return "unknown option";
         }
-        if (q->kind != Q_NONE) return "give one of --sphere, --aabb, --capsule, --ray";
+        if (q->kind != Q_NONE) return "give one of --sphere, --aabb, --capsule, --ray, --distance";
         if (val == NULL || !cli_parse_floats(val, q->v, n)) return "malformed numbers";
         q->kind = kind;
         i++;
     }
-    return q->kind == Q_NONE ? "give one of --sphere, --aabb, --capsule, --ray" : NULL;
+    return q->kind == Q_NONE ? "give one of --sphere, --aabb, --capsule, --ray, --distance" : NULL;
 }
 
 static occ_vec3_t vec(const float *p)
@@ -74,9 +94,42 @@ static occ_vec3_t vec(const float *p)
     return v;
 }
 
+/* --distance: the three answers of occ_distance_to_obstacle; 1 unless found or none. */
+static int run_distance(const occ_map_t *map, const query_t *q, FILE *out)
+{
+    static const char *const names[] = {"undecided", "found", "none"};
+    occ_nearest_entry_t *const heap = malloc((size_t)q->heap * sizeof *heap);
+    float dist = 0.0f;
+    occ_obstacle_t res = OCC_OBSTACLE_UNDECIDED;
+    const occ_err_t e = heap == NULL ? OCC_ERR_NOMEM
+                                     : occ_distance_to_obstacle(map, vec(q->v), q->v[3], q->policy,
+                                                                heap, q->heap, &dist, &res);
+    free(heap);
+    if (e != OCC_OK && e != OCC_ERR_NOMEM) { /* bad input: no answer at all */
+        if (q->json) fprintf(out, "{\"error\": \"%s\"}\n", occ_err_str(e));
+        else fprintf(stderr, "occmap query: %s\n", occ_err_str(e));
+        return 1;
+    }
+    if (q->json) {
+        fprintf(out, "{\"obstacle\": \"%s\", \"distance_m\": %.6g", names[res], (double)dist);
+        if (e != OCC_OK) fprintf(out, ", \"error\": \"%s\"", occ_err_str(e));
+        fprintf(out, "}\n");
+    } else if (res == OCC_OBSTACLE_FOUND) {
+        fprintf(out, "obstacle at %.6g m\n", (double)dist);
+    } else if (res == OCC_OBSTACLE_NONE) {
+        fprintf(out, "no obstacle within %.6g m\n", (double)dist);
+    } else {
+        fprintf(out, "UNDECIDED (%s): treat as an obstacle here\n", occ_err_str(e));
+    }
+    return e == OCC_OK ? 0 : 1;
+}
+
 /* Run one query and print its answer; returns 0 or 1 (error, printed). */
 static int run(const occ_map_t *map, const query_t *q, FILE *out)
 {
+    if (q->kind == Q_DISTANCE) {
+        return run_distance(map, q, out);
+    }
     occ_volume_t vol;
     occ_err_t e = OCC_OK;
     occ_ray_result_t ray;
@@ -106,6 +159,7 @@ static int run(const occ_map_t *map, const query_t *q, FILE *out)
         }
         break;
     }
+    case Q_DISTANCE: /* run_distance */
     case Q_NONE:
     default:
         e = OCC_ERR_ARG;
@@ -205,6 +259,7 @@ int cmd_query(int argc, char **argv)
     memset(&q, 0, sizeof q);
     q.kind = Q_NONE;
     q.policy = OCC_UNKNOWN_UNSAFE;
+    q.heap = DEFAULT_HEAP;
     /* Pull --batch FILE out; the rest is one query. */
     char *rest[64];
     int nrest = 0;

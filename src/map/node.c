@@ -37,7 +37,8 @@ static void fill_unknown(occ_node_t *const out, const occ_key_t key, const unsig
 occ_err_t occ_map_node_child(const occ_map_t *const map, const occ_node_t *const parent,
                              const unsigned slot, occ_node_t *const out)
 {
-    if (map == NULL || parent == NULL || out == NULL || parent->level == 0u || slot > 7u) {
+    if (map == NULL || parent == NULL || out == NULL || parent->level == 0u ||
+        parent->level > map->cfg.depth_levels || slot > 7u) { /* the level is shifted by below */
         if (out != NULL) {
             const occ_key_t zero = {{0u, 0u, 0u}};
             fill_unknown(out, zero, 0u, map != NULL ? map->write_gen - 1u : 0u);
@@ -63,6 +64,7 @@ occ_err_t occ_map_node_child(const occ_map_t *const map, const occ_node_t *const
     }
     out->key = key;
     out->level = (uint8_t)level;
+    out->gen = parent->gen;
     const occ_entry_t e = occ_entry_at(map, parent->children, level, slot);
     fill(map, out, e.value, level == 0u ? occ_value_flags(map, e.value) : e.flags, e.child);
     return OCC_OK;

@@ -1,0 +1,766 @@
+/*
+ * test_failclosed.c - issue 16, "fail closed": a caller that ignores an error code reads
+ * "unsafe", never stale or "clear". Every collision entry point answers unsafe on bad input;
+ * the obstacle distance has three outcomes (found, none within range, undecided); handles that
+ * keep block indices between calls (lookup cursor, volume iterator, nearest iterator, walk, node
+ * handle) answer OCC_ERR_STATE after each kind of write instead of following stale indices (ASan
+ * watches the reads); public levels >= 32 are saturated or refused, never an undefined shift
+ * (UBSan watches). Expected values are worked out by hand in the comments.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "occmap/occmap.h"
+#include "occmap/occ_collide_ccd.h"
+#include "occmap/occ_evict.h"
+#include "support/query_shapes.h"
+
+#define ARENA_BYTES OCC_ARENA_BYTES(4096, 4096)
+static uint8_t arena[ARENA_BYTES];
+static uint8_t scratch[1u << 20];
+static uint8_t filebuf[1u << 16];
+static occ_map_t map;
+
+static occ_vec3_t v3(float x, float y, float z)
+{
+    occ_vec3_t v = {x, y, z};
+    return v;
+}
+
+/* a == b without -Wfloat-equal's complaint (exact values worked out by hand). */
+static bool feq(float a, float b)
+{
+    return !(a < b) && !(a > b);
+}
+
+static occ_key_t key_of(occ_vec3_t p)
+{
+    occ_key_t k;
+    assert_int_equal(occ_map_key(&map, p, &k), OCC_OK);
+    return k;
+}
+
+/* The map of most tests (0.1 m, depth 16): one occupied voxel x in [1.0, 1.1), y and z in
+ * [0, 0.1); a free 10 x 10 slab of voxels x, y in [-0.5, 0.5), z in [0, 0.1); the rest unknown. */
+static const occ_vec3_t P_OCC = {1.05f, 0.05f, 0.05f};
+static const occ_vec3_t P_FREE = {0.05f, 0.05f, 0.05f};
+
+static void make_map(void)
+{
+    const occ_map_config_t cfg = occ_map_config_default();
+    assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+    assert_int_equal(occ_map_update(&map, P_OCC, 3.0f), OCC_OK);
+    for (int x = -5; x < 5; x++) {
+        for (int y = -5; y < 5; y++) {
+            const occ_vec3_t p = v3(0.1f * (float)x + 0.05f, 0.1f * (float)y + 0.05f, 0.05f);
+            assert_int_equal(occ_map_update(&map, p, -1.0f), OCC_OK);
+        }
+    }
+    assert_int_equal(occ_map_check(&map), OCC_OK);
+    assert_int_equal(occ_map_state_at(&map, P_OCC), OCC_STATE_OCCUPIED);
+    assert_int_equal(occ_map_state_at(&map, P_FREE), OCC_STATE_FREE);
+}
+
+/* Forget the content (not occ_map_clear, which resets the counters): every block must come
+ * back to the pools. */
+static int teardown(void **state)
+{
+    (void)state;
+    const occ_key_t zero = {{0u, 0u, 0u}};
+    if (occ_map_check(&map) != OCC_OK ||
+        occ_map_forget_key(&map, zero, map.cfg.depth_levels) != OCC_OK ||
+        occ_map_check(&map) != OCC_OK) {
+        return -1;
+    }
+    return map.inner.used == 0u && map.leaf.used == 0u ? 0 : -1;
+}
+
+/* ---- collision checks: unsafe on every error --------------------------------------------------- */
+
+/* What a previous successful call could have left: safe, and a FREE node. */
+static void poison(occ_collision_t *c)
+{
+    memset(c, 0, sizeof *c);
+    c->safe = true;
+    c->outside = true;
+    c->node.observed = true;
+    c->node.state = OCC_STATE_FREE;
+}
+
+static void assert_unsafe(const occ_collision_t *c, const char *what)
+{
+    if (c->safe || c->outside || c->node.state != OCC_STATE_UNKNOWN || c->node.observed) {
+        fail_msg("%s: safe %d outside %d node state %d observed %d", what, c->safe, c->outside,
+                 c->node.state, c->node.observed);
+    }
+}
+
+#define EXPECT_UNSAFE(call, err)              \
+    do {                                      \
+        poison(&col);                         \
+        assert_int_equal((call), (err));      \
+        assert_unsafe(&col, #call);           \
+    } while (0)
+
+static void sphere_support(const void *shape, const occ_vec3_t *d, occ_vec3_t *out)
+{
+    const float *const s = (const float *)shape; /* x, y, z, r */
+    const float n = sqrtf(d->x * d->x + d->y * d->y + d->z * d->z);
+    out->x = s[0] + s[3] * d->x / n;
+    out->y = s[1] + s[3] * d->y / n;
+    out->z = s[2] + s[3] * d->z / n;
+}
+
+static occ_convex_t convex_sphere(const float *s)
+{
+    occ_convex_t cv;
+    cv.shape = s;
+    cv.support = sphere_support;
+    cv.center = v3(s[0], s[1], s[2]);
+    cv.bmin = v3(s[0] - s[3], s[1] - s[3], s[2] - s[3]);
+    cv.bmax = v3(s[0] + s[3], s[1] + s[3], s[2] + s[3]);
+    return cv;
+}
+
+static void test_collision_errors_read_unsafe(void **state)
+{
+    (void)state;
+    make_map();
+    occ_collision_t col;
+    occ_volume_t v;
+    const occ_vec3_t nan3 = v3(NAN, 0.f, 0.f), inf3 = v3(0.f, INFINITY, 0.f);
+    const occ_unknown_policy_t bad_policy = (occ_unknown_policy_t)7;
+    const float half[3] = {0.1f, 0.1f, 0.1f}, neg_half[3] = {0.1f, -0.1f, 0.1f};
+    const occ_vec3_t axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const occ_vec3_t skew[3] = {{1, 0, 0}, {0.7071f, 0.7071f, 0}, {0, 0, 1}};
+    assert_int_equal(occ_volume_sphere(&v, P_FREE, 0.01f), OCC_OK);
+
+    EXPECT_UNSAFE(occ_collide_volume(NULL, &v, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_volume(&map, NULL, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_volume(&map, &v, bad_policy, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_sphere(NULL, P_FREE, 0.01f, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_sphere(&map, nan3, 0.01f, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_sphere(&map, P_FREE, -0.01f, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_sphere(&map, P_FREE, NAN, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_sphere(&map, P_FREE, 0.01f, bad_policy, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_aabb(&map, v3(0.1f, 0.f, 0.f), v3(0.f, 0.1f, 0.1f),
+                                   OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG); /* min > max */
+    EXPECT_UNSAFE(occ_collide_aabb(&map, inf3, P_FREE, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_obb(&map, P_FREE, neg_half, axes, OCC_UNKNOWN_SAFE, &col),
+                  OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_obb(&map, P_FREE, half, skew, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_obb(&map, P_FREE, NULL, axes, OCC_UNKNOWN_SAFE, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_capsule(&map, P_FREE, nan3, 0.01f, OCC_UNKNOWN_SAFE, &col),
+                  OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_capsule(&map, P_FREE, P_FREE, -1.f, OCC_UNKNOWN_SAFE, &col),
+                  OCC_ERR_ARG);
+
+    const float ball[4] = {0.05f, 0.05f, 0.05f, 0.01f};
+    occ_convex_t cv = convex_sphere(ball);
+    EXPECT_UNSAFE(occ_collide_convex(NULL, &cv, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_convex(&map, NULL, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_convex(&map, &cv, bad_policy, OCC_CCD_GJK, &col), OCC_ERR_ARG);
+    EXPECT_UNSAFE(occ_collide_convex(&map, &cv, OCC_UNKNOWN_SAFE, (occ_ccd_algo_t)9, &col),
+                  OCC_ERR_ARG);
+    cv.bmin.x = cv.bmax.x + 1.f; /* a bounding box inside out */
+    EXPECT_UNSAFE(occ_collide_convex(&map, &cv, OCC_UNKNOWN_SAFE, OCC_CCD_MPR, &col), OCC_ERR_ARG);
+    cv = convex_sphere(ball);
+    cv.support = NULL;
+    EXPECT_UNSAFE(occ_collide_convex(&map, &cv, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, &col), OCC_ERR_ARG);
+    cv = convex_sphere(ball);
+    cv.center = nan3;
+    EXPECT_UNSAFE(occ_collide_convex(&map, &cv, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, &col), OCC_ERR_ARG);
+
+    /* NULL out: the error alone, no crash. */
+    assert_int_equal(occ_collide_volume(&map, &v, OCC_UNKNOWN_SAFE, NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_collide_sphere(&map, nan3, 1.f, OCC_UNKNOWN_SAFE, NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_collide_convex(&map, &cv, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, NULL),
+                     OCC_ERR_ARG);
+}
+
+/* The same calls with good arguments still answer safe where it is (inside the free slab), and
+ * name the occupied voxel where it is not: unsafe-first did not make everything unsafe. */
+static void test_collision_answers_after_errors(void **state)
+{
+    (void)state;
+    make_map();
+    occ_collision_t col;
+    const float half[3] = {0.02f, 0.02f, 0.02f};
+    const occ_vec3_t axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const float ball[4] = {0.05f, 0.05f, 0.05f, 0.02f};
+    const occ_convex_t cv = convex_sphere(ball);
+    for (int round = 0; round < 2; round++) { /* each after a refused call on the same out */
+        poison(&col);
+        assert_int_equal(occ_collide_sphere(&map, P_FREE, NAN, OCC_UNKNOWN_SAFE, &col),
+                         OCC_ERR_ARG);
+        switch (round) {
+        case 0:
+            assert_int_equal(occ_collide_sphere(&map, P_FREE, 0.02f, OCC_UNKNOWN_UNSAFE, &col),
+                             OCC_OK);
+            break;
+        default:
+            assert_int_equal(occ_collide_convex(&map, &cv, OCC_UNKNOWN_UNSAFE, OCC_CCD_GJK, &col),
+                             OCC_OK);
+            break;
+        }
+        assert_true(col.safe);
+    }
+    assert_int_equal(occ_collide_obb(&map, P_FREE, half, axes, OCC_UNKNOWN_UNSAFE, &col), OCC_OK);
+    assert_true(col.safe);
+    assert_int_equal(occ_collide_capsule(&map, P_FREE, v3(0.3f, 0.05f, 0.05f), 0.02f,
+                                         OCC_UNKNOWN_UNSAFE, &col), OCC_OK);
+    assert_true(col.safe);
+    /* A capsule from the slab to x = 1.2 touches the occupied voxel (its only blocker with
+     * unknown counted free). */
+    assert_int_equal(occ_collide_capsule(&map, P_FREE, v3(1.2f, 0.05f, 0.05f), 0.02f,
+                                         OCC_UNKNOWN_SAFE, &col), OCC_OK);
+    assert_false(col.safe);
+    assert_false(col.outside);
+    assert_int_equal(col.node.state, OCC_STATE_OCCUPIED);
+    const occ_key_t kocc = key_of(P_OCC);
+    assert_int_equal(col.node.level, 0u);
+    assert_memory_equal(&col.node.key, &kocc, sizeof kocc);
+    /* Off the map under OCC_UNKNOWN_UNSAFE: unsafe and outside. */
+    assert_int_equal(occ_collide_sphere(&map, v3(3276.7f, 0.f, 0.f), 1.f, OCC_UNKNOWN_UNSAFE,
+                                        &col), OCC_OK);
+    assert_false(col.safe);
+    assert_true(col.outside);
+}
+
+/* A support function that writes the map on its first call: the walk over the box cannot
+ * finish on the old tree, so the answer is OCC_ERR_STATE and unsafe, not "safe". */
+typedef struct {
+    float s[4];
+    int calls;
+} writing_shape_t;
+
+static void writing_support(const void *shape, const occ_vec3_t *d, occ_vec3_t *out)
+{
+    writing_shape_t *const w = (writing_shape_t *)(uintptr_t)shape;
+    if (w->calls++ == 0) {
+        assert_int_equal(occ_map_update(&map, v3(-20.05f, 0.05f, 0.05f), 1.0f), OCC_OK);
+    }
+    sphere_support(w->s, d, out);
+}
+
+static void test_convex_map_written_during_check(void **state)
+{
+    (void)state;
+    make_map();
+    /* A ball at x = 0.85, r = 0.1 reaches x = 0.95, short of the occupied voxel at 1.0; its
+     * box is widened to x = 1.2, so the walk meets that voxel, tests it (no hit) and goes on. */
+    writing_shape_t w = {{0.85f, 0.05f, 0.05f, 0.1f}, 0};
+    occ_convex_t cv = convex_sphere(w.s);
+    cv.shape = &w;
+    cv.support = writing_support;
+    cv.bmax.x = 1.2f;
+    occ_collision_t col;
+    poison(&col);
+    assert_int_equal(occ_collide_convex(&map, &cv, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, &col),
+                     OCC_ERR_STATE);
+    assert_true(w.calls > 0);
+    assert_unsafe(&col, "convex check with a map write inside");
+    /* Without the write the same shape is safe. */
+    const occ_convex_t plain = convex_sphere(w.s);
+    occ_convex_t wide = plain;
+    wide.bmax.x = 1.2f;
+    assert_int_equal(occ_collide_convex(&map, &wide, OCC_UNKNOWN_SAFE, OCC_CCD_GJK, &col), OCC_OK);
+    assert_true(col.safe);
+}
+
+/* ---- the obstacle distance: found, none within range, undecided --------------------------------- */
+
+static void test_distance_three_outcomes(void **state)
+{
+    (void)state;
+    make_map();
+    static occ_nearest_entry_t buf[512];
+    float d = -1.f;
+    occ_obstacle_t r = OCC_OBSTACLE_UNDECIDED;
+    /* Found: from (0.05, 0.05, 0.05) to the voxel face at x = 1.0: 0.95 m (unknown is free). */
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 2.f, OCC_UNKNOWN_SAFE, buf, 512, &d, &r),
+                     OCC_OK);
+    assert_int_equal(r, OCC_OBSTACLE_FOUND);
+    assert_true(fabsf(d - 0.95f) < 1e-5f);
+    /* None within 0.5 m: the distance reads max_dist, a bound that holds. */
+    d = -1.f;
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 0.5f, OCC_UNKNOWN_SAFE, buf, 512, &d, &r),
+                     OCC_OK);
+    assert_int_equal(r, OCC_OBSTACLE_NONE);
+    assert_true(feq(d, 0.5f));
+    /* Unknown blocks: the unknown voxel on top of P_FREE's (z from 0.1) is 0.05 m away. */
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 2.f, OCC_UNKNOWN_UNSAFE, buf, 512, &d,
+                                              &r), OCC_OK);
+    assert_int_equal(r, OCC_OBSTACLE_FOUND);
+    assert_true(fabsf(d - 0.05f) < 1e-6f);
+    /* One heap entry: with unknown blocking, all 8 children of the root are candidates, so the
+     * heap overflows. That is "undecided", an obstacle right here, never "none". */
+    d = 7.f;
+    r = OCC_OBSTACLE_NONE;
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 2.f, OCC_UNKNOWN_UNSAFE, buf, 1, &d, &r),
+                     OCC_ERR_NOMEM);
+    assert_int_equal(r, OCC_OBSTACLE_UNDECIDED);
+    assert_true(feq(d, 0.f));
+    /* With unknown free only one branch holds the occupied voxel: one entry suffices. */
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 2.f, OCC_UNKNOWN_SAFE, buf, 1, &d, &r),
+                     OCC_OK);
+    assert_int_equal(r, OCC_OBSTACLE_FOUND);
+    assert_true(fabsf(d - 0.95f) < 1e-5f);
+}
+
+static void test_distance_errors_undecided(void **state)
+{
+    (void)state;
+    make_map();
+    occ_nearest_entry_t buf[64];
+    float d;
+    occ_obstacle_t r;
+    const occ_vec3_t nan3 = v3(0.f, NAN, 0.f);
+#define EXPECT_UNDECIDED(call)                          \
+    do {                                                \
+        d = 5.f;                                        \
+        r = OCC_OBSTACLE_NONE;                          \
+        assert_int_equal((call), OCC_ERR_ARG);          \
+        assert_int_equal(r, OCC_OBSTACLE_UNDECIDED);    \
+        assert_true(feq(d, 0.f));          \
+    } while (0)
+    EXPECT_UNDECIDED(occ_distance_to_obstacle(NULL, P_FREE, 1.f, OCC_UNKNOWN_SAFE, buf, 64, &d, &r));
+    EXPECT_UNDECIDED(occ_distance_to_obstacle(&map, nan3, 1.f, OCC_UNKNOWN_SAFE, buf, 64, &d, &r));
+    EXPECT_UNDECIDED(occ_distance_to_obstacle(&map, P_FREE, -1.f, OCC_UNKNOWN_SAFE, buf, 64, &d, &r));
+    EXPECT_UNDECIDED(occ_distance_to_obstacle(&map, P_FREE, NAN, OCC_UNKNOWN_SAFE, buf, 64, &d, &r));
+    EXPECT_UNDECIDED(occ_distance_to_obstacle(&map, P_FREE, 1.f, OCC_UNKNOWN_SAFE, NULL, 64, &d, &r));
+    EXPECT_UNDECIDED(occ_distance_to_obstacle(&map, P_FREE, 1.f, OCC_UNKNOWN_SAFE, buf, 0, &d, &r));
+    EXPECT_UNDECIDED(occ_distance_to_obstacle(&map, P_FREE, 1.f, (occ_unknown_policy_t)3, buf, 64,
+                                              &d, &r));
+#undef EXPECT_UNDECIDED
+    d = 5.f;
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 1.f, OCC_UNKNOWN_SAFE, buf, 64, &d,
+                                              NULL), OCC_ERR_ARG);
+    assert_true(feq(d, 0.f));
+    r = OCC_OBSTACLE_NONE;
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 1.f, OCC_UNKNOWN_SAFE, buf, 64, NULL,
+                                              &r), OCC_ERR_ARG);
+    assert_int_equal(r, OCC_OBSTACLE_UNDECIDED);
+}
+
+/* ---- stale handles --------------------------------------------------------------------------- */
+
+typedef void (*write_fn)(void);
+
+static void w_update(void)
+{
+    assert_int_equal(occ_map_update(&map, v3(-2.05f, 0.05f, 0.05f), 3.f), OCC_OK);
+}
+
+static void w_observe_key(void)
+{
+    assert_int_equal(occ_map_observe_key(&map, key_of(v3(0.05f, 2.05f, 0.05f)), false), OCC_OK);
+}
+
+static void w_observe_codes(void)
+{
+    const occ_code_t c = occ_morton_encode(key_of(v3(0.05f, 0.05f, -2.05f))) | OCC_CODE_HIT_BIT;
+    assert_int_equal(occ_map_observe_codes(&map, &c, 1u, NULL), OCC_OK);
+}
+
+static void w_set(void) /* the level-3 node (0.8 m) holding P_OCC becomes free */
+{
+    assert_int_equal(occ_map_set_key(&map, key_of(P_OCC), 3u, -2.f), OCC_OK);
+}
+
+static void w_forget(void)
+{
+    assert_int_equal(occ_map_forget_key(&map, key_of(P_OCC), 0u), OCC_OK);
+}
+
+static void w_insert(void)
+{
+    occ_insert_params_t ip = occ_insert_params_default();
+    const occ_vec3_t pts[2] = {{0.05f, 0.05f, 1.05f}, {0.55f, -0.35f, 0.85f}};
+    occ_insert_result_t res;
+    assert_int_equal(occ_map_insert_cloud(&map, &P_FREE, pts, 2u, &ip, scratch, sizeof scratch,
+                                          &res), OCC_OK);
+    assert_true(res.voxels_changed > 0u);
+}
+
+/* FAST_DISCRETE with n = 0 and a ray clipped at max range: only its coarse pass writes (the
+ * level-1 nodes along the ray are cleared, no voxel batch follows). */
+static void w_insert_fast(void)
+{
+    occ_insert_params_t ip = occ_insert_params_default();
+    ip.method = OCC_INSERT_FAST_DISCRETE;
+    ip.fast_d = 1u;
+    ip.fast_n = 0u;
+    ip.max_range_m = 0.5f;
+    const occ_vec3_t far = {0.05f, 0.05f, 3.05f};
+    occ_insert_result_t res;
+    assert_int_equal(occ_map_insert_cloud(&map, &P_FREE, &far, 1u, &ip, scratch, sizeof scratch,
+                                          &res), OCC_OK);
+    assert_true(res.coarse_updated > 0u);
+    assert_int_equal(res.voxels_updated, 0u);
+}
+
+static void w_evict(void) /* forget everything more than 0.5 m from (-3, -3, 0) */
+{
+    occ_evict_policy_t pol = occ_evict_policy_default();
+    pol.keep_radius_m = 0.5f;
+    occ_evict_out_t out;
+    occ_evict_out_init(&out);
+    const occ_vec3_t c = v3(-3.f, -3.f, 0.f);
+    assert_int_equal(occ_map_evict(&map, &c, &pol, UINT32_MAX, &out), OCC_OK);
+    assert_true(out.last_evictions > 0u);
+}
+
+static void w_clear(void)
+{
+    occ_map_clear(&map);
+}
+
+static void w_io_read(void) /* the same content, read back from a snapshot: new blocks */
+{
+    occ_io_buf_t b = {filebuf, sizeof filebuf, 0u};
+    assert_int_equal(occ_io_write(&map, OCC_FORMAT_SNAPSHOT, occ_io_buf_write, &b, NULL), OCC_OK);
+    assert_int_equal(occ_io_read(&map, filebuf, b.len, NULL), OCC_OK);
+    assert_int_equal(occ_map_state_at(&map, P_OCC), OCC_STATE_OCCUPIED);
+}
+
+static void stale_lookup(write_fn write)
+{
+    make_map();
+    occ_lookup_t lk;
+    occ_lookup_init(&lk, &map);
+    assert_int_equal(occ_lookup_state(&lk, P_OCC), OCC_STATE_OCCUPIED);
+    assert_int_equal(occ_lookup_status(&lk), OCC_OK);
+    write();
+    assert_int_equal(occ_lookup_status(&lk), OCC_ERR_STATE);
+    /* The same voxel (the cached node) and another one (a descent from cached blocks). */
+    assert_int_equal(occ_lookup_state(&lk, P_OCC), OCC_STATE_UNKNOWN);
+    occ_state_t s = OCC_STATE_FREE;
+    assert_int_equal(occ_lookup_read(&lk, P_FREE, &s), OCC_ERR_STATE);
+    assert_int_equal(s, OCC_STATE_UNKNOWN);
+    /* A fresh cursor reads the new map. */
+    occ_lookup_init(&lk, &map);
+    assert_int_equal(occ_lookup_read(&lk, P_OCC, &s), OCC_OK);
+    assert_int_equal(s, occ_map_state_at(&map, P_OCC));
+}
+
+static void stale_query(write_fn write)
+{
+    make_map();
+    occ_volume_t v;
+    assert_int_equal(occ_volume_sphere(&v, P_FREE, 1.5f), OCC_OK);
+    const occ_pred_t pred = {(uint8_t)OCC_PRED_ANY, 0u, 0u};
+    occ_query_iter_t it;
+    occ_query_node_t n;
+    assert_int_equal(occ_query_begin(&it, &map, &v, pred), OCC_OK);
+    assert_true(occ_query_next(&it, &n));
+    assert_int_equal(occ_query_status(&it), OCC_OK);
+    write();
+    assert_int_equal(occ_query_status(&it), OCC_ERR_STATE);
+    assert_false(occ_query_next(&it, &n));
+    assert_int_equal(occ_query_begin(&it, &map, &v, pred), OCC_OK);
+    assert_true(occ_query_next(&it, &n)); /* the sphere meets some node of any map */
+    assert_int_equal(occ_query_status(&it), OCC_OK);
+}
+
+static void stale_nearest(write_fn write)
+{
+    make_map();
+    static occ_nearest_entry_t buf[512];
+    const occ_pred_t pred = {(uint8_t)(OCC_PRED_OCCUPIED | OCC_PRED_UNKNOWN), 0u, 0u};
+    occ_nearest_t it;
+    occ_query_node_t n;
+    bool found = false;
+    assert_int_equal(occ_nearest_begin(&it, &map, P_FREE, 3.f, pred, buf, 512), OCC_OK);
+    assert_int_equal(occ_nearest_next(&it, &n, NULL, &found), OCC_OK);
+    assert_true(found);
+    write();
+    found = true;
+    assert_int_equal(occ_nearest_next(&it, &n, NULL, &found), OCC_ERR_STATE);
+    assert_false(found);
+    assert_int_equal(occ_nearest_begin(&it, &map, P_FREE, 3.f, pred, buf, 512), OCC_OK);
+    assert_int_equal(occ_nearest_next(&it, &n, NULL, &found), OCC_OK);
+    assert_true(found); /* unknown space within 3 m on any of these maps */
+}
+
+static void stale_walk(write_fn write)
+{
+    make_map();
+    occ_walk_t w;
+    occ_walk_node_t n;
+    occ_walk_begin(&w, &map);
+    assert_true(occ_walk_next(&w, &n));
+    assert_true(occ_walk_next(&w, &n));
+    assert_int_equal(occ_walk_status(&w), OCC_OK);
+    write();
+    assert_int_equal(occ_walk_status(&w), OCC_ERR_STATE);
+    assert_false(occ_walk_next(&w, &n));
+    occ_walk_begin(&w, &map);
+    while (occ_walk_next(&w, &n)) {
+    }
+    assert_int_equal(occ_walk_status(&w), OCC_OK);
+}
+
+static void assert_unknown_node(const occ_node_t *n)
+{
+    assert_false(n->observed);
+    assert_int_equal(n->state, OCC_STATE_UNKNOWN);
+    assert_int_equal(n->children, OCC_NONE);
+    assert_true((n->flags & OCC_NODE_HAS_UNKNOWN) != 0u);
+    assert_true((n->flags & (OCC_NODE_HAS_FREE | OCC_NODE_HAS_OCCUPIED)) == 0u);
+}
+
+static unsigned slot_of(occ_key_t k, unsigned level) /* child slot at `level` - 1 */
+{
+    return ((k.k[0] >> (level - 1u)) & 1u) | (((k.k[1] >> (level - 1u)) & 1u) << 1) |
+           (((k.k[2] >> (level - 1u)) & 1u) << 2);
+}
+
+static void stale_node(write_fn write)
+{
+    make_map();
+    const occ_key_t k = key_of(P_OCC);
+    occ_node_t root, child, grandchild;
+    occ_map_node_root(&map, &root);
+    assert_int_equal(occ_map_node_child(&map, &root, slot_of(k, 16u), &child), OCC_OK);
+    assert_true(child.children != OCC_NONE);
+    write();
+    memset(&grandchild, 0x5A, sizeof grandchild);
+    assert_int_equal(occ_map_node_child(&map, &child, slot_of(k, 15u), &grandchild),
+                     OCC_ERR_STATE);
+    assert_unknown_node(&grandchild);
+    /* The unknown answer is itself stale: nothing below it is followed either. */
+    assert_int_equal(occ_map_node_child(&map, &grandchild, 0u, &grandchild), OCC_ERR_STATE);
+    assert_unknown_node(&grandchild);
+    assert_int_equal(occ_map_node_child(&map, &root, 0u, &root), OCC_ERR_STATE); /* aliased */
+    assert_unknown_node(&root);
+    occ_map_node_root(&map, &root);
+    assert_int_equal(occ_map_node_child(&map, &root, slot_of(k, 16u), &child), OCC_OK);
+}
+
+static void stale_all(write_fn write)
+{
+    stale_lookup(write);
+    stale_query(write);
+    stale_nearest(write);
+    stale_walk(write);
+    stale_node(write);
+}
+
+#define STALE_TEST(name, fn)                  \
+    static void name(void **state)            \
+    {                                         \
+        (void)state;                          \
+        stale_all(fn);                        \
+    }
+STALE_TEST(test_stale_after_update, w_update)
+STALE_TEST(test_stale_after_observe_key, w_observe_key)
+STALE_TEST(test_stale_after_observe_codes, w_observe_codes)
+STALE_TEST(test_stale_after_set, w_set)
+STALE_TEST(test_stale_after_forget, w_forget)
+STALE_TEST(test_stale_after_insert, w_insert)
+STALE_TEST(test_stale_after_insert_fast_discrete, w_insert_fast)
+STALE_TEST(test_stale_after_evict, w_evict)
+STALE_TEST(test_stale_after_clear, w_clear)
+STALE_TEST(test_stale_after_io_read, w_io_read)
+
+/* Reads, and writes refused before they touch the tree, leave every handle valid. */
+static void test_reads_and_refused_writes_keep_handles(void **state)
+{
+    (void)state;
+    make_map();
+    occ_lookup_t lk;
+    occ_lookup_init(&lk, &map);
+    assert_int_equal(occ_lookup_state(&lk, P_OCC), OCC_STATE_OCCUPIED);
+    occ_walk_t w;
+    occ_walk_node_t wn;
+    occ_walk_begin(&w, &map);
+    assert_true(occ_walk_next(&w, &wn));
+    const uint32_t gen = map.write_gen;
+
+    occ_collision_t col;
+    occ_map_stats_t st;
+    occ_nearest_entry_t buf[64];
+    float d;
+    occ_obstacle_t r;
+    occ_io_buf_t b = {filebuf, sizeof filebuf, 0u};
+    assert_int_equal(occ_collide_sphere(&map, P_OCC, 0.5f, OCC_UNKNOWN_SAFE, &col), OCC_OK);
+    assert_int_equal(occ_distance_to_obstacle(&map, P_FREE, 2.f, OCC_UNKNOWN_SAFE, buf, 64, &d, &r),
+                     OCC_OK);
+    occ_map_stats(&map, &st);
+    assert_int_equal(occ_map_check(&map), OCC_OK);
+    assert_int_equal(occ_io_write(&map, OCC_FORMAT_SNAPSHOT, occ_io_buf_write, &b, NULL), OCC_OK);
+
+    occ_key_t far = key_of(P_OCC);
+    far.k[0] = 1u << 16;
+    const occ_code_t c_occ = occ_morton_encode(key_of(P_OCC));
+    const occ_code_t c_free = occ_morton_encode(key_of(P_FREE));
+    const occ_code_t descending[2] = {c_occ > c_free ? c_occ : c_free,
+                                      c_occ > c_free ? c_free : c_occ};
+    assert_int_equal(occ_map_update(&map, P_OCC, NAN), OCC_ERR_ARG);
+    assert_int_equal(occ_map_update(&map, v3(1e9f, 0.f, 0.f), 1.f), OCC_ERR_RANGE);
+    assert_int_equal(occ_map_observe_key(&map, far, true), OCC_ERR_RANGE);
+    assert_int_equal(occ_map_observe_codes(&map, descending, 2u, NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_map_set_key(&map, key_of(P_OCC), 17u, 1.f), OCC_ERR_ARG);
+    assert_int_equal(occ_map_forget_key(&map, far, 0u), OCC_ERR_RANGE);
+    assert_int_equal(occ_io_read(&map, filebuf, 10u, NULL), OCC_ERR_FORMAT);
+    occ_evict_policy_t pol = occ_evict_policy_default();
+    pol.keep_radius_m = 100.f; /* everything protected: nothing to evict */
+    occ_evict_out_t eo;
+    occ_evict_out_init(&eo);
+    assert_int_equal(occ_map_evict(&map, &P_FREE, &pol, 4000u, &eo), OCC_OK);
+    assert_int_equal(eo.last_evictions, 0u);
+
+    assert_int_equal(map.write_gen, gen);
+    assert_int_equal(occ_lookup_status(&lk), OCC_OK);
+    assert_int_equal(occ_lookup_state(&lk, P_OCC), OCC_STATE_OCCUPIED);
+    assert_int_equal(occ_walk_status(&w), OCC_OK);
+    assert_true(occ_walk_next(&w, &wn));
+}
+
+/* The bug the generation guards against: a cursor kept over occ_map_clear() and a refill of the
+ * arena with other content. Random refills; ASan would see a read outside the arena if a stale
+ * index were followed, and the answers must be UNKNOWN / done. Seed printed, OCC_SEED repeats. */
+static void test_stale_over_refill(void **state)
+{
+    (void)state;
+    uint64_t rng = qs_seed("test_failclosed refill");
+    static occ_nearest_entry_t buf[4096];
+    for (unsigned round = 0; round < 20u; round++) {
+        make_map();
+        for (unsigned i = 0; i < 200u; i++) { /* deep, scattered content */
+            const occ_vec3_t p = v3((float)qs_uniform(&rng, -50, 50), (float)qs_uniform(&rng, -50, 50),
+                                    (float)qs_uniform(&rng, -5, 5));
+            assert_int_equal(occ_map_update(&map, p, (i % 2u) != 0u ? 2.f : -1.f), OCC_OK);
+        }
+        occ_lookup_t lk;
+        occ_lookup_init(&lk, &map);
+        (void)occ_lookup_state(&lk, P_OCC);
+        occ_walk_t w;
+        occ_walk_node_t wn;
+        occ_walk_begin(&w, &map);
+        for (unsigned i = 0; i < 40u && occ_walk_next(&w, &wn); i++) {
+        }
+        occ_nearest_t nit;
+        occ_query_node_t qn;
+        bool found;
+        const occ_pred_t pred = {(uint8_t)OCC_PRED_OCCUPIED, 0u, 0u};
+        assert_int_equal(occ_nearest_begin(&nit, &map, P_FREE, 100.f, pred, buf, 4096), OCC_OK);
+        assert_int_equal(occ_nearest_next(&nit, &qn, NULL, &found), OCC_OK);
+        occ_map_clear(&map);
+        for (unsigned i = 0; i < 200u; i++) { /* the same blocks, other meaning */
+            const occ_vec3_t p = v3((float)qs_uniform(&rng, -3, 3), (float)qs_uniform(&rng, -3, 3),
+                                    (float)qs_uniform(&rng, -3, 3));
+            assert_int_equal(occ_map_update(&map, p, 2.f), OCC_OK);
+        }
+        for (unsigned i = 0; i < 100u; i++) {
+            const occ_vec3_t p = v3((float)qs_uniform(&rng, -50, 50), (float)qs_uniform(&rng, -50, 50),
+                                    (float)qs_uniform(&rng, -5, 5));
+            assert_int_equal(occ_lookup_state(&lk, p), OCC_STATE_UNKNOWN);
+        }
+        unsigned steps = 0;
+        while (occ_walk_next(&w, &wn)) {
+            steps++;
+        }
+        assert_int_equal(steps, 0u);
+        assert_int_equal(occ_walk_status(&w), OCC_ERR_STATE);
+        assert_int_equal(occ_nearest_next(&nit, &qn, NULL, &found), OCC_ERR_STATE);
+        assert_false(found);
+        assert_int_equal(occ_map_check(&map), OCC_OK);
+    }
+}
+
+/* ---- levels a caller passes: saturated or refused, no shift by 32 or more ----------------------- */
+
+static void test_levels_saturate(void **state)
+{
+    (void)state;
+    const unsigned depths[2] = {16u, 21u};
+    for (unsigned di = 0; di < 2u; di++) {
+        occ_map_config_t cfg = occ_map_config_default();
+        cfg.depth_levels = (uint8_t)depths[di];
+        assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+        assert_int_equal(occ_map_update(&map, P_OCC, 3.f), OCC_OK);
+        const unsigned depth = depths[di];
+        /* The root's edge: 0.1 m * 2^depth (6553.6 m at depth 16, 209715.2 m at 21). */
+        const float root = occ_map_node_size(&map, depth);
+        assert_true(fabsf(root - 0.1f * (float)(1u << depth)) <= 1e-3f * root);
+        const unsigned levels[5] = {depth + 1u, 31u, 32u, 33u, 255u};
+        const occ_key_t k = key_of(P_OCC);
+        for (unsigned li = 0; li < 5u; li++) {
+            const unsigned l = levels[li];
+            const float size = occ_map_node_size(&map, l);
+            assert_true(feq(size, root));
+            /* The root's centre is the map origin. */
+            const occ_vec3_t c = occ_map_key_center(&map, k, l);
+            assert_true(feq(c.x, 0.f) && feq(c.y, 0.f) && feq(c.z, 0.f));
+            const occ_key_t base = occ_key_at_level(k, l);
+            assert_int_equal(base.k[0] | base.k[1] | base.k[2], 0u);
+            occ_node_info_t info;
+            assert_int_equal(occ_map_read_key(&map, k, l, &info), OCC_ERR_ARG);
+            assert_int_equal(occ_map_set_key(&map, k, l, 1.f), OCC_ERR_ARG);
+            assert_int_equal(occ_map_forget_key(&map, k, l), OCC_ERR_ARG);
+            occ_volume_t v;
+            assert_int_equal(occ_volume_sphere(&v, P_OCC, 1.f), OCC_OK);
+            occ_info_gain_t g = {99u, 9.f}; /* what an earlier call could have left */
+            assert_int_equal(occ_info_gain(&map, &v, l, 0u, &g), OCC_ERR_ARG);
+            assert_true(g.unknown_cells == 0u && !(g.entropy_bits > 0.f));
+            occ_query_iter_t it;
+            const occ_pred_t pred = {0u, (uint8_t)(l > 255u ? 255u : l), 0u};
+            assert_int_equal(occ_query_begin(&it, &map, &v, pred), OCC_ERR_ARG);
+            occ_nearest_t nit;
+            occ_nearest_entry_t buf[8];
+            assert_int_equal(occ_nearest_begin(&nit, &map, P_OCC, 1.f, pred, buf, 8), OCC_ERR_ARG);
+            /* A node handle with a level no node has. */
+            occ_node_t root_node, out;
+            occ_map_node_root(&map, &root_node);
+            root_node.level = (uint8_t)l;
+            assert_int_equal(occ_map_node_child(&map, &root_node, 0u, &out), OCC_ERR_ARG);
+            assert_unknown_node(&out);
+        }
+        /* Level 31 keeps bit 31 of a key, 32 and above keep nothing. */
+        const occ_key_t high = {{0x80000001u, 0xC0000000u, 0x7FFFFFFFu}};
+        const occ_key_t b31 = occ_key_at_level(high, 31u);
+        assert_int_equal(b31.k[0], 0x80000000u);
+        assert_int_equal(b31.k[1], 0x80000000u);
+        assert_int_equal(b31.k[2], 0u);
+        const occ_key_t b32 = occ_key_at_level(high, 32u);
+        assert_int_equal(b32.k[0] | b32.k[1] | b32.k[2], 0u);
+        /* Levels in range are exact: level 3 is 0.8 m, the voxel 0.1 m. */
+        assert_true(fabsf(occ_map_node_size(&map, 3u) - 0.8f) < 1e-6f);
+        assert_true(fabsf(occ_map_node_size(&map, 0u) - 0.1f) < 1e-9f);
+    }
+    assert_true(feq(occ_map_node_size(NULL, 3u), 0.f));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_teardown(test_collision_errors_read_unsafe, teardown),
+        cmocka_unit_test_teardown(test_collision_answers_after_errors, teardown),
+        cmocka_unit_test_teardown(test_convex_map_written_during_check, teardown),
+        cmocka_unit_test_teardown(test_distance_three_outcomes, teardown),
+        cmocka_unit_test_teardown(test_distance_errors_undecided, teardown),
+        cmocka_unit_test_teardown(test_stale_after_update, teardown),
+        cmocka_unit_test_teardown(test_stale_after_observe_key, teardown),
+        cmocka_unit_test_teardown(test_stale_after_observe_codes, teardown),
+        cmocka_unit_test_teardown(test_stale_after_set, teardown),
+        cmocka_unit_test_teardown(test_stale_after_forget, teardown),
+        cmocka_unit_test_teardown(test_stale_after_insert, teardown),
+        cmocka_unit_test_teardown(test_stale_after_insert_fast_discrete, teardown),
+        cmocka_unit_test_teardown(test_stale_after_evict, teardown),
+        cmocka_unit_test_teardown(test_stale_after_clear, teardown),
+        cmocka_unit_test_teardown(test_stale_after_io_read, teardown),
+        cmocka_unit_test_teardown(test_reads_and_refused_writes_keep_handles, teardown),
+        cmocka_unit_test_teardown(test_stale_over_refill, teardown),
+        cmocka_unit_test_teardown(test_levels_saturate, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
