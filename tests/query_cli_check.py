@@ -65,4 +65,28 @@ run(["--sphere", "0,0,nan,1"], rc=2)
 run(["--sphere", "0,0,0,1", "--aabb", "0,0,0,1,1,1"], rc=2)
 text = run(["--sphere", "500,500,500,0.3"])
 assert text.startswith("COLLIDES"), text
-print(f"PASS query cli: {len(queries)} queries, batch identical, policies and errors as documented")
+# --distance: the three answers. Found agrees with the sphere check at that radius (2 cm either
+# side); far outside the scan nothing blocks with unknown free, and the unknown point itself
+# blocks at 0 by default; a 1-entry heap overflows: undecided, exit 1, never "none".
+near = json.loads(run(["--distance", "0,0,0.5,3", "--unknown", "safe", "--json"]))
+assert near["obstacle"] == "found" and 0.05 < near["distance_m"] < 3, near
+for r, hit in ((near["distance_m"] + 0.02, True), (near["distance_m"] - 0.02, False)):
+    s = json.loads(run(["--sphere", f"0,0,0.5,{r}", "--unknown", "safe", "--json"]))
+    assert s["collides"] == hit, (r, s, near)
+none = json.loads(run(["--distance", "500,500,500,1", "--unknown", "safe", "--json"]))
+assert none == {"obstacle": "none", "distance_m": 1}, none
+here = json.loads(run(["--distance", "500,500,500,1", "--json"]))
+assert here == {"obstacle": "found", "distance_m": 0}, here
+undecided = json.loads(run(["--distance", "0,0,0.5,3", "--heap", "1", "--json"], rc=1))
+assert undecided["obstacle"] == "undecided" and undecided["distance_m"] == 0, undecided
+assert "error" in undecided, undecided
+assert run(["--distance", "0,0,0.5,3", "--heap", "1"], rc=1).startswith("UNDECIDED")
+assert "error" in json.loads(run(["--distance", "0,0,0.5,-1", "--json"], rc=1))
+run(["--distance", "0,0,0.5,3", "--heap", "0"], rc=2)
+with tempfile.NamedTemporaryFile("w", suffix=".txt", delete=False) as f:
+    f.write("--distance 0,0,0.5,3 --unknown safe\n--distance 0,0,0.5,3 --heap 1\n")
+    dbatch = f.name
+dl = [json.loads(x) for x in run(["--batch", dbatch, "--json"], rc=1).strip().splitlines()]
+assert dl == [near, undecided], dl
+print(f"PASS query cli: {len(queries)} queries, batch identical, policies and errors as documented, "
+      f"distance found/none/undecided")
