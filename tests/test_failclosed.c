@@ -4,8 +4,8 @@
  * the obstacle distance has three outcomes (found, none within range, undecided); handles that
  * keep block indices between calls (lookup cursor, volume iterator, nearest iterator, walk, node
  * handle) answer OCC_ERR_STATE after each kind of write instead of following stale indices (ASan
- * watches the reads); public levels >= 32 are saturated or refused, never an undefined shift
- * (UBSan watches). Expected values are worked out by hand in the comments.
+ * watches the reads); public levels >= 32 are saturated or refused, never an undefined shift,
+ * and keys off the map never overflow (UBSan watches). Expected values are worked out by hand in the comments.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -740,6 +740,25 @@ static void test_levels_saturate(void **state)
     assert_true(feq(occ_map_node_size(NULL, 3u), 0.f));
 }
 
+/* Keys no voxel has (>= 2^depth, up to 2^32 - 1): the centre they would have, outside the map,
+ * and no signed overflow (UBSan). Depth 16 at 0.1 m: the map spans +-3276.8 m. */
+static void test_key_center_off_map(void **state)
+{
+    (void)state;
+    const occ_map_config_t cfg = occ_map_config_default();
+    assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+    const occ_key_t k = {{0x80000000u, 0xFFFFFFFFu, 1u << 16}};
+    const occ_vec3_t c = occ_map_key_center(&map, k, 0u);
+    /* x: (2^31 - 2^15) * 0.1 + 0.05 = 214745088.05; y: (2^32 - 1 - 2^15) * 0.1 + 0.05 =
+     * 429493452.8; z: 2^15 * 0.1 + 0.05 = 3276.85 (float rounding: relative 1e-7). */
+    assert_true(fabs((double)c.x - 214745088.05) < 30.0);
+    assert_true(fabs((double)c.y - 429493452.8) < 60.0);
+    assert_true(fabs((double)c.z - 3276.85) < 1e-3);
+    /* The last voxel of the map, for comparison: 3276.75. */
+    const occ_key_t last = {{0xFFFFu, 0xFFFFu, 0xFFFFu}};
+    assert_true(fabs((double)occ_map_key_center(&map, last, 0u).x - 3276.75) < 1e-3);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -761,6 +780,7 @@ int main(void)
         cmocka_unit_test_teardown(test_reads_and_refused_writes_keep_handles, teardown),
         cmocka_unit_test_teardown(test_stale_over_refill, teardown),
         cmocka_unit_test_teardown(test_levels_saturate, teardown),
+        cmocka_unit_test_teardown(test_key_center_off_map, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

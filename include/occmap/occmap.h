@@ -197,7 +197,8 @@ void occ_map_clear(occ_map_t *map);
  * [-2^(D-1) res, 2^(D-1) res) per axis. */
 occ_err_t occ_map_key(const occ_map_t *map, occ_vec3_t p, occ_key_t *key);
 /* Centre (metres) of the node at `level` that contains voxel `key`. A level above depth_levels
- * saturates to depth_levels: the root's centre, the map origin (0, 0, 0). */
+ * saturates to depth_levels: the root's centre, the map origin (0, 0, 0). A key >= 2^depth_levels
+ * (no voxel of the map) gets the centre it would have, outside the map volume. */
 occ_vec3_t occ_map_key_center(const occ_map_t *map, occ_key_t key, unsigned level);
 /* Edge length (metres) of a node at `level`: resolution * 2^level. A level above depth_levels
  * saturates to depth_levels (the root's edge, the whole map); NULL map: 0. */

@@ -133,12 +133,14 @@ occ_vec3_t occ_map_key_center(const occ_map_t *const map, const occ_key_t key, c
 {
     /* Above depth_levels both the key mask and occ_map_node_size saturate: the root's centre. */
     const occ_key_t base = occ_key_at_level(key, level);
-    const int32_t half = (int32_t)1 << (map->cfg.depth_levels - 1u);
+    /* 64-bit: a caller key >= 2^31 (off the map) must not overflow; it gets the centre it
+     * would have, outside the map. */
+    const int64_t half = (int64_t)1 << (map->cfg.depth_levels - 1u);
     const float res = map->cfg.resolution_m;
     const float offset = 0.5f * occ_map_node_size(map, level);
     occ_vec3_t c;
-    c.x = (float)((int32_t)base.k[0] - half) * res + offset;
-    c.y = (float)((int32_t)base.k[1] - half) * res + offset;
-    c.z = (float)((int32_t)base.k[2] - half) * res + offset;
+    c.x = (float)((int64_t)base.k[0] - half) * res + offset;
+    c.y = (float)((int64_t)base.k[1] - half) * res + offset;
+    c.z = (float)((int64_t)base.k[2] - half) * res + offset;
     return c;
 }
