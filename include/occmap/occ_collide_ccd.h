@@ -31,7 +31,9 @@ typedef enum { OCC_CCD_GJK = 0, OCC_CCD_MPR = 1 } occ_ccd_algo_t;
  * OCC_UNKNOWN_UNSAFE)? The tree is walked over the box bmin..bmax with the blocking predicate;
  * every blocking node found there is tested against the shape with libccd (tolerance: libccd's
  * default epsilon, so shapes within ~1e-6 m of a node may go either way).
- * OCC_ERR_ARG for NULL, a NULL support, NaN, bmin > bmax, a bad policy or algo. */
+ * OCC_ERR_ARG for NULL, a NULL support, NaN, bmin > bmax, a bad policy or algo; OCC_ERR_STATE
+ * when the support function wrote the map during the check. `out` (when non-NULL) reads unsafe
+ * on every error: safe is set false on entry and true only once every blocking node was tested. */
 occ_err_t occ_collide_convex(const occ_map_t *map, const occ_convex_t *shape,
                              occ_unknown_policy_t policy, occ_ccd_algo_t algo,
                              occ_collision_t *out);
