@@ -353,9 +353,9 @@ typedef struct {
 void occ_map_node_root(const occ_map_t *map, occ_node_t *out);
 /* Child `slot` (0..7: bit 0 = +x half, bit 1 = +y, bit 2 = +z) of `parent`. A uniform parent's
  * children are reported with the parent's value (as if expanded). OCC_ERR_ARG for NULL, a
- * parent level of 0 or above depth_levels, a slot > 7; OCC_ERR_STATE when the map was written (or cleared) since `parent` was made:
- * nothing is read from the tree and `out` (when non-NULL) gets an unobserved, UNKNOWN node
- * without children, still stale. */
+ * parent level of 0 or above depth_levels, a slot > 7; OCC_ERR_STATE when the map was written
+ * (or cleared) since `parent` was made. On either error nothing is read from the tree and `out`
+ * (when non-NULL) gets an unobserved, UNKNOWN node without children that is itself stale. */
 occ_err_t occ_map_node_child(const occ_map_t *map, const occ_node_t *parent, unsigned slot,
                              occ_node_t *out);
 

@@ -39,7 +39,7 @@ occ_err_t occ_map_node_child(const occ_map_t *const map, const occ_node_t *const
 {
     if (map == NULL || parent == NULL || out == NULL || parent->level == 0u ||
         parent->level > map->cfg.depth_levels || slot > 7u) { /* the level is shifted by below */
-        if (out != NULL) {
+        if (out != NULL) { /* unknown, and stale on purpose: nothing below it is followed */
             const occ_key_t zero = {{0u, 0u, 0u}};
             fill_unknown(out, zero, 0u, map != NULL ? map->write_gen - 1u : 0u);
         }
