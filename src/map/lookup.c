@@ -100,18 +100,26 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
     return occ_q_state(m, lk->val);
 }
 
-occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
+/* Both public forms share this body, inlined: the cursor is on the hot path of trajectories. */
+static inline occ_err_t lookup(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
 {
-    occ_state_t s = OCC_STATE_UNKNOWN;
     occ_err_t e = occ_lookup_status(lk);
+    *state = OCC_STATE_UNKNOWN;
     if (e == OCC_OK) {
         occ_key_t k;
         if (point_key(lk->map, p, &k)) {
-            s = cached_state(lk, k);
+            *state = cached_state(lk, k);
         } else {
             e = occ_q_finite3(p) ? OCC_ERR_RANGE : OCC_ERR_ARG;
         }
     }
+    return e;
+}
+
+occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
+{
+    occ_state_t s;
+    const occ_err_t e = lookup(lk, p, &s);
     if (state != NULL) {
         *state = s;
     }
@@ -121,6 +129,6 @@ occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
 occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
 {
     occ_state_t s;
-    (void)occ_lookup_read(lk, p, &s); /* every error answers UNKNOWN */
+    (void)lookup(lk, p, &s); /* every error answers UNKNOWN */
     return s;
 }
