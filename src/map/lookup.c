@@ -100,35 +100,29 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
     return occ_q_state(m, lk->val);
 }
 
-/* Both public forms share this body, inlined: the cursor is on the hot path of trajectories. */
-static inline occ_err_t lookup(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
+occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
 {
-    occ_err_t e = occ_lookup_status(lk);
-    *state = OCC_STATE_UNKNOWN;
-    if (e == OCC_OK) {
-        occ_key_t k;
-        if (point_key(lk->map, p, &k)) {
-            *state = cached_state(lk, k);
-        } else {
-            e = occ_q_finite3(p) ? OCC_ERR_RANGE : OCC_ERR_ARG;
-        }
+    occ_key_t k;
+    if (occ_lookup_status(lk) != OCC_OK || !point_key(lk->map, p, &k)) {
+        return OCC_STATE_UNKNOWN; /* stale cursor, NULL, NaN or off the map */
     }
-    return e;
+    return cached_state(lk, k);
 }
 
+/* The key is computed twice here, so that occ_lookup_state, the hot path of trajectories, keeps
+ * the only (inlined) copy of the cursor's body. */
 occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
 {
-    occ_state_t s;
-    const occ_err_t e = lookup(lk, p, &s);
+    occ_state_t s = OCC_STATE_UNKNOWN;
+    occ_err_t e = occ_lookup_status(lk);
+    occ_key_t k;
+    if (e == OCC_OK && !point_key(lk->map, p, &k)) {
+        e = occ_q_finite3(p) ? OCC_ERR_RANGE : OCC_ERR_ARG;
+    } else if (e == OCC_OK) {
+        s = occ_lookup_state(lk, p);
+    }
     if (state != NULL) {
         *state = s;
     }
     return e;
-}
-
-occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
-{
-    occ_state_t s;
-    (void)lookup(lk, p, &s); /* every error answers UNKNOWN */
-    return s;
 }
