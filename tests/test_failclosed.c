@@ -625,6 +625,37 @@ static void test_reads_and_refused_writes_keep_handles(void **state)
     assert_true(occ_walk_next(&w, &wn));
 }
 
+/* occ_lookup_read names the error occ_lookup_state hides, with UNKNOWN; NULL handles are ARG. */
+static void test_lookup_read_errors(void **state)
+{
+    (void)state;
+    make_map();
+    occ_lookup_t lk;
+    occ_lookup_init(&lk, &map);
+    occ_state_t s = OCC_STATE_FREE;
+    assert_int_equal(occ_lookup_read(&lk, v3(NAN, 0.f, 0.f), &s), OCC_ERR_ARG);
+    assert_int_equal(s, OCC_STATE_UNKNOWN);
+    s = OCC_STATE_FREE;
+    assert_int_equal(occ_lookup_read(&lk, v3(0.f, 0.f, INFINITY), &s), OCC_ERR_ARG);
+    assert_int_equal(s, OCC_STATE_UNKNOWN);
+    s = OCC_STATE_FREE;
+    assert_int_equal(occ_lookup_read(&lk, v3(0.f, 3276.8f, 0.f), &s), OCC_ERR_RANGE); /* edge */
+    assert_int_equal(s, OCC_STATE_UNKNOWN);
+    assert_int_equal(occ_lookup_read(&lk, P_FREE, &s), OCC_OK);
+    assert_int_equal(s, OCC_STATE_FREE);
+    assert_int_equal(occ_lookup_read(&lk, P_OCC, NULL), OCC_OK);
+    assert_int_equal(occ_lookup_read(NULL, P_OCC, &s), OCC_ERR_ARG);
+    assert_int_equal(s, OCC_STATE_UNKNOWN);
+    assert_int_equal(occ_lookup_state(NULL, P_OCC), OCC_STATE_UNKNOWN);
+    assert_int_equal(occ_lookup_status(NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_query_status(NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_walk_status(NULL), OCC_ERR_ARG);
+    occ_query_node_t n;
+    bool found = true;
+    assert_int_equal(occ_nearest_next(NULL, &n, NULL, &found), OCC_ERR_ARG);
+    assert_false(found);
+}
+
 /* The bug the generation guards against: a cursor kept over occ_map_clear() and a refill of the
  * arena with other content. Random refills; ASan would see a read outside the arena if a stale
  * index were followed, and the answers must be UNKNOWN / done. Seed printed, OCC_SEED repeats. */
@@ -778,6 +809,7 @@ int main(void)
         cmocka_unit_test_teardown(test_stale_after_clear, teardown),
         cmocka_unit_test_teardown(test_stale_after_io_read, teardown),
         cmocka_unit_test_teardown(test_reads_and_refused_writes_keep_handles, teardown),
+        cmocka_unit_test_teardown(test_lookup_read_errors, teardown),
         cmocka_unit_test_teardown(test_stale_over_refill, teardown),
         cmocka_unit_test_teardown(test_levels_saturate, teardown),
         cmocka_unit_test_teardown(test_key_center_off_map, teardown),
