@@ -174,7 +174,8 @@ typedef struct {
      * insert and integrate, set, forget, evict, clear, read into the map). Handles that keep
      * block indices between calls (occ_lookup_t, occ_query_iter_t, occ_nearest_t, occ_walk_t,
      * occ_node_t) record it when made and answer OCC_ERR_STATE once it moved. occ_map_init()
-     * starts it at 0: handles taken before a re-init of the same struct are not detected. */
+     * (and occ_io_load(), which initializes) restarts it: handles taken before a re-init of the
+     * same struct are not detected, so drop them with the old map. */
     uint32_t write_gen;
 } occ_map_t;
 
