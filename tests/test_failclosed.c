@@ -656,6 +656,31 @@ static void test_lookup_read_errors(void **state)
     assert_false(found);
 }
 
+/* An iterator whose begin was refused (the error ignored) reports nothing and reads nothing,
+ * whatever the caller's memory held before. */
+static void test_refused_iterators_report_nothing(void **state)
+{
+    (void)state;
+    make_map();
+    occ_volume_t v;
+    assert_int_equal(occ_volume_sphere(&v, P_FREE, 1.f), OCC_OK);
+    occ_query_iter_t it;
+    memset(&it, 0x5A, sizeof it);
+    const occ_pred_t bad = {0x10u, 0u, 0u};
+    assert_int_equal(occ_query_begin(&it, &map, &v, bad), OCC_ERR_ARG);
+    occ_query_node_t n;
+    assert_false(occ_query_next(&it, &n));
+    assert_int_equal(occ_query_status(&it), OCC_ERR_ARG);
+    occ_nearest_t nit;
+    memset(&nit, 0x5A, sizeof nit);
+    occ_nearest_entry_t buf[8];
+    const occ_pred_t any = {0u, 0u, 0u};
+    assert_int_equal(occ_nearest_begin(&nit, &map, P_FREE, -1.f, any, buf, 8), OCC_ERR_ARG);
+    bool found = true;
+    assert_int_equal(occ_nearest_next(&nit, &n, NULL, &found), OCC_ERR_ARG);
+    assert_false(found);
+}
+
 /* The bug the generation guards against: a cursor kept over occ_map_clear() and a refill of the
  * arena with other content. Random refills; ASan would see a read outside the arena if a stale
  * index were followed, and the answers must be UNKNOWN / done. Seed printed, OCC_SEED repeats. */
@@ -810,6 +835,7 @@ int main(void)
         cmocka_unit_test_teardown(test_stale_after_io_read, teardown),
         cmocka_unit_test_teardown(test_reads_and_refused_writes_keep_handles, teardown),
         cmocka_unit_test_teardown(test_lookup_read_errors, teardown),
+        cmocka_unit_test_teardown(test_refused_iterators_report_nothing, teardown),
         cmocka_unit_test_teardown(test_stale_over_refill, teardown),
         cmocka_unit_test_teardown(test_levels_saturate, teardown),
         cmocka_unit_test_teardown(test_key_center_off_map, teardown),

@@ -139,7 +139,8 @@ typedef struct {
 } occ_query_iter_t;
 
 /* Start iterating the nodes of `map` that intersect `vol` and match `pred`. OCC_ERR_ARG for
- * NULL, bad states bits, min_level > depth_levels. O(1). */
+ * NULL, bad states bits, min_level > depth_levels; a refused iterator reports nothing
+ * (occ_query_next false, occ_query_status OCC_ERR_ARG). O(1). */
 occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_volume_t *vol,
                           occ_pred_t pred);
 /* Next node; false when done. Amortized O(depth) per node touched. Also false, without reading
@@ -147,7 +148,8 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
  * safety answer from the nodes seen must then check occ_query_status(). */
 bool occ_query_next(occ_query_iter_t *it, occ_query_node_t *out);
 /* OCC_OK while the iterator is valid, OCC_ERR_STATE once the map was written since
- * occ_query_begin() (the nodes reported may then be incomplete), OCC_ERR_ARG for NULL. O(1). */
+ * occ_query_begin() (the nodes reported may then be incomplete), OCC_ERR_ARG for NULL or an
+ * iterator occ_query_begin() refused. O(1). */
 occ_err_t occ_query_status(const occ_query_iter_t *it);
 
 /* Voxels (level 0) of the map inside `vol`, by state. Whole nodes inside the volume count
@@ -211,7 +213,8 @@ typedef struct {
 /* Start a nearest-first search from `p` over nodes within `max_dist_m` (>= 0) that match `pred`
  * (OCC_ITER_SPLIT is ignored: uniform nodes come whole, at their distance). `buf` holds `cap`
  * entries (a few hundred suffice for max_dist of a few metres; each entry is a node waiting to
- * be opened). OCC_ERR_ARG for NULL, NaN, negative distance, cap == 0. p may lie outside the map. */
+ * be opened). OCC_ERR_ARG for NULL, NaN, negative distance, cap == 0 (occ_nearest_next on a
+ * refused iterator answers OCC_ERR_ARG). p may lie outside the map. */
 occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t p,
                             float max_dist_m, occ_pred_t pred, occ_nearest_entry_t *buf,
                             size_t cap);

@@ -67,6 +67,9 @@ occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t 
                             float max_dist_m, occ_pred_t pred, occ_nearest_entry_t *buf,
                             size_t cap)
 {
+    if (it != NULL) {
+        it->map = NULL; /* refused: occ_nearest_next answers OCC_ERR_ARG */
+    }
     if (it == NULL || map == NULL || buf == NULL || cap == 0u || !occ_q_finite3(p) ||
         !occ_q_finite(max_dist_m) || max_dist_m < 0.0f || (pred.states & ~OCC_PRED_ANY) != 0u ||
         pred.min_level > map->cfg.depth_levels) {
@@ -103,7 +106,7 @@ occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist
     if (found != NULL) {
         *found = false;
     }
-    if (it == NULL || out == NULL || found == NULL) {
+    if (it == NULL || it->map == NULL || out == NULL || found == NULL) {
         return OCC_ERR_ARG;
     }
     const occ_map_t *const m = it->map;

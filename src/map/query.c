@@ -94,6 +94,9 @@ unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsign
 occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_volume_t *vol,
                           occ_pred_t pred)
 {
+    if (it != NULL) {
+        it->map = NULL; /* refused: occ_query_next answers false, occ_query_status ARG */
+    }
     if (it == NULL || map == NULL || vol == NULL || (pred.states & ~OCC_PRED_ANY) != 0u ||
         pred.min_level > map->cfg.depth_levels || (pred.options & ~OCC_ITER_SPLIT) != 0u) {
         return OCC_ERR_ARG;
