@@ -2,9 +2,11 @@
  * fuzz_reader.c - libFuzzer harness for one reader (FUZZ_FORMAT = OCC_FORMAT_BT, _OT or
  * _SNAPSHOT, set by tests/io.mk). Properties: no crash or sanitizer report on any input; an
  * input the reader accepts gives a map that passes occ_map_check(), whose rewrite in the same
- * format is accepted again; a refused input leaves the destination map untouched.
+ * format is accepted again; a refused input leaves the destination map untouched. The core is
+ * built with live asserts (tests/io.mk): no input may break an internal invariant either.
  */
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,6 +17,17 @@
 #endif
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* OCC_ASSERT's hook (tests/support/occ_test_config.h) without CMocka: a failed invariant is a
+ * finding, reported and ended like a crash so libFuzzer keeps the input. */
+void mock_assert(const int result, const char *const expression, const char *const file,
+                 const int line)
+{
+    if (!result) {
+        fprintf(stderr, "%s:%d: OCC_ASSERT(%s) failed\n", file, line, expression);
+        abort();
+    }
+}
 
 static uint8_t arena[1u << 20] __attribute__((aligned(8)));
 static uint8_t arena2[1u << 20] __attribute__((aligned(8)));
