@@ -348,7 +348,8 @@ typedef struct {
 void occ_map_node_root(const occ_map_t *map, occ_node_t *out);
 /* Child `slot` (0..7: bit 0 = +x half, bit 1 = +y, bit 2 = +z) of `parent`. A uniform parent's
  * children are reported with the parent's value (as if expanded). OCC_ERR_ARG for level 0 or a
- * slot > 7. */
+ * slot > 7, and for a handle that cannot be a node of this map (level above the root, or a child
+ * block the map never carved). */
 occ_err_t occ_map_node_child(const occ_map_t *map, const occ_node_t *parent, unsigned slot,
                              occ_node_t *out);
 
