@@ -4,9 +4,10 @@
  * (through tree_internal.h) the way a core bug would, then proves that the path which trusts the
  * map stops at the broken invariant (expect_assert_failure) before it dereferences a block out of
  * the arena: read paths (state_at, read_key, the lookup cursor, castRay's cursor, the walk), a
- * write path, the pools' allocator, a walk's stack bound. The auditor, occ_map_check(), must
- * instead report the same damage as OCC_ERR_CORRUPT without asserting. That ordinary use fires
- * no assert is the rest of the suite, which runs on the same build.
+ * write path, the pools' allocator, stack bounds (release, the file readers' tree builder),
+ * level and slot ranges. The auditor, occ_map_check(), must instead report the same damage as
+ * OCC_ERR_CORRUPT without asserting. That ordinary use fires no assert is the rest of the suite,
+ * which runs on the same build.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,6 +19,7 @@
 
 #include "occmap/occmap.h"
 #include "map/tree_internal.h"
+#include "map/io_internal.h"
 
 /* expect_assert_failure(call), and the assert that fired is the one named (its expression as
  * written in src/): another assert on the way would mean the path broke somewhere else first. */
@@ -264,6 +266,32 @@ static void test_release_level_out_of_range(void **state)
                      "level >= 1u && level <= m->cfg.depth_levels");
 }
 
+static void test_builder_stack_bound(void **state)
+{
+    (void)state;
+    /* The file readers drive the tree builder and guarantee it a depth <= 21; a builder told 30
+     * levels (the dry run: no map, no block touched) stops at its frame stack's bound. */
+    static occ_build_t b;
+    occ_build_begin(&b, NULL, 30u);
+    occ_build_open_root(&b);
+    for (unsigned i = 0; i < OCC_MAX_DEPTH; i++) {
+        occ_build_open(&b, 0u);
+    }
+    assert_int_equal(b.sp, OCC_MAX_DEPTH + 1u); /* every frame in use */
+    expect_assert_on(occ_build_open(&b, 0u), "level >= 1u && b->sp <= OCC_MAX_DEPTH");
+}
+
+static void test_builder_slot_range(void **state)
+{
+    (void)state;
+    static occ_build_t b;
+    occ_build_begin(&b, NULL, DEPTH);
+    occ_build_open_root(&b);
+    expect_assert_on(occ_build_leaf(&b, 8u, 0), "b->sp >= 1u && slot < 8u");
+    occ_build_leaf(&b, 7u, 0); /* slot 7 is the last one */
+    assert_int_equal(b.st[0].set, 0x80u);
+}
+
 static void test_node_child_foreign_handle_is_an_error(void **state)
 {
     (void)state;
@@ -298,6 +326,8 @@ int main(void)
         T(test_pool_alloc_counters_broken),
         T(test_release_stack_bound),
         T(test_release_level_out_of_range),
+        T(test_builder_stack_bound),
+        T(test_builder_slot_range),
         T(test_node_child_foreign_handle_is_an_error),
     };
 #undef T
