@@ -25,9 +25,9 @@ HOST_WARN := $(WARN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 CXXWARN := -std=c++14 -Wall -Wextra -Werror -Wno-deprecated-copy -Wno-class-memaccess
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 INC := -Iinclude -Isrc
-# Live asserts for test builds of the core: OCC_ASSERT -> CMocka's mock_assert (a program that
-# links such a build links libcmocka or defines mock_assert). Release and cross builds keep
-# OCC_ASSERT at nothing. Defined before the fragments so they can use it.
+# Live asserts for test builds of the core: OCC_ASSERT -> mock_assert (libcmocka's in CMocka
+# tests; other programs linking such a build include tests/support/occ_assert_abort.h). Release
+# and cross builds keep OCC_ASSERT at nothing. Defined before the fragments so they can use it.
 OCC_TEST_ASSERTS := -iquote tests/support -DOCC_CONFIG_HEADER='"occ_test_config.h"'
 
 # Package lists: fragments append. apt is only called when something is missing.

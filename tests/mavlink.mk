@@ -36,7 +36,7 @@ TEST_BUILD_EXTRA += $(MAV_REF)/tlog_ref.txt $(MAV_REF)/py_frames.bin $(MAV_REF)/
 
 # A small host program that writes C-encoded frames for pymavlink to check.
 $(MAV_REF)/mav_dump: $(BUILD)/asanhost/tests/mavlink/mav_dump.o $(BUILD)/asan/libocc.a
-	$(CC) $(SAN) -o $@ $^ -lcmocka -lm
+	$(CC) $(SAN) -o $@ $^ -lm
 
 # C encoder -> pymavlink decoder, field by field.
 test-mavlink-roundtrip: $(MAV_REF)/mav_dump $(BUILD)/.deps-ok

@@ -6,28 +6,17 @@
  * built with live asserts (tests/io.mk): no input may break an internal invariant either.
  */
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "occmap/occmap.h"
+#include "../support/occ_assert_abort.h" /* a failed OCC_ASSERT is a finding: abort */
 
 #ifndef FUZZ_FORMAT
 #error "define FUZZ_FORMAT"
 #endif
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
-/* OCC_ASSERT's hook (tests/support/occ_test_config.h) without CMocka: a failed invariant is a
- * finding, reported and ended like a crash so libFuzzer keeps the input. */
-void mock_assert(const int result, const char *const expression, const char *const file,
-                 const int line)
-{
-    if (!result) {
-        fprintf(stderr, "%s:%d: OCC_ASSERT(%s) failed\n", file, line, expression);
-        abort();
-    }
-}
 
 static uint8_t arena[1u << 20] __attribute__((aligned(8)));
 static uint8_t arena2[1u << 20] __attribute__((aligned(8)));

@@ -3,8 +3,9 @@
  * Makefile): OCC_ASSERT is live and reports through CMocka's mock_assert(), so a broken internal
  * invariant fails the running test, and expect_assert_failure() can prove an assert fires.
  * src/ never includes cmocka.h: mock_assert's prototype (as in cmocka.h 1.1.5) is declared here.
- * A program that links the test build of the core links libcmocka (outside a CMocka test, a
- * failed mock_assert prints "file:line: error: Failure!" and exits with status 255).
+ * A CMocka test gets mock_assert from libcmocka; any other program linking a test build of the
+ * core (the soak, the fuzz harnesses) includes tests/support/occ_assert_abort.h in one file,
+ * which defines a mock_assert that prints and aborts (libcmocka's would exit 255 silently).
  */
 #ifndef OCC_TEST_CONFIG_H_INCLUDED
 #define OCC_TEST_CONFIG_H_INCLUDED
