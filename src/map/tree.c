@@ -29,6 +29,7 @@ static occ_value_t max_of8(const occ_value_t *const v)
 void occ_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
     OCC_ASSERT(level >= 1u && *node.child == OCC_NONE);
+    OCC_ASSERT(level <= m->cfg.depth_levels);
     const occ_value_t v = *node.value;
     if (level == 1u) {
         const uint32_t idx = occ_pool_alloc_leaf(m);
