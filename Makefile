@@ -25,6 +25,10 @@ HOST_WARN := $(WARN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 CXXWARN := -std=c++14 -Wall -Wextra -Werror -Wno-deprecated-copy -Wno-class-memaccess
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 INC := -Iinclude -Isrc
+# Live asserts for test builds of the core: OCC_ASSERT -> mock_assert (libcmocka's in CMocka
+# tests; other programs linking such a build include tests/support/occ_assert_abort.h). Release
+# and cross builds keep OCC_ASSERT at nothing. Defined before the fragments so they can use it.
+OCC_TEST_ASSERTS := -iquote tests/support -DOCC_CONFIG_HEADER='"occ_test_config.h"'
 
 # Package lists: fragments append. apt is only called when something is missing.
 APT_PKGS := build-essential libcmocka-dev liboctomap-dev octomap-tools libccd-dev libeigen3-dev \
@@ -76,7 +80,7 @@ $(DEPS_STAMP): Makefile $(wildcard port/*.mk tests/*.mk tools/*.mk bench/*.mk)
 
 # ---- the library (release and sanitizer builds) ------------------------------------------------
 REL_CFLAGS := $(WARN) -O2 -g $(INC)
-ASAN_CFLAGS := $(WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1
+ASAN_CFLAGS := $(WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 $(OCC_TEST_ASSERTS)
 
 $(BUILD)/rel/%.o: %.c
 	@mkdir -p $(dir $@)

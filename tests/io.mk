@@ -36,7 +36,7 @@ fuzz_fmt_ot := OCC_FORMAT_OT
 fuzz_fmt_occ := OCC_FORMAT_SNAPSHOT
 
 IO_FUZZ_FLAGS := -std=c99 -O1 -g -fsanitize=fuzzer-no-link,address,undefined \
-                 -fno-sanitize-recover=all -DOCC_TESTING=1 $(INC)
+                 -fno-sanitize-recover=all -DOCC_TESTING=1 $(OCC_TEST_ASSERTS) $(INC)
 IO_FUZZ_CORE := $(OCC_CORE_SRC:%.c=$(IO_FUZZ_DIR)/obj/%.o)
 $(IO_FUZZ_DIR)/obj/%.o: %.c
 	@mkdir -p $(dir $@)

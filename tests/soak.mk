@@ -15,7 +15,7 @@ $(SOAK_BIN): $(BUILD)/relhost/tests/soak/soak.o $(PORT_SRC:%.c=$(BUILD)/relhost/
 SOAK_LIB_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC) $(OCC_CCD_SRC)
 $(BUILD)/asansoak/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 -DOCC_POOL_PARANOID=0 $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
+	$(CC) $(WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 $(OCC_TEST_ASSERTS) -DOCC_POOL_PARANOID=0 $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
 $(BUILD)/asansoak/libocc.a: $(SOAK_LIB_SRC:%.c=$(BUILD)/asansoak/%.o)
 	@rm -f $@
 	$(AR) rcs $@ $^

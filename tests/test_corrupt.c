@@ -193,6 +193,22 @@ static void test_counters(void **state)
     expect_corrupt("leaf used/free_count shifted together");
 }
 
+/* The auditor must survive any bytes (OCC_ASSERT is live in this build: an index or depth it
+ * followed unchecked would fail the test instead of returning CORRUPT). */
+static void test_depth_out_of_range(void **state)
+{
+    (void)state;
+    static const uint8_t bad[] = {0u, OCC_MAX_DEPTH + 1u, 0xFFu};
+    for (size_t i = 0; i < sizeof bad; i++) {
+        map.cfg.depth_levels = bad[i];
+        expect_corrupt("depth_levels outside 1..21");
+    }
+    map.cfg.depth_levels = 3u; /* valid, but one less than the tree's: levels run out */
+    expect_corrupt("depth_levels one below the tree's");
+    map.cfg.depth_levels = 5u;
+    expect_corrupt("depth_levels one above the tree's");
+}
+
 static void test_leaked_block(void **state)
 {
     (void)state;
@@ -203,7 +219,7 @@ static void test_leaked_block(void **state)
     expect_corrupt("leaked inner block (from the free list)");
     map.leaf.free_head = OCC_NONE;
     map.leaf.free_count = 0u;
-    (void)occ_pool_alloc_leaf(&map);
+    map.leaf.hwm++; /* one more block carved (by hand: the allocator asserts on these counters) */
     map.leaf.used = map.leaf.hwm - 0u; /* consistent counters, unreachable blocks */
     map.leaf.peak = map.leaf.used;
     expect_corrupt("free list dropped: blocks neither used nor free");
@@ -319,7 +335,7 @@ int main(void)
 #define T(f) cmocka_unit_test_setup_teardown(f, setup_map, teardown_map)
     const struct CMUnitTest tests[] = {
         T(test_undamaged),          T(test_free_list_cycles),        T(test_free_list_foreign),
-        T(test_counters),           T(test_leaked_block),            T(test_wrong_values),
+        T(test_counters),           T(test_depth_out_of_range),      T(test_leaked_block),            T(test_wrong_values),
         T(test_wrong_indicators),   T(test_unpruned_equal_block),    T(test_child_index_out_of_range),
         T(test_shared_and_freed_blocks),
     };

@@ -53,7 +53,21 @@ extern "C" {
  *                      keys can then differ from OctoMap's for points within ~1e-7 relative
  *                      of a voxel border.
  * OCC_USE_BMI2      1: Morton interleave with the x86 BMI2 pdep/pext instructions.
- * OCC_ASSERT(x)     internal-invariant check; defaults to nothing (map it to mock_assert in tests).
+ * OCC_ASSERT(x)     internal-invariant check (memory-guarding invariants: an allocation result, a
+ *                   block index below its pool's high-water mark before every dereference, level
+ *                   and slot ranges, walk stack depths). Never for caller mistakes: those are
+ *                   error codes. Default: nothing (x is not evaluated, only type-checked by
+ *                   sizeof, so release and firmware code is unchanged and variables that only
+ *                   an assert reads do not warn). x has no side effects.
+ *                   Tests (the ASan build, OCC_TESTING) define it in the OCC_CONFIG_HEADER
+ *                   tests/support/occ_test_config.h as CMocka's mock_assert(), so a broken
+ *                   invariant fails the test and expect_assert_failure() can prove one fires.
+ *                   A firmware build maps it in its own OCC_CONFIG_HEADER, e.g. to a trap that
+ *                   stops the vehicle's map task at the fault (the debugger or the HardFault
+ *                   handler then has the PC of the failed check):
+ *                     #define OCC_ASSERT(x) ((x) ? (void)0 : __builtin_trap())
+ *                   or to the RTOS's own assert hook. The map is then no longer trusted:
+ *                   occ_map_check() tells whether it can be kept.
  */
 #ifndef OCC_VALUE_FLOAT
 #define OCC_VALUE_FLOAT 0
@@ -69,7 +83,7 @@ extern "C" {
 #define OCC_USE_BMI2 0
 #endif
 #ifndef OCC_ASSERT
-#define OCC_ASSERT(x) ((void)0)
+#define OCC_ASSERT(x) ((void)sizeof((x) ? 1 : 0))
 #endif
 
 #define OCC_MAX_DEPTH 21u         /* 3 x 21 bits of key fit a 63-bit Morton code. */
@@ -354,9 +368,10 @@ typedef struct {
 void occ_map_node_root(const occ_map_t *map, occ_node_t *out);
 /* Child `slot` (0..7: bit 0 = +x half, bit 1 = +y, bit 2 = +z) of `parent`. A uniform parent's
  * children are reported with the parent's value (as if expanded). OCC_ERR_ARG for NULL, a
- * parent level of 0 or above depth_levels, a slot > 7; OCC_ERR_STATE when the map was written
- * (or cleared) since `parent` was made. On either error nothing is read from the tree and `out`
- * (when non-NULL) gets an unobserved, UNKNOWN node without children that is itself stale. */
+ * parent level of 0 or above depth_levels, a slot > 7, or a child block the map never carved;
+ * OCC_ERR_STATE when the map was written (or cleared) since `parent` was made. On either error
+ * nothing is read from the tree and `out` (when non-NULL) gets an unobserved, UNKNOWN node
+ * without children that is itself stale. */
 occ_err_t occ_map_node_child(const occ_map_t *map, const occ_node_t *parent, unsigned slot,
                              occ_node_t *out);
 

@@ -41,10 +41,12 @@ static void descend(cursor_t *c, unsigned level)
     const uint32_t k2 = c->key[2];
     const occ_inner_block_t *const top = c->inner_top;
     const unsigned stop = c->stop;
+    OCC_ASSERT(level >= 1u && level <= c->m->cfg.depth_levels);
     uint32_t b = c->blk[level];
     while (level > 1u) {
         const unsigned l = level - 1u;
         const unsigned slot = ((k0 >> l) & 1u) | (((k1 >> l) & 1u) << 1) | (((k2 >> l) & 1u) << 2);
+        OCC_ASSERT(b < c->m->inner.hwm);
         const occ_inner_block_t *const ib = top - b; /* occ_inner_at(m, b) */
         const uint32_t ch = ib->child[slot];
         if (ch == OCC_NONE || (ib->flags[slot] & stop) == 0u) {
@@ -57,6 +59,7 @@ static void descend(cursor_t *c, unsigned level)
         level = l;
     }
     c->lu = 0;
+    OCC_ASSERT(b < c->m->leaf.hwm);
     c->val = c->leaf_base[b].value[(k0 & 1u) | ((k1 & 1u) << 1) | ((k2 & 1u) << 2)];
 }
 
@@ -64,8 +67,8 @@ static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3], 
 {
     c->m = m;
     c->stop = stop;
-    c->inner_top = occ_inner_at(m, 0u);
-    c->leaf_base = occ_leaf_at(m, 0u);
+    c->inner_top = occ_inner_base(m);
+    c->leaf_base = occ_leaf_base(m);
     c->key[0] = key[0];
     c->key[1] = key[1];
     c->key[2] = key[2];

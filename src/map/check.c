@@ -117,6 +117,11 @@ occ_err_t occ_map_check(const occ_map_t *const m)
                    ? OCC_OK
                    : OCC_ERR_CORRUPT;
     }
+    /* The auditor survives any bytes: depth, counters and every index are range-checked here
+     * before they are followed, so the accessors' asserts never see a bad one from this walk. */
+    if (depth < 1u || depth > OCC_MAX_DEPTH) {
+        return OCC_ERR_CORRUPT;
+    }
     const uint32_t root_hwm = depth == 1u ? m->leaf.hwm : m->inner.hwm;
     if (m->root_child >= root_hwm ||
         !check_block(m, m->root_child, depth, m->root_value, m->root_flags)) {

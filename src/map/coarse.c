@@ -52,6 +52,7 @@ static occ_nodep_t node_at(occ_map_t *const m, const uint32_t block, const unsig
 static void apply_subtree(occ_map_t *const m, const uint32_t block, const unsigned slot,
                           const unsigned level, const occ_value_t delta)
 {
+    OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
     const occ_nodep_t top = node_at(m, block, slot);
     if (*top.child == OCC_NONE) {
         apply_uniform(m, top, delta);

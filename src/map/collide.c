@@ -53,6 +53,7 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
             occ_q_fill_node(m, ck, l, e.value, e.flags, true, out);
             return true;
         }
+        OCC_ASSERT(sp < OCC_MAX_DEPTH && l >= 1u);
         frame_t *const nf = &st[sp++];
         nf->block = e.child;
         nf->key = ck;

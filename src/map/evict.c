@@ -207,6 +207,7 @@ static bool children_childless(const occ_map_t *const m, const uint32_t block)
 
 static void push(occ_evict_cursor_t *const cur, const uint32_t block, const occ_code_t base)
 {
+    OCC_ASSERT(cur->sp <= OCC_MAX_DEPTH);
     const unsigned i = cur->sp++;
     cur->block[i] = block;
     cur->next[i] = 0u;

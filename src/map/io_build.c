@@ -74,6 +74,7 @@ static uint32_t new_block(occ_map_t *const m, const unsigned level)
 
 static void push(occ_build_t *const b, const unsigned level, const unsigned slot, const uint32_t blk)
 {
+    OCC_ASSERT(b->sp <= OCC_MAX_DEPTH && slot < 8u);
     occ_build_frame_t *const f = &b->st[b->sp++];
     f->block = blk;
     f->level = (uint8_t)level;
@@ -99,6 +100,7 @@ void occ_build_open_root(occ_build_t *const b)
 
 void occ_build_open(occ_build_t *const b, const unsigned slot)
 {
+    OCC_ASSERT(b->sp >= 1u && slot < 8u);
     occ_build_frame_t *const p = &b->st[b->sp - 1u];
     const unsigned level = p->level - 1u;
     OCC_ASSERT(level >= 1u && b->sp <= OCC_MAX_DEPTH);
@@ -127,6 +129,7 @@ static void dry_child(occ_build_frame_t *const p, const occ_value_t v, const boo
 
 void occ_build_leaf(occ_build_t *const b, const unsigned slot, const occ_value_t v)
 {
+    OCC_ASSERT(b->sp >= 1u && slot < 8u);
     occ_build_frame_t *const p = &b->st[b->sp - 1u];
     b->nodes++;
     p->set = (uint8_t)(p->set | (1u << slot));
@@ -144,6 +147,7 @@ void occ_build_leaf(occ_build_t *const b, const unsigned slot, const occ_value_t
 
 void occ_build_close(occ_build_t *const b)
 {
+    OCC_ASSERT(b->sp >= 1u);
     occ_build_frame_t *const f = &b->st[b->sp - 1u];
     const bool prune = f->set == 0xFFu && !f->any_block && occ_value_eq(f->vmin, f->vmax);
     if (prune) {

@@ -249,6 +249,7 @@ static bool has_unobserved(const occ_map_t *const m, const uint32_t block, const
             return true;
         }
         if (ib->child[i] != OCC_NONE) {
+            OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
             st[sp].block = ib->child[i];
             st[sp].level = (uint8_t)(f->level - 1u);
             st[sp].next = 0u;
@@ -345,6 +346,7 @@ void occ_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const 
         }
         f->next = (uint8_t)(i + 1u);
         const uint32_t child = occ_inner_at(m, f->block)->child[i];
+        OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
         emit_frame_t *const g = &st[sp];
         g->block = child;
         g->level = (uint8_t)(f->level - 1u);
@@ -420,6 +422,7 @@ void occ_ot_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const 
             ot_rec(s, ib->value[i], 0u);
             continue;
         }
+        OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
         emit_frame_t *const g = &st[sp];
         g->block = ib->child[i];
         g->level = (uint8_t)(f->level - 1u);

@@ -270,6 +270,7 @@ static void put_payload(const occ_map_t *const m, occ_sink_t *const s)
             continue;
         }
         f->next = (uint8_t)(i + 1u);
+        OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
         snap_frame_t *const g = &st[sp++];
         g->block = occ_inner_at(m, f->block)->child[i];
         g->level = (uint8_t)(f->level - 1u);

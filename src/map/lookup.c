@@ -17,6 +17,7 @@ static inline bool point_key(const occ_map_t *m, occ_vec3_t p, occ_key_t *k)
 static inline occ_value_t descend(const occ_map_t *m, const occ_key_t *k, unsigned level,
                                   uint32_t b, uint32_t *path, unsigned *lu)
 {
+    OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
     while (level > 1u) {
         level--;
         const occ_inner_block_t *const ib = occ_inner_at(m, b);
@@ -81,6 +82,7 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
             return occ_q_state(m, lk->val); /* same uniform node (or voxel) */
         }
         level = occ_bit_length32(x); /* highest changed bit + 1 */
+        OCC_ASSERT(level > lk->lu && level <= depth); /* blk[level] is on the cached path */
         b = lk->blk[level];
     } else {
         lk->key = k;

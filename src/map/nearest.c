@@ -126,6 +126,7 @@ occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist
             *found = true;
             return OCC_OK;
         }
+        OCC_ASSERT(top.level >= 1u && top.level <= m->cfg.depth_levels);
         const unsigned level = top.level - 1u;
         const uint32_t bit = 1u << level;
         const float h = occ_q_half(m, level);

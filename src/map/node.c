@@ -11,6 +11,16 @@ static void fill(const occ_map_t *const m, occ_node_t *const out, const occ_valu
     out->flags = (uint8_t)(flags | (children == OCC_NONE ? OCC_NODE_UNIFORM : 0u));
 }
 
+/* The handle could be a node of this map: its level is below the root's, its child block was
+ * carved (a handle of another map, or forged, otherwise). */
+static bool handle_fits(const occ_map_t *const m, const occ_node_t *const parent,
+                        const unsigned level)
+{
+    const uint32_t hwm = level == 0u ? m->leaf.hwm : m->inner.hwm;
+    return parent->level <= m->cfg.depth_levels &&
+           (parent->children == OCC_NONE || parent->children < hwm);
+}
+
 void occ_map_node_root(const occ_map_t *const map, occ_node_t *const out)
 {
     const occ_key_t zero = {{0u, 0u, 0u}};
@@ -51,6 +61,11 @@ occ_err_t occ_map_node_child(const occ_map_t *const map, const occ_node_t *const
         return OCC_ERR_STATE;
     }
     const unsigned level = parent->level - 1u;
+    if (!handle_fits(map, parent, level)) { /* a caller's handle is range-checked, not asserted */
+        const occ_node_t bad = *parent; /* out may alias parent */
+        fill_unknown(out, bad.key, bad.level, map->write_gen - 1u);
+        return OCC_ERR_ARG;
+    }
     occ_key_t key = parent->key;
     key.k[0] |= (uint32_t)(slot & 1u) << level;
     key.k[1] |= (uint32_t)((slot >> 1) & 1u) << level;

@@ -21,9 +21,17 @@ static size_t gap_bytes(const occ_map_t *const m)
            (size_t)m->leaf.hwm * sizeof(occ_leaf_block_t);
 }
 
+/* The carved blocks of both pools fit the arena (gap_bytes() did not wrap). */
+static bool pools_fit(const occ_map_t *const m)
+{
+    return (uint64_t)m->inner.hwm * sizeof(occ_inner_block_t) +
+               (uint64_t)m->leaf.hwm * sizeof(occ_leaf_block_t) <= (uint64_t)m->arena_bytes;
+}
+
 static void note_alloc(occ_pool_t *const p)
 {
     p->used++;
+    OCC_ASSERT(p->used + p->free_count == p->hwm);
     if (p->used > p->peak) {
         p->peak = p->used;
     }
@@ -40,8 +48,12 @@ bool occ_pool_can_supply(const occ_map_t *const m, const uint32_t n_inner, const
 uint32_t occ_pool_alloc_inner(occ_map_t *const m)
 {
     uint32_t idx = m->inner.free_head;
+    OCC_ASSERT(pools_fit(m));
     if (idx != OCC_NONE) {
+        OCC_ASSERT(m->inner.free_count > 0u);
+        OCC_ASSERT(occ_inner_at(m, idx)->flags[7] == OCC_INNER_FREE_MARK);
         m->inner.free_head = occ_inner_at(m, idx)->child[0];
+        OCC_ASSERT(m->inner.free_head == OCC_NONE || m->inner.free_head < m->inner.hwm);
         m->inner.free_count--;
     } else if (gap_bytes(m) >= sizeof(occ_inner_block_t)) {
         idx = m->inner.hwm++;
@@ -56,8 +68,11 @@ uint32_t occ_pool_alloc_inner(occ_map_t *const m)
 uint32_t occ_pool_alloc_leaf(occ_map_t *const m)
 {
     uint32_t idx = m->leaf.free_head;
+    OCC_ASSERT(pools_fit(m));
     if (idx != OCC_NONE) {
+        OCC_ASSERT(m->leaf.free_count > 0u);
         memcpy(&m->leaf.free_head, occ_leaf_at(m, idx)->value, sizeof(uint32_t));
+        OCC_ASSERT(m->leaf.free_head == OCC_NONE || m->leaf.free_head < m->leaf.hwm);
         m->leaf.free_count--;
     } else if (gap_bytes(m) >= sizeof(occ_leaf_block_t)) {
         idx = m->leaf.hwm++;

@@ -142,6 +142,7 @@ static inline void push(occ_query_iter_t *it, occ_key_t pkey, unsigned level, ui
                  occ_value_t uv, unsigned i)
 {
     const occ_map_t *const m = it->map;
+    OCC_ASSERT(i < OCC_MAX_DEPTH && level < m->cfg.depth_levels);
     unsigned pm;
     if (block == OCC_NONE) {
         pm = 0xFFu; /* the uniform parent matched, so does every part of it */
@@ -223,6 +224,7 @@ static bool next_start(occ_query_iter_t *it, occ_query_node_t *out)
     }
     it->istart++;
     const occ_code_t code = occ_morton_encode(key);
+    OCC_ASSERT(level <= depth);
     while (level > it->start_level && child != OCC_NONE) {
         if (check && !occ_q_contains(flags, it->pred.states)) {
             break; /* nothing wanted below: skip this node */
@@ -275,6 +277,7 @@ bool occ_query_next(occ_query_iter_t *it, occ_query_node_t *out)
             }
             const unsigned slot = occ_first_slot(mk);
             it->mask[i] = (uint8_t)(mk & (mk - 1u));
+            OCC_ASSERT(i < depth);
             const unsigned level = depth - 1u - i;
             const uint32_t bit = 1u << level;
             it->path.k[0] = (it->path.k[0] & ~bit) | ((slot & 1u) ? bit : 0u);

@@ -29,6 +29,7 @@ static occ_value_t max_of8(const occ_value_t *const v)
 void occ_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
     OCC_ASSERT(level >= 1u && *node.child == OCC_NONE);
+    OCC_ASSERT(level <= m->cfg.depth_levels);
     const occ_value_t v = *node.value;
     if (level == 1u) {
         const uint32_t idx = occ_pool_alloc_leaf(m);
@@ -58,6 +59,7 @@ bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned
     if (child == OCC_NONE) {
         return false;
     }
+    OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
     occ_value_t nv;
     uint8_t nf = 0u;
     bool prunable;
@@ -70,7 +72,8 @@ bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned
             prunable = prunable && occ_value_eq(b->value[i], b->value[0]);
         }
         if (prunable) {
-            (void)occ_pool_free_leaf(m, child);
+            const bool freed = occ_pool_free_leaf(m, child);
+            OCC_ASSERT(freed);
         }
     } else {
         const occ_inner_block_t *const b = occ_inner_at(m, child);
@@ -81,7 +84,8 @@ bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned
             prunable = prunable && b->child[i] == OCC_NONE && occ_value_eq(b->value[i], b->value[0]);
         }
         if (prunable) {
-            (void)occ_pool_free_inner(m, child);
+            const bool freed = occ_pool_free_inner(m, child);
+            OCC_ASSERT(freed);
         }
     }
     if (prunable) {
@@ -98,8 +102,10 @@ void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const
     if (*node.child == OCC_NONE) {
         return;
     }
+    OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
     if (level == 1u) {
-        (void)occ_pool_free_leaf(m, *node.child);
+        const bool freed = occ_pool_free_leaf(m, *node.child);
+        OCC_ASSERT(freed);
         *node.child = OCC_NONE;
         return;
     }
@@ -122,8 +128,10 @@ void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const
                 continue;
             }
             if (lvl[sp] == 1u) {
-                (void)occ_pool_free_leaf(m, c);
+                const bool freed = occ_pool_free_leaf(m, c);
+                OCC_ASSERT(freed);
             } else {
+                OCC_ASSERT(sp < OCC_MAX_DEPTH && lvl[sp] > 1u);
                 sp++;
                 blk[sp] = c;
                 lvl[sp] = (uint8_t)(lvl[sp - 1u] - 1u);
@@ -131,7 +139,8 @@ void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const
             }
             continue;
         }
-        (void)occ_pool_free_inner(m, blk[sp]);
+        const bool freed = occ_pool_free_inner(m, blk[sp]);
+        OCC_ASSERT(freed);
         if (sp == 0u) {
             break;
         }

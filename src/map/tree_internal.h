@@ -49,15 +49,32 @@ typedef struct {
 #define OCC_PREFETCH(addr) ((void)(addr))
 #endif
 
+/* Block accessors. Every dereference of a block goes through them (or asserts the same itself):
+ * the index names a block carved from the arena (below the pool's high-water mark). */
 static inline occ_inner_block_t *occ_inner_at(const occ_map_t *m, uint32_t idx)
 {
+    OCC_ASSERT(idx < m->inner.hwm);
     return (occ_inner_block_t *)(void *)(m->arena + m->arena_bytes -
                                          ((size_t)idx + 1u) * sizeof(occ_inner_block_t));
 }
 
 static inline occ_leaf_block_t *occ_leaf_at(const occ_map_t *m, uint32_t idx)
 {
+    OCC_ASSERT(idx < m->leaf.hwm);
     return (occ_leaf_block_t *)(void *)(m->arena + (size_t)idx * sizeof(occ_leaf_block_t));
+}
+
+/* Where block 0 of each pool is (carved or not), for walks that index from a base pointer:
+ * they assert the index against the high-water mark themselves. */
+static inline const occ_inner_block_t *occ_inner_base(const occ_map_t *m)
+{
+    return (const occ_inner_block_t *)(const void *)(m->arena + m->arena_bytes -
+                                                     sizeof(occ_inner_block_t));
+}
+
+static inline const occ_leaf_block_t *occ_leaf_base(const occ_map_t *m)
+{
+    return (const occ_leaf_block_t *)(const void *)m->arena;
 }
 
 static inline occ_nodep_t occ_root(occ_map_t *m)
@@ -71,6 +88,7 @@ static inline occ_nodep_t occ_root(occ_map_t *m)
 
 static inline occ_nodep_t occ_inner_node(const occ_map_t *m, uint32_t block, unsigned slot)
 {
+    OCC_ASSERT(slot < 8u);
     occ_inner_block_t *const b = occ_inner_at(m, block);
     occ_nodep_t n;
     n.child = &b->child[slot];
@@ -119,6 +137,7 @@ typedef struct {
 static inline occ_entry_t occ_entry_at(const occ_map_t *m, uint32_t block, unsigned level,
                                        unsigned slot)
 {
+    OCC_ASSERT(level < m->cfg.depth_levels && slot < 8u); /* blocks hold levels below the root */
     occ_entry_t e;
     if (level == 0u) {
         e.value = occ_leaf_at(m, block)->value[slot];
@@ -136,6 +155,7 @@ static inline occ_entry_t occ_entry_at(const occ_map_t *m, uint32_t block, unsig
 /* Slot (0..7) of the child at `level` - 1 that holds key `k`: bit `level` of x, y, z. */
 static inline unsigned occ_key_slot(const occ_key_t *k, unsigned level)
 {
+    OCC_ASSERT(level < OCC_MAX_DEPTH);
     return ((k->k[0] >> level) & 1u) | (((k->k[1] >> level) & 1u) << 1) |
            (((k->k[2] >> level) & 1u) << 2);
 }
@@ -171,6 +191,7 @@ static inline unsigned occ_bit_length32(uint32_t x)
 /* Child slot (0..7) of voxel `code` inside its ancestor at `level` (>= 1). */
 static inline unsigned occ_code_slot(occ_code_t code, unsigned level)
 {
+    OCC_ASSERT(level >= 1u && level <= OCC_MAX_DEPTH);
     return (unsigned)((code >> (3u * (level - 1u))) & 7u);
 }
 

@@ -28,6 +28,7 @@ static occ_code_t child_code(const occ_code_t code, const unsigned slot, const u
 
 static void push(occ_walk_t *const w, const uint32_t block, const unsigned level)
 {
+    OCC_ASSERT(w->sp <= OCC_MAX_DEPTH && level < w->map->cfg.depth_levels);
     w->stack[w->sp].block = block;
     w->stack[w->sp].level = (uint8_t)level;
     w->stack[w->sp].next = 0u;

@@ -2,13 +2,15 @@
  * fuzz_reader.c - libFuzzer harness for one reader (FUZZ_FORMAT = OCC_FORMAT_BT, _OT or
  * _SNAPSHOT, set by tests/io.mk). Properties: no crash or sanitizer report on any input; an
  * input the reader accepts gives a map that passes occ_map_check(), whose rewrite in the same
- * format is accepted again; a refused input leaves the destination map untouched.
+ * format is accepted again; a refused input leaves the destination map untouched. The core is
+ * built with live asserts (tests/io.mk): no input may break an internal invariant either.
  */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "occmap/occmap.h"
+#include "../support/occ_assert_abort.h" /* a failed OCC_ASSERT is a finding: abort */
 
 #ifndef FUZZ_FORMAT
 #error "define FUZZ_FORMAT"
