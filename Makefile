@@ -30,7 +30,8 @@ INC := -Iinclude -Isrc
 # and cross builds keep OCC_ASSERT at nothing. Defined before the fragments so they can use it.
 OCC_TEST_ASSERTS := -iquote tests/support -DOCC_CONFIG_HEADER='"occ_test_config.h"'
 
-# Package lists: fragments append. apt is only called when something is missing.
+# Package lists: fragments append. apt is only called when something is missing; a package
+# named pkg:ARCH (tests/i386.mk) adds ARCH to dpkg's architectures first if it is not there.
 APT_PKGS := build-essential libcmocka-dev liboctomap-dev octomap-tools libccd-dev libeigen3-dev \
             libpng-dev gcc-arm-none-eabi libnewlib-arm-none-eabi bzip2 python3-venv \
             qemu-system-arm valgrind clang
@@ -68,6 +69,10 @@ $(DEPS_STAMP): Makefile $(wildcard port/*.mk tests/*.mk tools/*.mk bench/*.mk)
 	if [ -n "$$missing" ]; then \
 	  echo "deps: installing$$missing"; \
 	  export DEBIAN_FRONTEND=noninteractive; \
+	  for a in $$(printf '%s\n' $$missing | sed -n 's/^[^:]*:\([a-z0-9]*\)$$/\1/p' | sort -u); do \
+	    { dpkg --print-architecture; dpkg --print-foreign-architectures; } | grep -qx "$$a" || \
+	      { echo "deps: adding architecture $$a"; dpkg --add-architecture "$$a"; }; \
+	  done; \
 	  apt-get update -q && apt-get install -y -q --no-install-recommends $$missing; \
 	fi
 	@if [ ! -x $(PY) ] || ! $(PY) -c "import pymavlink, dronecan" 2>/dev/null \
@@ -116,7 +121,8 @@ $(BUILD)/occmap: $(TOOL_SRC:%.c=$(BUILD)/relhost/%.o) $(PORT_SRC:%.c=$(BUILD)/re
 all: $(DEPS_STAMP) $(BUILD)/libocc.a $(BUILD)/occmap
 
 # ---- tests -------------------------------------------------------------------------------------
-TEST_BINS := $(TEST_C:tests/%.c=$(BUILD)/asan/tests/bin/%)
+# Fragments add binaries built elsewhere (tests/i386.mk: the same tests with a 32-bit size_t).
+TEST_BINS := $(TEST_C:tests/%.c=$(BUILD)/asan/tests/bin/%) $(TEST_BINS_EXTRA)
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/asanhost/%.o,$(patsubst %.cpp,$(BUILD)/asanhost/%.o,$(TEST_SUPPORT_SRC)))
 TEST_PORT_OBJ := $(PORT_SRC:%.c=$(BUILD)/asanhost/%.o)
 

@@ -81,7 +81,8 @@ static void test_err_str(void **state)
     (void)state;
     const occ_err_t codes[] = {OCC_OK,         OCC_ERR_ARG,   OCC_ERR_RANGE,
                                OCC_ERR_NOMEM,  OCC_ERR_FORMAT, OCC_ERR_IO,
-                               OCC_ERR_STATE,  OCC_ERR_UNSUPPORTED, OCC_ERR_CORRUPT};
+                               OCC_ERR_STATE,  OCC_ERR_UNSUPPORTED, OCC_ERR_CORRUPT,
+                               OCC_ERR_SCRATCH};
     const size_t n = sizeof codes / sizeof codes[0];
     for (size_t i = 0; i < n; i++) {
         const char *const s = occ_err_str(codes[i]);
@@ -96,7 +97,7 @@ static void test_err_str(void **state)
         assert_true((int)codes[i] < 0);
     }
     /* Codes outside the enum still give text. */
-    const int odd[] = {1, -9, -100, 12345, INT32_MIN};
+    const int odd[] = {1, -10, -100, 12345, INT32_MIN};
     for (size_t i = 0; i < sizeof odd / sizeof odd[0]; i++) {
         const char *const s = occ_err_str((occ_err_t)odd[i]);
         assert_non_null(s);

@@ -216,6 +216,7 @@ int cmd_build(int argc, char **argv)
     }
     occ_insert_result_t sum;
     memset(&sum, 0, sizeof sum);
+    size_t scratch_peak = 0; /* the most scratch one scan wrote (of `need` allocated) */
     double ms = 0.0;
     const double t_start = now_ms();
     for (size_t i = 0; rc == 0 && i < in.n; i++) {
@@ -237,6 +238,7 @@ int cmd_build(int argc, char **argv)
         sum.voxel_visits += r.voxel_visits;
         sum.voxels_updated += r.voxels_updated;
         sum.coarse_updated += r.coarse_updated;
+        scratch_peak = r.scratch_used > scratch_peak ? r.scratch_used : scratch_peak;
         if (in.n > 1u && now_ms() - t_start > 1000.0) {
             fprintf(stderr, "\roccmap build: scan %zu/%zu, %.0f ms integrating", i + 1u, in.n,
                     ms);
@@ -254,9 +256,11 @@ int cmd_build(int argc, char **argv)
             cli_print_stats_json(stdout, &map, &st);
             printf(", \"method\": \"%s\", \"scans\": %zu, \"points\": %zu, \"points_skipped\": %zu,"
                    " \"rays\": %zu, \"voxel_visits\": %zu, \"voxels_updated\": %zu,"
-                   " \"coarse_updated\": %zu, \"integrate_ms\": %.3f, ",
+                   " \"coarse_updated\": %zu, \"scratch_bytes\": %zu, \"scratch_used\": %zu,"
+                   " \"integrate_ms\": %.3f, ",
                    names[method], in.n, sum.points_integrated, sum.points_skipped, sum.rays_cast,
-                   sum.voxel_visits, sum.voxels_updated, sum.coarse_updated, ms);
+                   sum.voxel_visits, sum.voxels_updated, sum.coarse_updated, need, scratch_peak,
+                   ms);
             evict_cli_print_json(stdout, &ev);
             printf("}\n");
         } else {
@@ -265,6 +269,8 @@ int cmd_build(int argc, char **argv)
                    names[method], in.n, sum.points_integrated, sum.points_skipped, total_pts);
             printf("integrated        %zu rays, %zu voxel visits, %zu voxel updates, %.1f ms\n",
                    sum.rays_cast, sum.voxel_visits, sum.voxels_updated, ms);
+            printf("scratch           %zu bytes written at most, of %zu allocated (the bound)\n",
+                   scratch_peak, need);
         }
         if (out_path != NULL) {
             char msg[512] = "";

@@ -11,8 +11,9 @@
  *
  * Memory: no heap. The per-scan key sets live in the caller's scratch buffer. They are sorted
  * Morton codes (radix sort), de-duplicated and applied with one occ_map_observe_codes() call,
- * which touches the tree in Morton order. If the scratch cannot hold them, or the pools cannot
- * hold the result, the call returns OCC_ERR_NOMEM and the map is exactly as before.
+ * which touches the tree in Morton order. If the scratch cannot hold them the call returns
+ * OCC_ERR_SCRATCH; if the pools cannot hold the result, OCC_ERR_NOMEM; either way the map is
+ * exactly as before (automatic eviction aside, see auto_evict).
  *
  * Work: O(sum over rays of the voxels each ray crosses) for traversal, bounded per ray by
  * 3 * (max_range / resolution + 2) + 2 voxels (the whole map's edge with unlimited range), plus
@@ -45,6 +46,35 @@ extern "C" {
 #define OCC_INSERT_FILTER_BITS 15
 #endif
 #endif
+/* Radix passes over the 63 key bits: 6 with 11-bit digits (host), 8 with 8-bit digits (ARM). */
+#define OCC_INSERT_RADIX_PASSES ((63u + OCC_INSERT_RADIX_BITS - 1u) / OCC_INSERT_RADIX_BITS)
+
+/* ---- Scratch sizing at compile time (firmware: `static uint8_t scratch[...]`) ----------------
+ * OCC_INSERT_SCRATCH_FIXED_BYTES: what every call takes whatever the scan: up to 7 bytes to
+ * align the scratch, the filter (2^FILTER_BITS * 8) and the sort's histograms (RADIX_PASSES *
+ * 2^RADIX_BITS * 4): 311,303 bytes on a host, 10,247 on ARM.
+ * OCC_INSERT_SCRATCH_BYTES(n_points, max_ray_voxels): enough scratch for SIMPLE, DISCRETE,
+ * SUPER_RAYS and FAST_DISCRETE with d = 0, for up to n_points points whose rays (after clipping
+ * to max range) span at most max_ray_voxels keys on each axis between the origin's voxel and
+ * the end's: per point 8 bytes (its end voxel) and 16 per code its ray can emit (3 v + 4 keys
+ * and its hit: the codes and the sort's temporary). For a max range R at resolution res pass
+ * ceil(R / res) + 2 (rounding of the keys). Integer constant expressions: both arguments must
+ * be integer constants; the product must fit a size_t (OCC_INSERT_SCRATCH_FITS says so, for a
+ * compile-time check). The bound is exact for one point with a ray that long on every axis: one
+ * byte less is refused with OCC_ERR_SCRATCH (tests/test_integrate.c). Not covered:
+ * FAST_DISCRETE with d > 0 (its coarse set, see occ_insert_scratch_bytes_scan). */
+#define OCC_INSERT_SCRATCH_FIXED_BYTES                                                        \
+    (7u + ((size_t)1 << OCC_INSERT_FILTER_BITS) * 8u +                                       \
+     (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u)
+#define OCC_INSERT_SCRATCH_PER_POINT(max_ray_voxels) \
+    (8u + 16u * (3u * (size_t)(max_ray_voxels) + 5u))
+#define OCC_INSERT_SCRATCH_BYTES(n_points, max_ray_voxels) \
+    (OCC_INSERT_SCRATCH_FIXED_BYTES +                      \
+     (size_t)(n_points) * OCC_INSERT_SCRATCH_PER_POINT(max_ray_voxels))
+#define OCC_INSERT_SCRATCH_FITS(n_points, max_ray_voxels)                                   \
+    ((size_t)(max_ray_voxels) <= (SIZE_MAX / 16u - 5u) / 3u &&                                 \
+     (size_t)(n_points) <= (SIZE_MAX - OCC_INSERT_SCRATCH_FIXED_BYTES) /                      \
+                               OCC_INSERT_SCRATCH_PER_POINT(max_ray_voxels))
 
 typedef enum {
     /* One exact ray per point (OctoMap insertPointCloud, discretize = false). */
@@ -85,7 +115,10 @@ typedef struct {
      * needs it: the result equals one batch, but the call is then no longer all-or-nothing
      * (on OCC_ERR_NOMEM the chunks before the failing one stay applied; out->voxels_updated
      * says how many). `auto_evict_state` (required with a policy) accumulates the statistics.
-     * FAST_DISCRETE's coarse free-space pass is applied before and is not covered. */
+     * FAST_DISCRETE with d > 0: its coarse pass and the voxel updates are checked together
+     * against a bound as if none of their nodes existed; when the pools are short of it, the
+     * call evicts for that bound first and fails with OCC_ERR_NOMEM if even that cannot be
+     * met (the coarse pass is not chunked; what was evicted stays evicted). */
     const struct occ_evict_policy *auto_evict;  /* occ_evict_policy_t */
     struct occ_evict_out *auto_evict_state;     /* occ_evict_out_t */
 } occ_insert_params_t;
@@ -104,14 +137,17 @@ typedef struct {
     size_t voxels_occupied;   /* ... of which as occupied */
     size_t voxels_changed;    /* voxels whose stored value changed */
     size_t coarse_updated;    /* FAST_DISCRETE: coarse nodes updated as free */
-    size_t scratch_used;      /* scratch bytes this call used at most */
+    size_t scratch_used;      /* scratch bytes this call wrote (filter, histograms, its sets and
+                               * the high-water of its code arrays; what it reserved but never
+                               * wrote is not counted), also on error. <= scratch_bytes; not a
+                               * size that would suffice: use the bounds below for that. */
 } occ_insert_result_t;
 
 /* Scratch bytes that make occ_map_insert_cloud() never fail for lack of scratch, for up to
  * `n_points` points whose rays are at most `max_ray_m` long (pass max(max_range, farthest point
  * distance); <= 0 or non-finite means "the whole map": a huge number). Formula:
- *   fixed + 16 * n_points * (3 * (ceil(max_ray_m / res) + 2) + 2) + 16 * n_points
- * where fixed = 2^OCC_INSERT_FILTER_BITS * 8 + 6 * 2^OCC_INSERT_RADIX_BITS * 4 + 64.
+ *   OCC_INSERT_SCRATCH_BYTES(n_points, ceil(max_ray_m / res) + 2)
+ * (the fixed term is this build's: OCC_INSERT_RADIX_PASSES differs between host and ARM).
  * SUPER_RAYS needs no more than SIMPLE; FAST_DISCRETE with d > 0 needs in addition 32 bytes
  * per 4x4x4 block of level-d nodes of the scan's bounding box and 16 bytes per coarse sample
  * (occ_insert_scratch_bytes_scan() counts both; this function does not). Saturates at
@@ -121,7 +157,8 @@ size_t occ_insert_scratch_bytes(const occ_map_t *map, size_t n_points, float max
 
 /* The same bound computed for one scan: per ray the keys the DDA can emit (|dk|_1 + 4), summed
  * (FAST_DISCRETE: plus its coarse set over the scan's box). Bad points count 0. O(n). Returns
- * 0 if an argument is NULL. With at least this much scratch, OCC_ERR_NOMEM means the pools. */
+ * 0 if an argument is NULL. With at least this much scratch the call never returns
+ * OCC_ERR_SCRATCH. Saturates at SIZE_MAX (a box too big for any scratch). */
 size_t occ_insert_scratch_bytes_scan(const occ_map_t *map, const occ_vec3_t *origin,
                                      const occ_vec3_t *points, size_t n_points,
                                      const occ_insert_params_t *params);
@@ -130,9 +167,11 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *map, const occ_vec3_t *ori
  * the map frame. `scratch` (any alignment, owned by the call only while it runs) holds the
  * per-scan sets; less than the bound above may still work: the sets are compacted when full.
  * `out` (may be NULL) gets the counters, also on error (then nothing was applied).
+ * Scratch beyond 32 GiB is not used (the sort counts codes in 32 bits).
  * Errors: OCC_ERR_ARG (NULL map/origin/params, points NULL with n > 0, origin NaN/Inf, bad
- * method or fast_d >= depth_levels), OCC_ERR_RANGE (origin outside the map), OCC_ERR_NOMEM
- * (scratch or pools too small: the map is unchanged, oom_count is bumped by the pool case).
+ * method or fast_d >= depth_levels), OCC_ERR_RANGE (origin outside the map), OCC_ERR_SCRATCH
+ * (the scratch cannot hold the scan's sets: the map is unchanged, oom_count is not bumped),
+ * OCC_ERR_NOMEM (the pools cannot hold the result: the map is unchanged, oom_count is bumped).
  * Bad points are not an error: they are skipped and counted.
  * Differences to OctoMap: an origin outside the map is an error (OctoMap would still mark the
  * end points); with discretize=true OctoMap wraps out-of-map points into the map, here they

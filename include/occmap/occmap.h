@@ -100,12 +100,15 @@ typedef enum {
     OCC_OK = 0,
     OCC_ERR_ARG = -1,         /* NULL pointer, NaN/Inf, bad size or config */
     OCC_ERR_RANGE = -2,       /* coordinate or key outside the map volume */
-    OCC_ERR_NOMEM = -3,       /* pool or caller scratch too small; nothing was changed */
+    OCC_ERR_NOMEM = -3,       /* a pool (or a caller buffer other than an integrator's
+                                 scratch) too small; nothing was changed */
     OCC_ERR_FORMAT = -4,      /* corrupt or malformed input bytes */
     OCC_ERR_IO = -5,          /* a caller stream or OS call failed (port layer) */
     OCC_ERR_STATE = -6,       /* call not valid in the object's current state */
     OCC_ERR_UNSUPPORTED = -7, /* valid input this build does not handle */
-    OCC_ERR_CORRUPT = -8      /* occ_map_check() found broken invariants */
+    OCC_ERR_CORRUPT = -8,     /* occ_map_check() found broken invariants */
+    OCC_ERR_SCRATCH = -9      /* the caller's scratch is too small for this call (oom_count is
+                                 not bumped: it counts the pools); nothing was changed */
 } occ_err_t;
 
 /* Short constant English text for an error code (never NULL). */

@@ -147,7 +147,8 @@ float occ_float16_to_float(uint16_t h)
 
 size_t occ_dronecan_frame_count(size_t payload_len)
 {
-    return (payload_len <= 7u) ? 1u : (payload_len + 2u + 6u) / 7u;
+    /* ceil((len + 2) / 7) without the sum, which wraps for a length near SIZE_MAX */
+    return (payload_len <= 7u) ? 1u : payload_len / 7u + (payload_len % 7u + 2u + 6u) / 7u;
 }
 
 occ_err_t occ_dronecan_send_transfer(const occ_can_iface_t *iface, uint32_t can_id,

@@ -9,9 +9,15 @@
 #include "occmap/occ_evict.h"
 #include "coarse_internal.h"
 #include "integrate_internal.h"
+#include "sat_internal.h"
 
 #define FILTER_N ((size_t)1 << OCC_INSERT_FILTER_BITS)
-#define FIXED_BYTES (FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u + 64u)
+/* The filter and the histograms, carved at the aligned start of the scratch. */
+#define FIXED_RT (FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u)
+/* The public sizing macro's fixed term is this carve plus the alignment, in every build. */
+typedef char fixed_term_matches_header[OCC_INSERT_SCRATCH_FIXED_BYTES == 7u + FIXED_RT ? 1 : -1];
+/* Scratch beyond this is not used: the sort counts codes in 32 bits (32 GiB on a 64-bit host). */
+#define SCRATCH_MAX ((size_t)UINT32_MAX < SIZE_MAX / 8u ? (size_t)UINT32_MAX * 8u : SIZE_MAX)
 
 occ_insert_params_t occ_insert_params_default(void)
 {
@@ -23,19 +29,6 @@ occ_insert_params_t occ_insert_params_default(void)
     p.fast_d = 2;
     p.super_k = 4;
     return p;
-}
-
-static size_t sat_mul(const size_t a, const size_t b)
-{
-    if (a != 0u && b > SIZE_MAX / a) {
-        return SIZE_MAX;
-    }
-    return a * b;
-}
-
-static size_t sat_add(const size_t a, const size_t b)
-{
-    return a > SIZE_MAX - b ? SIZE_MAX : a + b;
 }
 
 static bool uses_ends(const occ_insert_method_t m)
@@ -55,10 +48,10 @@ size_t occ_insert_scratch_bytes(const occ_map_t *const map, const size_t n_point
     if (!(cells < edge)) {
         cells = edge;
     }
-    const size_t per_ray = 3u * ((size_t)cells + 2u) + 2u;
-    size_t bytes = sat_mul(sat_mul(16u, n_points), per_ray);
-    bytes = sat_add(bytes, sat_mul(16u, n_points));
-    return sat_add(bytes, FIXED_BYTES);
+    /* Two voxels of rounding: the float quotient above and the keys of the ray's ends. */
+    const size_t per_point = OCC_INSERT_SCRATCH_BYTES(1u, (size_t)cells + 2u) -
+                             OCC_INSERT_SCRATCH_FIXED_BYTES;
+    return occ_sat_add(occ_sat_mul(n_points, per_point), OCC_INSERT_SCRATCH_FIXED_BYTES);
 }
 
 size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_t *const origin,
@@ -73,7 +66,7 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_
     const float o[3] = {origin->x, origin->y, origin->z};
     uint32_t ko[3];
     if (!occ_raygeo_key(&g, o, ko)) {
-        return FIXED_BYTES;
+        return OCC_INSERT_SCRATCH_FIXED_BYTES;
     }
     const bool fast = params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u &&
                       params->fast_d < map->cfg.depth_levels;
@@ -90,28 +83,28 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_
         uint32_t k[3];
         if (occ_raygeo_key(&g, p, k)) {
             const size_t b = occ_dda_bound(ko, k);
-            codes = sat_add(codes, b + 1u);
-            samples = sat_add(samples, (b >> params->fast_d) + 2u);
+            codes = occ_sat_add(codes, b + 1u);
+            samples = occ_sat_add(samples, (b >> params->fast_d) + 2u);
             for (unsigned a = 0; a < 3u; a++) {
                 lo[a] = k[a] < lo[a] ? k[a] : lo[a];
                 hi[a] = k[a] > hi[a] ? k[a] : hi[a];
             }
         }
     }
-    size_t bytes = sat_mul(16u, codes);
-    bytes = sat_add(bytes, sat_mul(16u, n_points));
+    size_t bytes = occ_sat_mul(16u, codes);
+    bytes = occ_sat_add(bytes, occ_sat_mul(8u, n_points));
     if (fast) {
         /* The coarse nodes' set over the scan's box at level d, and their codes. */
         size_t cbricks = 1;
         for (unsigned a = 0; a < 3u; a++) {
             const uint32_t l = ((((lo[a] >= 2u ? lo[a] - 2u : 0u) >> params->fast_d) >> 2) & ~7u);
             const uint32_t h = ((hi[a] + 2u) >> params->fast_d) >> 2;
-            cbricks = sat_mul(cbricks, (size_t)(((h - l) | 7u) + 1u));
+            cbricks = occ_sat_mul(cbricks, (size_t)(((h - l) | 7u) + 1u));
         }
-        bytes = sat_add(bytes, sat_mul(32u, cbricks));
-        bytes = sat_add(bytes, sat_mul(16u, samples));
+        bytes = occ_sat_add(bytes, occ_sat_mul(32u, cbricks));
+        bytes = occ_sat_add(bytes, occ_sat_mul(16u, samples));
     }
-    return sat_add(bytes, FIXED_BYTES);
+    return occ_sat_add(bytes, OCC_INSERT_SCRATCH_FIXED_BYTES);
 }
 
 /* ---- the insert context -------------------------------------------------------------------- */
@@ -120,6 +113,7 @@ bool occ_ictx_reserve(occ_ictx_t *const x, const size_t need)
     if (x->cap - x->n >= need) {
         return true;
     }
+    occ_ictx_note(x, x->n, x->n);
     occ_code_t *const s = occ_keyset_sort(x->a, x->b, x->n, x->hist);
     const size_t m = occ_keyset_unique(s, x->n);
     if (s != x->a) {
@@ -226,6 +220,7 @@ static size_t discretize(occ_ictx_t *const x, const occ_vec3_t *const points, co
     x->r->points_integrated = m;
     /* a and b are still empty: use them as the sort's buffers. Keys outside the box carry
      * bit 63 (ignored by the sort); they are rare and may repeat, which only repeats a ray. */
+    occ_ictx_note(x, m, 0);
     occ_code_t *const s = occ_keyset_sort(ends, x->a, m, x->hist);
     size_t u = 0;
     for (size_t i = 0; i < m; i++) {
@@ -327,32 +322,50 @@ static size_t box_bricks(occ_ictx_t *const x, const occ_vec3_t *const points,
         x->box_hi[a] = hi[a];
         bs->b0[a] = (lo[a] >> 2) & ~7u;
         bs->nb[a] = (((hi[a] >> 2) - bs->b0[a]) | 7u) + 1u;
-        if (bricks > SIZE_MAX / 64u / bs->nb[a]) {
-            return 0;
-        }
-        bricks *= bs->nb[a];
+        bricks = occ_sat_mul(bricks, bs->nb[a]);
+    }
+    if (bricks > SIZE_MAX / 64u) {
+        return 0;
     }
     bs->stride_y = bs->nb[0] >> 3;
     bs->stride_z = (size_t)(bs->nb[0] >> 3) * (bs->nb[1] >> 3);
     return bricks;
 }
 
-/* FAST_DISCRETE: the coarse nodes' codes, a capacity check covering them and the fine codes,
- * then the coarse update (cfg.miss / (2d + 1) on every voxel below each node). After this the
- * fine batch cannot run out of blocks. */
+/* Can the pools supply what the coarse pass and the voxel batch need (bounds as if no node
+ * existed)? In automatic mode, evict for that first (the coarse pass cannot be chunked). */
+static bool coarse_fits(occ_map_t *const map, const occ_vec3_t *const origin,
+                        const occ_insert_params_t *const params, const uint64_t n_inner,
+                        const uint64_t n_leaf)
+{
+    if (n_inner > OCC_NONE || n_leaf > OCC_NONE) {
+        return false;
+    }
+    if (occ_pool_can_supply(map, (uint32_t)n_inner, (uint32_t)n_leaf)) {
+        return true;
+    }
+    return params->auto_evict != NULL &&
+           occ_map_evict_for(map, origin, params->auto_evict, (uint32_t)n_inner,
+                             (uint32_t)n_leaf, params->auto_evict_state) == OCC_OK &&
+           occ_pool_can_supply(map, (uint32_t)n_inner, (uint32_t)n_leaf);
+}
+
+/* FAST_DISCRETE: the coarse nodes' codes (in `spare`), a capacity check covering them and the
+ * fine codes, then the coarse update (cfg.miss / (2d + 1) on every voxel below each node). After
+ * this the fine batch cannot run out of blocks. */
 static occ_err_t apply_coarse(occ_ictx_t *const x, occ_bitset_t *const cbs,
                               const occ_code_t *const fine, const size_t nf,
-                              occ_code_t *const spare, const size_t spare_cap)
+                              occ_code_t *const spare, const size_t spare_cap,
+                              const occ_vec3_t *const origin,
+                              const occ_insert_params_t *const params)
 {
     occ_map_t *const map = x->map;
     if (spare_cap < cbs->n_touched) {
-        map->oom_count++;
-        return OCC_ERR_NOMEM;
+        return OCC_ERR_SCRATCH;
     }
     const size_t nc = occ_bitset_extract(cbs, NULL, 0, spare, spare_cap, spare, x->hist);
     if (nc == SIZE_MAX) {
-        map->oom_count++;
-        return OCC_ERR_NOMEM;
+        return OCC_ERR_SCRATCH;
     }
     const unsigned d = x->cd;
     for (size_t i = 0; i < nc; i++) {
@@ -361,8 +374,7 @@ static occ_err_t apply_coarse(occ_ictx_t *const x, occ_bitset_t *const cbs,
     uint64_t ci, cl, fi, fl;
     occ_coarse_need(spare, nc, d, map->cfg.depth_levels, &ci, &cl);
     occ_coarse_need(fine, nf, 0, map->cfg.depth_levels, &fi, &fl);
-    if (ci + fi > OCC_NONE || cl + fl > OCC_NONE ||
-        !occ_pool_can_supply(map, (uint32_t)(ci + fi), (uint32_t)(cl + fl))) {
+    if (!coarse_fits(map, origin, params, ci + fi, cl + fl)) {
         map->oom_count++;
         return OCC_ERR_NOMEM;
     }
@@ -427,6 +439,97 @@ static uint8_t *align8(void *const p)
     return (uint8_t *)p + ((8u - (u & 7u)) & 7u);
 }
 
+/* The scan's sorted, collapsed codes; FAST_DISCRETE's coarse pass (d > 0); then one coherent
+ * batch update in Morton order (all or nothing, except in automatic mode). */
+static occ_err_t collapse_and_apply(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                                    const occ_vec3_t *const origin, const bool dense,
+                                    occ_bitset_t *const bs, occ_bitset_t *const cbs)
+{
+    occ_insert_result_t *const r = x->r;
+    occ_code_t *codes, *spare; /* spare: free scratch after the fine codes, for the coarse ones */
+    size_t m, spare_cap;
+    if (dense) {
+        if (x->b_cap < x->n || x->b_cap < bs->n_touched) {
+            return OCC_ERR_SCRATCH;
+        }
+        occ_ictx_note(x, 0, x->n > bs->n_touched ? x->n : bs->n_touched);
+        occ_code_t *const hs = occ_keyset_sort(x->a, x->b, x->n, x->hist);
+        const size_t nh = occ_keyset_unique(hs, x->n);
+        if (hs != x->a) {
+            memcpy(x->a, hs, nh * sizeof *hs);
+        }
+        m = occ_bitset_extract(bs, x->a, nh, x->b, x->b_cap, x->b, x->hist);
+        if (m == SIZE_MAX) {
+            occ_ictx_note(x, 0, x->b_cap);
+            return OCC_ERR_SCRATCH;
+        }
+        occ_ictx_note(x, 0, m);
+        codes = x->b;
+        spare = x->b + m;
+        spare_cap = x->b_cap - m;
+    } else {
+        occ_ictx_note(x, x->n, x->n);
+        codes = occ_keyset_sort(x->a, x->b, x->n, x->hist);
+        m = occ_keyset_unique(codes, x->n);
+        spare = codes == x->a ? x->b : x->a;
+        spare_cap = x->cap;
+    }
+    size_t hits = 0;
+    for (size_t i = 0; i < m; i++) {
+        hits += (size_t)(codes[i] >> 63);
+    }
+    occ_map_t *const map = x->map;
+    if (x->cbs != NULL) {
+        const occ_err_t ce = apply_coarse(x, cbs, codes, m, spare, spare_cap, origin, params);
+        /* The extraction wrote its sort's temporary and the coarse codes at spare. */
+        const size_t sw = ce == OCC_ERR_SCRATCH
+                              ? spare_cap
+                              : (cbs->n_touched > r->coarse_updated ? cbs->n_touched
+                                                                     : r->coarse_updated);
+        const size_t off = (size_t)(spare - (spare >= x->b ? x->b : x->a));
+        occ_ictx_note(x, spare >= x->b ? 0u : off + sw, spare >= x->b ? off + sw : 0u);
+        if (ce != OCC_OK) {
+            return ce;
+        }
+    }
+    size_t changed = 0;
+    occ_err_t e = occ_map_observe_codes(map, codes, m, &changed);
+    if (e == OCC_ERR_NOMEM && params->auto_evict != NULL) {
+        size_t applied = 0;
+        e = evict_and_apply(map, origin, params, codes, m, &changed, &applied);
+        r->voxels_updated = applied;
+    }
+    if (e != OCC_OK) {
+        return e;
+    }
+    r->voxels_updated = m;
+    r->voxels_occupied = hits;
+    r->voxels_free = m - hits;
+    r->voxels_changed = changed;
+    return OCC_OK;
+}
+
+/* out->scratch_used: the bytes of scratch the call wrote - the histograms, the filter (sorted
+ * path), the end voxels, the dense and coarse sets (words and touched lists) and the high-water
+ * marks of the two code arrays. Memory the call reserved but never wrote is not counted. */
+static size_t touched_bytes(const occ_ictx_t *const x, const occ_insert_params_t *const params,
+                            const size_t dense_bricks, const size_t cbricks)
+{
+    size_t b = OCC_KS_HIST_WORDS * 4u;
+    if (x->bs == NULL) {
+        b += FILTER_N * 8u;
+    } else {
+        b += 8u * (dense_bricks + x->bs->n_touched);
+    }
+    if (params->method == OCC_INSERT_DISCRETE || params->method == OCC_INSERT_FAST_DISCRETE) {
+        b += 8u * x->r->points_integrated;
+    }
+    if (x->cbs != NULL) {
+        b += 8u * (cbricks + x->cbs->n_touched);
+    }
+    return b + 8u * (x->a_hwm + x->b_hwm);
+}
+
 occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const origin,
                                const occ_vec3_t *const points, const size_t n_points,
                                const occ_insert_params_t *const params, void *const scratch,
@@ -462,44 +565,42 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
     x.max_range_r = (occ_rr_t)x.max_range;
 
     /* Carve the scratch: filter | histograms | end voxels (n) | the rest. */
-    uint8_t *p = scratch != NULL ? align8(scratch) : NULL;
-    const size_t usable = p != NULL ? scratch_bytes - (size_t)(p - (uint8_t *)scratch) : 0u;
-    const size_t fixed = FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u;
-    const size_t ends_bytes = uses_ends(params->method) ? n_points * 8u : 0u;
-    if (p == NULL || scratch_bytes < 8u || usable < fixed + ends_bytes + 16u) {
-        map->oom_count++;
-        return OCC_ERR_NOMEM;
+    uint8_t *const p = scratch != NULL ? align8(scratch) : NULL;
+    const size_t pad = p != NULL ? (size_t)(p - (uint8_t *)scratch) : 0u;
+    const size_t usable = occ_sat_sub(scratch_bytes, pad) < SCRATCH_MAX
+                              ? occ_sat_sub(scratch_bytes, pad)
+                              : SCRATCH_MAX;
+    const size_t ends_bytes = uses_ends(params->method) ? occ_sat_mul(n_points, 8u) : 0u;
+    if (p == NULL || usable < occ_sat_add(FIXED_RT, ends_bytes)) {
+        return OCC_ERR_SCRATCH;
     }
     x.filt = (occ_code_t *)(void *)p;
     x.hist = (uint32_t *)(void *)(p + FILTER_N * 8u);
-    occ_code_t *const ends = (occ_code_t *)(void *)(p + fixed);
-    uint8_t *const rest0 = p + fixed + ends_bytes;
-    const size_t rest0_bytes = usable - fixed - ends_bytes;
-    r->scratch_used = (size_t)(p - (uint8_t *)scratch) + fixed + ends_bytes;
+    occ_code_t *const ends = (occ_code_t *)(void *)(p + FIXED_RT);
+    uint8_t *rest = p + FIXED_RT + ends_bytes;
+    size_t rest_bytes = usable - FIXED_RT - ends_bytes;
 
     /* Dense set when the scan's box is small enough for the scratch, else sorted codes. */
     occ_bitset_t bs, cbs;
     memset(&bs, 0, sizeof bs);
     memset(&cbs, 0, sizeof cbs);
-    size_t bricks = box_bricks(&x, points, n_points, &bs);
-    uint8_t *rest = rest0;
-    size_t rest_bytes = rest0_bytes;
+    const size_t bricks = box_bricks(&x, points, n_points, &bs);
     size_t cbricks = 0;
     if (params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u) {
-        /* The coarse nodes' set, over the same box at level d. */
+        /* The coarse nodes' set, over the same box at level d (2048 bricks per axis are 2^33:
+         * the product saturates, it never wraps). */
         x.cd = params->fast_d;
         x.cn = params->fast_n;
         cbricks = 1;
         for (unsigned a = 0; a < 3u; a++) {
             cbs.b0[a] = ((x.box_lo[a] >> x.cd) >> 2) & ~7u;
             cbs.nb[a] = ((((x.box_hi[a] >> x.cd) >> 2) - cbs.b0[a]) | 7u) + 1u;
-            cbricks *= cbs.nb[a];
+            cbricks = occ_sat_mul(cbricks, cbs.nb[a]);
         }
         cbs.stride_y = cbs.nb[0] >> 3;
         cbs.stride_z = (size_t)(cbs.nb[0] >> 3) * (cbs.nb[1] >> 3);
         if (cbricks > rest_bytes / 32u) {
-            map->oom_count++;
-            return OCC_ERR_NOMEM;
+            return OCC_ERR_SCRATCH;
         }
         cbs.words = (uint64_t *)(void *)rest;
         cbs.touched = cbs.words + cbricks;
@@ -507,17 +608,16 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         rest_bytes -= 16u * cbricks;
         x.cbs = &cbs;
     }
-    const size_t hits_cap = n_points + 1u;
+    const size_t hits_cap = occ_sat_add(n_points, 1u);
     /* FAST_DISCRETE with n = 0 casts no voxel rays: only hits, no dense set needed. */
     const bool no_fine = x.cbs != NULL && x.cn == 0u;
     bool dense = !no_fine && bricks > 0u && bricks <= rest_bytes / 64u &&
                  hits_cap <= (rest_bytes / 2u - 16u * bricks) / 16u;
-    size_t m = 0;
-    occ_code_t *codes = NULL;
     int rc = 0;
     for (unsigned attempt = 0; attempt < 2u; attempt++) {
-        const size_t used0 = r->scratch_used; /* the counters are still zero here */
         x.n = 0;
+        x.a_hwm = 0;
+        x.b_hwm = 0;
         if (x.cbs != NULL) {
             memset(cbs.words, 0, cbricks * 8u);
             cbs.n_touched = 0;
@@ -546,71 +646,16 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         rc = run_method(&x, params, points, n_points, ends);
         if (rc >= 0 && dense && bs.overflow) {
             memset(r, 0, sizeof *r); /* cannot happen with the padded box; stay exact anyway */
-            r->scratch_used = used0;
             dense = false;
             continue;
         }
         break;
     }
-    if (rc < 0 || (x.cbs != NULL && cbs.overflow)) {
-        map->oom_count++;
-        return OCC_ERR_NOMEM;
-    }
-    occ_code_t *spare = NULL; /* free scratch after the fine codes, for the coarse ones */
-    size_t spare_cap = 0;
-    if (dense) {
-        const size_t bcap = (size_t)((rest + rest_bytes) - (uint8_t *)(void *)x.b) / 8u;
-        if (bcap < x.n || bcap < bs.n_touched) {
-            map->oom_count++;
-            return OCC_ERR_NOMEM;
-        }
-        occ_code_t *const hs = occ_keyset_sort(x.a, x.b, x.n, x.hist);
-        const size_t nh = occ_keyset_unique(hs, x.n);
-        if (hs != x.a) {
-            memcpy(x.a, hs, nh * sizeof *hs);
-        }
-        m = occ_bitset_extract(&bs, x.a, nh, x.b, bcap, x.b, x.hist);
-        if (m == SIZE_MAX) {
-            map->oom_count++;
-            return OCC_ERR_NOMEM;
-        }
-        codes = x.b;
-        spare = x.b + m;
-        spare_cap = bcap - m;
-        r->scratch_used += 16u * bricks + 8u * hits_cap + 8u * m;
-    } else {
-        /* Sort and collapse everything. */
-        codes = occ_keyset_sort(x.a, x.b, x.n, x.hist);
-        m = occ_keyset_unique(codes, x.n);
-        spare = codes == x.a ? x.b : x.a;
-        spare_cap = x.cap;
-        r->scratch_used += 16u * x.cap; /* both halves may have been written */
-    }
-    size_t hits = 0;
-    for (size_t i = 0; i < m; i++) {
-        hits += (size_t)(codes[i] >> 63);
-    }
-    if (x.cbs != NULL) {
-        const occ_err_t ce = apply_coarse(&x, &cbs, codes, m, spare, spare_cap);
-        if (ce != OCC_OK) {
-            return ce;
-        }
-        r->scratch_used += 16u * cbricks;
-    }
-    /* One coherent batch update in Morton order (all or nothing, except in automatic mode). */
-    size_t changed = 0;
-    occ_err_t e = occ_map_observe_codes(map, codes, m, &changed);
-    if (e == OCC_ERR_NOMEM && params->auto_evict != NULL) {
-        size_t applied = 0;
-        e = evict_and_apply(map, origin, params, codes, m, &changed, &applied);
-        r->voxels_updated = applied;
-    }
-    if (e != OCC_OK) {
-        return e;
-    }
-    r->voxels_updated = m;
-    r->voxels_occupied = hits;
-    r->voxels_free = m - hits;
-    r->voxels_changed = changed;
-    return OCC_OK;
+    occ_ictx_note(&x, x.n, 0);
+    const occ_err_t e = rc < 0 || (x.cbs != NULL && cbs.overflow)
+                            ? OCC_ERR_SCRATCH
+                            : collapse_and_apply(&x, params, origin, dense, &bs, &cbs);
+    r->scratch_used = touched_bytes(&x, params, dense ? bricks : 0u, cbricks);
+    return e;
 }
+

@@ -63,7 +63,7 @@ static inline occ_code_t occ_code_step(occ_code_t c, unsigned dim, int step)
 
 /* ---- key sets (keyset.c) ----------------------------------------------------------------- */
 #define OCC_KS_RADIX (1u << OCC_INSERT_RADIX_BITS)
-#define OCC_KS_PASSES ((63u + OCC_INSERT_RADIX_BITS - 1u) / OCC_INSERT_RADIX_BITS)
+#define OCC_KS_PASSES OCC_INSERT_RADIX_PASSES
 /* Histogram words the sort needs (uint32_t). */
 #define OCC_KS_HIST_WORDS ((size_t)OCC_KS_PASSES * OCC_KS_RADIX)
 
@@ -172,8 +172,16 @@ typedef struct {
     occ_bitset_t *cbs;     /* FAST_DISCRETE, d > 0: coarse nodes (keys >> cd) to clear */
     uint8_t cd, cn;        /* FAST_DISCRETE: coarse level d and n */
     uint32_t box_lo[3], box_hi[3]; /* keys of the scan's box (padded) */
+    size_t a_hwm, b_hwm;   /* codes ever written at a[] and at b[] (scratch_used) */
     occ_insert_result_t *r;
 } occ_ictx_t;
+
+/* Note that codes a[0..na) and b[0..nb) have been written. */
+static inline void occ_ictx_note(occ_ictx_t *x, size_t na, size_t nb)
+{
+    x->a_hwm = na > x->a_hwm ? na : x->a_hwm;
+    x->b_hwm = nb > x->b_hwm ? nb : x->b_hwm;
+}
 
 /* Make room for `need` more codes in a (sorting and collapsing what is there if needed). */
 bool occ_ictx_reserve(occ_ictx_t *x, size_t need);

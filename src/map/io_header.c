@@ -78,7 +78,7 @@ static bool parse_real(occ_cursor_t *const c, float *const out)
             if (mant != 0u) {
                 digits++;
             }
-        } else {
+        } else if (exp10 < 100000) { /* an int32_t that a 2 GiB run of digits cannot wrap */
             exp10++;
         }
         p++;
@@ -87,7 +87,7 @@ static bool parse_real(occ_cursor_t *const c, float *const out)
         p++;
         while (p < c->len && is_digit(c->buf[p])) {
             any = true;
-            if (digits < 19u) {
+            if (digits < 19u && exp10 > -100000) {
                 mant = mant * 10u + (uint64_t)(c->buf[p] - '0');
                 exp10--;
                 if (mant != 0u) {

@@ -5,6 +5,7 @@
  */
 #include <string.h>
 
+#include "sat_internal.h"
 #include "tree_internal.h"
 
 #ifndef OCC_POOL_PARANOID
@@ -127,7 +128,7 @@ uint32_t occ_arena_blocks_for_bytes(const size_t arena_bytes, const uint32_t n_i
         return 0u;
     }
     const size_t usable = arena_bytes - OCC_ARENA_ALIGN;
-    const size_t inner_bytes = (size_t)n_inner * sizeof(occ_inner_block_t);
+    const size_t inner_bytes = occ_sat_mul(n_inner, sizeof(occ_inner_block_t));
     if (inner_bytes > usable) {
         return 0u;
     }

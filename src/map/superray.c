@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "integrate_internal.h"
+#include "sat_internal.h"
 
 #define SR_MAX_GROUP 4096u  /* rays handled together (a bigger cell is done in parts) */
 #define SR_MAX_EDGES 4096u  /* grid edges per projection inside one bundle */
@@ -298,11 +299,13 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
 {
     /* Workspace in the dense path's free scratch: end cells and point indices (sorted as
      * pairs), per-bundle rays, edges, signature keys and the signature stamps. */
-    const size_t need = n * 24u + SR_MAX_GROUP * (sizeof(sr_ray_t) + 8u) +
-                        3u * SR_MAX_EDGES * sizeof(occ_rr_t) + SR_STAMPS * 4u + 64u;
-    if (x->bs == NULL || x->b_cap * 8u < need || n >= UINT32_MAX) {
+    const size_t need = occ_sat_add(occ_sat_mul(n, 24u),
+                                    SR_MAX_GROUP * (sizeof(sr_ray_t) + 8u) +
+                                        3u * SR_MAX_EDGES * sizeof(occ_rr_t) + SR_STAMPS * 4u + 64u);
+    if (x->bs == NULL || x->b_cap < need / 8u + 1u || n >= UINT32_MAX) {
         return run_single(x, points, n);
     }
+    occ_ictx_note(x, 0, need / 8u + 1u);
     uint64_t *const keys = x->b;
     uint64_t *const tkeys = keys + n;
     uint32_t *const vals = (uint32_t *)(void *)(tkeys + n);
