@@ -44,7 +44,7 @@ for b in $bins; do
   CMOCKA_MESSAGE_OUTPUT=STDOUT "$b" >"$log" 2>&1; rc=$?
   secs=$(elapsed "$start")
   p=$(cmocka_count "$log" PASSED); f=$(cmocka_count "$log" FAILED); s=$(cmocka_count "$log" SKIPPED)
-  f=$((f + $(grep -ac '^\[  ERROR   \] ' "$log")))   # a failed setup or teardown (leak check)
+  f=$((f + $(grep -acE '^\[  ERROR   \] [A-Za-z_]' "$log")))   # a failed setup or teardown (leak check)
   if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi   # crash, sanitizer abort or no summary
   if [ "$p" -eq 0 ] && [ "$f" -eq 0 ] && [ "$s" -eq 0 ]; then f=1; fi  # ran no test at all
   pass=$((pass + p)); fail=$((fail + f))

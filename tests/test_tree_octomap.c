@@ -29,6 +29,7 @@
 #include "occmap/occmap.h"
 #include "occmap/occ_scan.h"
 #include "support/oracle_tree.h"
+#include "support/leak_check.h"
 
 #define STEP_ERR (0.5f / (float)OCC_FIXED_ONE)
 #define SCAN_BZ2 "/usr/share/doc/liboctomap-dev/examples/data/scan.dat.bz2"
@@ -70,10 +71,7 @@ static int teardown_maps(void **state)
     (void)state;
     oracle_tree_free(oracle);
     oracle = NULL;
-    occ_map_clear(&map);
-    occ_map_stats_t st;
-    occ_map_pool_stats(&map, &st);
-    return st.inner_used == 0u && st.leaf_used == 0u && occ_map_check(&map) == OCC_OK ? 0 : -1;
+    return leak_check(&map);
 }
 
 static uint32_t urand(uint32_t n)
