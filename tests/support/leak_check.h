@@ -13,6 +13,8 @@
  *     one; then every pool must be at used == 0 and occ_map_check() must still hold;
  *  4. it clears the map, so the next test starts from an empty one.
  * A map never initialized (a zeroed static, depth 0) has nothing to check.
+ * Cost: a walk, plus the release, which is quadratic in the blocks under OCC_POOL_PARANOID (on in
+ * test builds: each free scans the free list), so keep it to fixture-sized maps (<~10^4 blocks).
  * Returns 0, or -1 after printing what is wrong: a teardown returns it (CMocka then reports the
  * test as an ERROR), a test asserts it is 0.
  */
