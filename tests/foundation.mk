@@ -39,7 +39,7 @@ $(MORTON_BMI2_BIN): $(FOUNDATION_DIR)/test_morton_bmi2.o $(FOUNDATION_DIR)/morto
 test-morton-bmi2: $(MORTON_BMI2_BIN)
 	@if [ "$(FOUNDATION_HAVE_BMI2)" = 1 ]; then \
 	  CMOCKA_MESSAGE_OUTPUT=STDOUT $(MORTON_BMI2_BIN); \
-	else echo "skip: this CPU has no bmi2 (portable path tested by test_morton)"; fi
+	else echo "SKIP: this CPU has no bmi2 (portable path tested by test_morton)"; exit 77; fi
 
 # ---- compile-time variants of the core --------------------------------------------------------
 # $(1) name, $(2) flags, $(3) tests. Each variant rebuilds every core file with the flags and runs

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
+#include "support/leak_check.h"
 
 #define ARENA_SIZE OCC_ARENA_BYTES(256, 256)
 static uint8_t arena[ARENA_SIZE];
@@ -67,13 +68,7 @@ static int setup_map(void **state)
 static int teardown_map(void **state)
 {
     (void)state;
-    if (occ_map_check(&map) != OCC_OK) {
-        return -1;
-    }
-    occ_map_clear(&map);
-    occ_map_stats_t st;
-    occ_map_pool_stats(&map, &st);
-    return st.inner_used == 0u && st.leaf_used == 0u && occ_map_check(&map) == OCC_OK ? 0 : -1;
+    return leak_check(&map);
 }
 
 static void test_err_str(void **state)

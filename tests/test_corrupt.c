@@ -14,6 +14,7 @@
 
 #include "occmap/occmap.h"
 #include "map/tree_internal.h"
+#include "support/leak_check.h"
 
 #define ARENA_SIZE OCC_ARENA_BYTES(64, 64)
 static uint8_t arena[ARENA_SIZE];
@@ -68,8 +69,7 @@ static int setup_map(void **state)
 static int teardown_map(void **state)
 {
     (void)state;
-    occ_map_clear(&map);
-    return map.inner.used == 0u && map.leaf.used == 0u && occ_map_check(&map) == OCC_OK ? 0 : -1;
+    return leak_check(&map);
 }
 
 static void restore(void)

@@ -34,6 +34,7 @@
 #include "occmap/occ_integrate.h"
 #include "occmap/occ_scan.h"
 #include "map/tree_internal.h"
+#include "support/leak_check.h"
 
 #define VOL 64u                     /* shadow volume edge, voxels */
 #define VOL_N (VOL * VOL * VOL)
@@ -370,8 +371,7 @@ static void shadow_case(const occ_evict_mode_t mode, const occ_evict_shape_t sha
         assert_true(out.evictions > 0u);
         assert_true(changed > 0u || mode == OCC_EVICT_COARSEN);
     }
-    occ_map_clear(&m);
-    assert_int_equal(occ_map_check(&m), OCC_OK);
+    assert_int_equal(leak_check(&m), 0);
 }
 
 static void test_shadow_robot(void **state)
@@ -489,6 +489,7 @@ static void test_coarsen_rule(void **state)
     assert_int_equal(info.state, OCC_STATE_FREE);
     assert_true(info.level >= 2u);
     assert_true(fabsf(info.logodds - occ_value_to_logodds(occ_value_from_logodds(cfg.miss))) < 1e-6f);
+    assert_int_equal(leak_check(&m), 0);
 }
 
 /* Slices: the same map evicted in slices of every budget 1..8 ends as the one-shot result. */
@@ -534,7 +535,9 @@ static void test_slices_match_oneshot(void **state)
             snapshot(&m2, base, &after_grid);
             assert_memory_equal(&before_grid, &after_grid, sizeof before_grid);
             assert_int_equal(o2.blocks_freed, o1.blocks_freed);
+            assert_int_equal(leak_check(&m2), 0);
         }
+        assert_int_equal(leak_check(&m1), 0);
         p.budget_blocks = 0u;
     }
 }

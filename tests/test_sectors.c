@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "occmap/occ_feed.h"
+#include "support/leak_check.h"
 
 #define ARENA_BYTES (8u << 20)
 static uint8_t arena[ARENA_BYTES];
@@ -33,13 +34,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    assert_int_equal(occ_map_check(&map), OCC_OK);
-    occ_map_clear(&map);
-    occ_map_stats_t st;
-    occ_map_pool_stats(&map, &st);
-    assert_int_equal(st.inner_used, 0);
-    assert_int_equal(st.leaf_used, 0);
-    return 0;
+    return leak_check(&map);
 }
 
 static void reinit(float res, unsigned depth)

@@ -24,6 +24,7 @@
 #include "occmap/occmap.h"
 #include "map/tree_internal.h"
 #include "support/shadow_grid.h"
+#include "support/leak_check.h"
 
 #define VOL_LOG2 5u
 #define ARENA_SIZE OCC_ARENA_BYTES(60000, 40000)
@@ -58,10 +59,7 @@ static int setup_seed(void **state)
 static int teardown_map(void **state)
 {
     (void)state;
-    occ_map_clear(&map);
-    occ_map_stats_t st;
-    occ_map_pool_stats(&map, &st);
-    return st.inner_used == 0u && st.leaf_used == 0u && occ_map_check(&map) == OCC_OK ? 0 : -1;
+    return leak_check(&map);
 }
 
 static occ_key_t mk(uint32_t x, uint32_t y, uint32_t z)

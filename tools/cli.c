@@ -64,19 +64,56 @@ void cli_error(const char *cmd, const char *fmt, ...)
     va_end(ap);
 }
 
+/* Shortest "%.*g" of `v` (up to max_digits) that reads back as `v` (as a float if is_float). */
+static const char *json_number(char *buf, const double v, const int max_digits, const int is_float)
+{
+    if (!isfinite(v)) {
+        snprintf(buf, CLI_NUM_CHARS, "null");
+        return buf;
+    }
+    for (int digits = 1; digits <= max_digits; digits++) {
+        snprintf(buf, CLI_NUM_CHARS, "%.*g", digits, v);
+        const double back = strtod(buf, NULL);
+        const double want = is_float ? (double)(float)back : back;
+        if (!(want < v) && !(want > v)) {
+            break;
+        }
+    }
+    return buf;
+}
+
+const char *cli_json_double(char *buf, const double v)
+{
+    return json_number(buf, v, 17, 0);
+}
+
+const char *cli_json_float(char *buf, const float v)
+{
+    return json_number(buf, (double)v, 9, 1);
+}
+
 void cli_print_stats_json(FILE *f, const occ_map_t *map, const occ_map_stats_t *st)
 {
-    fprintf(f, "\"resolution_m\": %.6g, \"depth_levels\": %u, \"inner_nodes\": %llu, "
+    char res[CLI_NUM_CHARS], occ[CLI_NUM_CHARS], fre[CLI_NUM_CHARS];
+    fprintf(f, "\"resolution_m\": %s, \"depth_levels\": %u, \"inner_nodes\": %llu, "
                "\"leaf_nodes\": %llu, \"occupied_leaves\": %llu, \"free_leaves\": %llu, "
-               "\"occupied_volume_m3\": %.6g, \"free_volume_m3\": %.6g, \"memory_bytes\": %zu, ",
-            (double)map->cfg.resolution_m, (unsigned)map->cfg.depth_levels,
+               "\"occupied_voxels\": %llu, \"free_voxels\": %llu, "
+               "\"occupied_volume_m3\": %s, \"free_volume_m3\": %s, \"memory_bytes\": %zu, ",
+            cli_json_float(res, map->cfg.resolution_m), (unsigned)map->cfg.depth_levels,
             (unsigned long long)st->inner_nodes, (unsigned long long)st->leaf_nodes,
             (unsigned long long)st->occupied_leaves, (unsigned long long)st->free_leaves,
-            (double)st->occupied_volume_m3, (double)st->free_volume_m3, st->bytes_used);
+            (unsigned long long)st->occupied_voxels, (unsigned long long)st->free_voxels,
+            cli_json_double(occ, st->occupied_volume_m3), cli_json_double(fre, st->free_volume_m3),
+            st->bytes_used);
     if (st->has_known) {
-        fprintf(f, "\"bbox_min\": [%.6g, %.6g, %.6g], \"bbox_max\": [%.6g, %.6g, %.6g]",
-                (double)st->bbox_min.x, (double)st->bbox_min.y, (double)st->bbox_min.z,
-                (double)st->bbox_max.x, (double)st->bbox_max.y, (double)st->bbox_max.z);
+        const float box[6] = {st->bbox_min.x, st->bbox_min.y, st->bbox_min.z,
+                              st->bbox_max.x, st->bbox_max.y, st->bbox_max.z};
+        char b[6][CLI_NUM_CHARS];
+        for (int i = 0; i < 6; i++) {
+            cli_json_float(b[i], box[i]);
+        }
+        fprintf(f, "\"bbox_min\": [%s, %s, %s], \"bbox_max\": [%s, %s, %s]", b[0], b[1], b[2],
+                b[3], b[4], b[5]);
     } else {
         fprintf(f, "\"bbox_min\": null, \"bbox_max\": null");
     }
@@ -90,8 +127,8 @@ void cli_print_stats_text(FILE *f, const occ_map_t *map, const occ_map_stats_t *
             (unsigned long long)st->inner_nodes, (unsigned long long)st->leaf_nodes);
     fprintf(f, "leaves            %llu occupied, %llu free\n",
             (unsigned long long)st->occupied_leaves, (unsigned long long)st->free_leaves);
-    fprintf(f, "volume            %.3f m3 occupied, %.3f m3 free\n",
-            (double)st->occupied_volume_m3, (double)st->free_volume_m3);
+    fprintf(f, "volume            %.6f m3 occupied, %.6f m3 free\n", st->occupied_volume_m3,
+            st->free_volume_m3);
     fprintf(f, "memory            %zu bytes (%u inner + %u leaf blocks), peak %zu, arena %zu\n",
             st->bytes_used, st->inner_used, st->leaf_used, st->bytes_peak, st->arena_bytes);
     if (st->has_known) {

@@ -23,9 +23,17 @@ int cli_parse_size(const char *s, size_t *out);
 /* Print an error "occmap <cmd>: <msg>" to stderr. */
 void cli_error(const char *cmd, const char *fmt, ...);
 
+/* JSON number text that reads back as exactly `v`: the shortest "%.*g" that round-trips (at most
+ * 17 significant digits for a double, 9 for a float). `buf` must hold CLI_NUM_CHARS; returns
+ * it. Non-finite values print as null (JSON has no NaN/Inf). */
+#define CLI_NUM_CHARS 32
+const char *cli_json_double(char *buf, double v);
+const char *cli_json_float(char *buf, float v);
+
 /* Print the map statistics keys (without braces) as JSON members:
  * "resolution_m", "depth_levels", "inner_nodes", "leaf_nodes", "occupied_leaves", "free_leaves",
- * "occupied_volume_m3", "free_volume_m3", "memory_bytes", "bbox_min", "bbox_max". */
+ * "occupied_voxels", "free_voxels", "occupied_volume_m3", "free_volume_m3", "memory_bytes",
+ * "bbox_min", "bbox_max". Every number round-trips (cli_json_double / cli_json_float). */
 void cli_print_stats_json(FILE *f, const occ_map_t *map, const occ_map_stats_t *st);
 /* The same as human-readable lines. */
 void cli_print_stats_text(FILE *f, const occ_map_t *map, const occ_map_stats_t *st);

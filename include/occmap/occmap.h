@@ -303,7 +303,10 @@ typedef struct {
     uint64_t nodes;           /* observed nodes, root included: OctoMap's size() */
     uint64_t inner_nodes;     /* observed nodes with children */
     uint64_t leaf_nodes;      /* observed nodes without children (OctoMap's leaves) */
-    float occupied_volume_m3, free_volume_m3;
+    /* Voxels x resolution^3 in double, with the resolution a user writes (the shortest decimal
+     * that round-trips resolution_m: 0.1f -> 0.1), so they equal octomap::OcTree(0.1)'s sums of
+     * its leaves' volumes to ~1e-15 relative (a float sum was off in the 7th digit). */
+    double occupied_volume_m3, free_volume_m3;
     bool has_known;           /* false: nothing observed, the bbox is empty */
     occ_vec3_t bbox_min, bbox_max; /* metres, of the observed space */
 } occ_map_stats_t;

@@ -7,7 +7,7 @@ occmap=$1; map=$2; py=$3
 here=$(cd "$(dirname "$0")" && pwd)
 if ! unshare -n true 2>/dev/null; then
   echo "SKIP can-mcast: cannot create a network namespace here (unshare -n needs root or user namespaces; environment limit)"
-  exit 0
+  exit 77
 fi
 exec unshare -n bash -c '
   set -e

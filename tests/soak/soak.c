@@ -196,7 +196,7 @@ int main(int argc, char **argv)
     }
     if (access(TUM_DIR "/my_association.txt", R_OK) != 0) {
         printf("SKIP soak: %s absent (needs ../shared)\n", TUM_DIR);
-        return 0;
+        return 77; /* skipped: tests/run_all.sh counts it (a failure under CI=true) */
     }
     source_t src[16];
     const size_t n_src = load_sources(&o, src, 16u);
