@@ -400,6 +400,18 @@ static int32_t clamp_key(int32_t k, int32_t hi)
     return k < 0 ? 0 : (k > hi ? hi : k);
 }
 
+static uint16_t to_cm(float d, const occ_sectors_config_t *cfg)
+{
+    const float cm = floorf(d * 100.0f);
+    if (cm <= (float)cfg->min_distance_cm) {
+        return cfg->min_distance_cm;
+    }
+    if (cm >= (float)cfg->max_distance_cm) {
+        return cfg->max_distance_cm;
+    }
+    return (uint16_t)cm;
+}
+
 /* The unsafe answer every sector holds on an error: an obstacle at the minimum distance (a value
  * both autopilots act on; 0 and UINT16_MAX would be skipped by ArduPilot). */
 static void fill_unsafe(occ_sectors_t *out, const occ_sectors_config_t *cfg)
@@ -445,18 +457,6 @@ static float ground_lift(const occ_map_t *map, const occ_pose_t *pose,
         }
         k.k[2] = cfg->map_ned ? k.k[2] + 1u : k.k[2] - 1u;
     }
-}
-
-static uint16_t to_cm(float d, const occ_sectors_config_t *cfg)
-{
-    const float cm = floorf(d * 100.0f);
-    if (cm <= (float)cfg->min_distance_cm) {
-        return cfg->min_distance_cm;
-    }
-    if (cm >= (float)cfg->max_distance_cm) {
-        return cfg->max_distance_cm;
-    }
-    return (uint16_t)cm;
 }
 
 occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
