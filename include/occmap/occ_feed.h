@@ -74,7 +74,8 @@ occ_pose_t occ_pose_from_ned(float north_m, float east_m, float down_m, float ya
 typedef struct {
     uint8_t n_sectors;             /* 1..72 */
     float increment_deg;           /* (0, 90], n_sectors * increment_deg <= 360 */
-    float angle_offset_deg;        /* body angle of sector 0's centre, clockwise positive */
+    float angle_offset_deg;        /* body angle of sector 0's centre, clockwise positive; 0 by
+                                    * default (the MAVLink feed's default is -20: occ_mavlink.h) */
     float band_below_m, band_above_m; /* vertical band around the vehicle, metres >= 0, sum > 0 */
     uint16_t min_distance_cm, max_distance_cm; /* 1 <= min < max <= 65533 */
     bool unknown_as_distance;      /* see the header comment: false -> UINT16_MAX */
