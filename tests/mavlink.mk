@@ -42,8 +42,10 @@ $(MAV_REF)/mav_dump: $(BUILD)/asanhost/tests/mavlink/mav_dump.o $(BUILD)/asan/li
 test-mavlink-roundtrip: $(MAV_REF)/mav_dump $(BUILD)/.deps-ok
 	$(MAV_REF)/mav_dump $(MAV_REF)/c_frames.bin $(MAV_REF)/c_frames.txt
 	$(PY) tools/mav_check_c_frames.py $(MAV_REF)/c_frames.bin $(MAV_REF)/c_frames.txt
-# occmap feed over UDP loopback against a pymavlink peer: poses in, OBSTACLE_DISTANCE out,
-# heartbeat rate, and the stale-pose timeout.
+# occmap feed over UDP loopback against a pymavlink peer playing ArduPilot: SET_MESSAGE_INTERVAL
+# requests (and a logged refusal), poses only from the autopilot, OBSTACLE_DISTANCE out checked
+# against sector_ref.py and through ArduPilot's face rule (issue 16's geb079 case), heartbeat
+# rate, the stale-pose timeout.
 test-mavlink-udp: $(BUILD)/occmap $(BUILD)/.deps-ok
 	$(PY) tools/mav_feed_peer.py --occmap $(BUILD)/occmap --test
 TEST_STEPS += test-mavlink-roundtrip test-mavlink-udp

@@ -158,13 +158,42 @@ typedef struct {
     uint16_t cm[OCC_SECTORS_MAX];
 } ref_t;
 
+/* The ground rule of occ_feed.h, in double: the first occupied voxel down the vehicle's column
+ * (from its own voxel while the voxel reaches above za) lifts za to its top + clearance. */
+static double ref_band_lo(const occ_pose_t *p, const occ_sectors_config_t *cfg, double za,
+                          double zb)
+{
+    if (!cfg->ignore_ground) {
+        return za;
+    }
+    const double res = map.cfg.resolution_m;
+    const int64_t half = (int64_t)1 << (map.cfg.depth_levels - 1);
+    const int64_t kx = (int64_t)floor((double)p->x / res) + half;
+    const int64_t ky = (int64_t)floor((double)p->y / res) + half;
+    for (int64_t kz = (int64_t)floor((double)p->z / res) + half; kz >= 0; kz--) {
+        const double top = (double)(kz - half + 1) * res;
+        if (!(top > za)) {
+            break;
+        }
+        occ_key_t k = {{(uint32_t)kx, (uint32_t)ky, (uint32_t)kz}};
+        occ_node_info_t info;
+        assert_int_equal(occ_map_read_key(&map, k, 0, &info), OCC_OK);
+        if (info.observed && info.state == OCC_STATE_OCCUPIED) {
+            const double lifted = top + (double)cfg->ground_clearance_m;
+            return lifted > za && lifted < zb ? lifted : za;
+        }
+    }
+    return za;
+}
+
 static void reference(const occ_pose_t *p, const occ_sectors_config_t *cfg, ref_t *r)
 {
     const double res = map.cfg.resolution_m;
     const int64_t half = (int64_t)1 << (map.cfg.depth_levels - 1);
     const double R = cfg->max_distance_cm * 0.01;
     const double px = p->x, py = p->y, pz = p->z, yaw = p->yaw_rad;
-    const double za = pz - (double)cfg->band_below_m, zb = pz + (double)cfg->band_above_m;
+    const double zb = pz + (double)cfg->band_above_m;
+    const double za = ref_band_lo(p, cfg, pz - (double)cfg->band_below_m, zb);
     const double inc = (double)cfg->increment_deg * M_PI / 180.0;
     const double off = (double)cfg->angle_offset_deg * M_PI / 180.0;
     for (unsigned s = 0; s < cfg->n_sectors; s++) {
@@ -204,7 +233,7 @@ static void reference(const occ_pose_t *p, const occ_sectors_config_t *cfg, ref_
         } else if (r->d_unk[s] < R) {
             r->cm[s] = cfg->unknown_as_distance ? ref_cm(r->d_unk[s], cfg) : UINT16_MAX;
         } else {
-            r->cm[s] = cfg->max_distance_cm;
+            r->cm[s] = (uint16_t)(cfg->max_distance_cm + 1u); /* "no obstacle" */
         }
     }
 }
@@ -312,6 +341,8 @@ static void random_config(occ_sectors_config_t *cfg)
     cfg->min_distance_cm = (uint16_t)(5 + rand() % 30);
     cfg->max_distance_cm = (uint16_t)(150 + rand() % 200);
     cfg->unknown_as_distance = (rand() & 1) != 0;
+    cfg->ignore_ground = (rand() & 3) != 0;
+    cfg->ground_clearance_m = (float)(urand() * 0.3);
 }
 
 static void test_random_maps(void **state)
@@ -379,14 +410,14 @@ static void test_behind_180(void **state)
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     /* Nearest wall point (-0.9, 0.05): 0.95 m. */
     assert_int_equal(sect.distance_cm[36], 95);
-    assert_int_equal(sect.distance_cm[0], 250);   /* ahead: free up to 2.5 m */
-    assert_int_equal(sect.distance_cm[18], 250);  /* right (south) */
+    assert_int_equal(sect.distance_cm[0], 251);   /* ahead: free up to 2.5 m: max + 1 */
+    assert_int_equal(sect.distance_cm[18], 251);  /* right (south) */
     assert_int_equal(compare(&p, &cfg, "behind"), 0);
     /* Facing west (yaw pi): the wall is ahead, sector 0; yaw -pi the same. */
     p.yaw_rad = (float)M_PI;
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sect.distance_cm[0], 95);
-    assert_int_equal(sect.distance_cm[36], 250);
+    assert_int_equal(sect.distance_cm[36], 251);
     p.yaw_rad = -(float)M_PI;
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sect.distance_cm[0], 95);
@@ -517,6 +548,163 @@ static void test_ned_mirror(void **state)
     }
 }
 
+/* A room on a floor: observed free space z in [0, 1.6) over [-3.2, 3.2)^2, the floor voxels
+ * z in [-0.1, 0) occupied (unknown below), a wall x in [2.0, 2.1) up to 1.6 m. */
+static void floor_room(void)
+{
+    occ_key_t k;
+    for (double x = -3.2; x < 3.2; x += 1.6) {
+        for (double y = -3.2; y < 3.2; y += 1.6) {
+            key_at(x + 0.05, y + 0.05, 0.05, &k);
+            assert_int_equal(occ_map_set_key(&map, k, 4, -2.0f), OCC_OK);
+        }
+    }
+    for (double x = -2.95; x < 3.0; x += 0.1) {
+        for (double y = -2.95; y < 3.0; y += 0.1) {
+            key_at(x, y, -0.05, &k);
+            assert_int_equal(occ_map_update_key(&map, k, 2.0f), OCC_OK);
+        }
+    }
+    for (double y = -2.95; y < 3.0; y += 0.1) {
+        for (double z = -0.05; z < 1.6; z += 0.1) {
+            key_at(2.05, y, z, &k);
+            assert_int_equal(occ_map_update_key(&map, k, 2.0f), OCC_OK);
+        }
+    }
+}
+
+static unsigned sectors_below(unsigned cm)
+{
+    unsigned n = 0;
+    for (unsigned s = 0; s < sect.n; s++) {
+        n += sect.distance_cm[s] < cm ? 1u : 0u;
+    }
+    return n;
+}
+
+/* The vehicle standing on the floor can arm (ArduPilot wants > 0.6 m in every face): the ground
+ * rule keeps the floor out of the band, the wall stays in; without it the floor is everywhere. */
+static void test_floor_standing(void **state)
+{
+    (void)state;
+    floor_room();
+    occ_sectors_config_t cfg = occ_sectors_config_default();
+    cfg.max_distance_cm = 300; /* the free room reaches 3.15 m */
+    occ_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f}; /* 5 cm above the floor, facing east */
+    assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
+    assert_int_equal(sectors_below(61), 0);
+    assert_int_equal(sect.distance_cm[0], 195);   /* the wall ahead */
+    assert_int_equal(sect.distance_cm[36], 301);  /* behind: free (floor ignored) */
+    assert_int_equal(compare(&p, &cfg, "floor-standing"), 0);
+    /* Flying over it at 0.3 m and at 1.2 m: the same. */
+    p.z = 0.3f;
+    assert_int_equal(compare(&p, &cfg, "floor-0.3"), 0);
+    assert_int_equal(sectors_below(61), 0);
+    p.z = 1.2f;
+    assert_int_equal(compare(&p, &cfg, "floor-1.2"), 0);
+    assert_int_equal(sectors_below(61), 0);
+    /* The old band: the floor is an obstacle at 0 m in every sector (min_distance). */
+    cfg.ignore_ground = false;
+    p.z = 0.05f;
+    assert_int_equal(compare(&p, &cfg, "floor-kept"), 0);
+    assert_int_equal(sectors_below(21), 72);
+    /* A box on the floor (z 0..0.3) taller than the clearance is an obstacle (west, 1.05 m). */
+    occ_key_t k;
+    for (double z = 0.05; z < 0.3; z += 0.1) {
+        key_at(-1.05, 0.05, z, &k);
+        assert_int_equal(occ_map_update_key(&map, k, 2.0f), OCC_OK);
+    }
+    cfg.ignore_ground = true;
+    assert_int_equal(compare(&p, &cfg, "floor-box"), 0);
+    assert_true(sect.distance_cm[36] >= 104 && sect.distance_cm[36] <= 105);
+    /* With a clearance above its top it is not. */
+    cfg.ground_clearance_m = 0.35f;
+    assert_int_equal(compare(&p, &cfg, "floor-box-low"), 0);
+    assert_int_equal(sect.distance_cm[36], 301);
+}
+
+/* Separate settings below and above: a shelf at 0.8..0.9 m north, a low box south. */
+static void test_band_below_above(void **state)
+{
+    (void)state;
+    floor_room();
+    occ_key_t k;
+    for (double x = -0.45; x < 0.5; x += 0.1) {
+        key_at(x, 1.05, 0.85, &k); /* shelf: 1.0 m north, z 0.8..0.9 */
+        assert_int_equal(occ_map_update_key(&map, k, 2.0f), OCC_OK);
+        key_at(x, -1.55, 0.25, &k); /* box top: 1.5 m south, z 0.2..0.3 */
+        assert_int_equal(occ_map_update_key(&map, k, 2.0f), OCC_OK);
+    }
+    occ_sectors_config_t cfg = occ_sectors_config_default();
+    cfg.max_distance_cm = 300; /* the free room reaches 3.15 m */
+    occ_pose_t p = {0.05f, 0.05f, 0.6f, (float)(M_PI / 2.0), 0.0f, 0.0f}; /* facing north */
+    cfg.band_below_m = 0.2f;
+    cfg.band_above_m = 0.1f; /* [0.4, 0.7): neither */
+    assert_int_equal(compare(&p, &cfg, "band-none"), 0);
+    assert_int_equal(sect.distance_cm[0], 301);
+    assert_int_equal(sect.distance_cm[36], 301);
+    cfg.band_above_m = 0.3f; /* [0.4, 0.9): the shelf ahead */
+    assert_int_equal(compare(&p, &cfg, "band-above"), 0);
+    assert_int_equal(sect.distance_cm[0], 95);
+    assert_int_equal(sect.distance_cm[36], 301);
+    cfg.band_above_m = 0.1f;
+    cfg.band_below_m = 0.35f; /* [0.25, 0.7): the box behind */
+    assert_int_equal(compare(&p, &cfg, "band-below"), 0);
+    assert_int_equal(sect.distance_cm[0], 301);
+    assert_int_equal(sect.distance_cm[36], 155);
+}
+
+static void assert_unsafe(uint16_t want)
+{
+    assert_int_equal(sect.n, 0);
+    for (unsigned s = 0; s < OCC_SECTORS_MAX; s++) {
+        assert_int_equal(sect.distance_cm[s], want);
+        assert_true(fabsf(sect.d_occ_m[s]) + fabsf(sect.d_unk_m[s]) < 1e-30f);
+    }
+}
+
+/* Every error leaves the unsafe answer (an obstacle at min_distance) in all 72 values, also
+ * over the values of an earlier good call. */
+static void test_fail_closed(void **state)
+{
+    (void)state;
+    floor_room();
+    occ_sectors_config_t cfg = occ_sectors_config_default();
+    occ_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f};
+    assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
+    assert_true(sect.distance_cm[36] > cfg.min_distance_cm);
+    assert_int_equal(occ_sectors_compute(NULL, &p, &cfg, &sect), OCC_ERR_ARG);
+    assert_unsafe(cfg.min_distance_cm);
+    assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
+    assert_int_equal(occ_sectors_compute(&map, NULL, &cfg, &sect), OCC_ERR_ARG);
+    assert_unsafe(cfg.min_distance_cm);
+    assert_int_equal(occ_sectors_compute(&map, &p, NULL, &sect), OCC_ERR_ARG);
+    assert_unsafe(1);
+    occ_sectors_config_t bad = cfg;
+    bad.n_sectors = 0;
+    bad.min_distance_cm = 35;
+    assert_int_equal(occ_sectors_compute(&map, &p, &bad, &sect), OCC_ERR_ARG);
+    assert_unsafe(35);
+    p.yaw_rad = NAN;
+    assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_ERR_ARG);
+    assert_unsafe(cfg.min_distance_cm);
+    p.yaw_rad = 0.0f;
+    p.x = 1e7f;
+    assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_ERR_RANGE);
+    assert_unsafe(cfg.min_distance_cm);
+    bad = cfg;
+    bad.ground_clearance_m = -0.1f;
+    p.x = 0.05f;
+    assert_int_equal(occ_sectors_compute(&map, &p, &bad, &sect), OCC_ERR_ARG);
+    bad.ground_clearance_m = NAN;
+    assert_int_equal(occ_sectors_config_check(&bad), OCC_ERR_ARG);
+    bad = cfg;
+    bad.max_distance_cm = OCC_SECTORS_MAX_DISTANCE_CM + 1u; /* max + 1 would read "unknown" */
+    assert_int_equal(occ_sectors_config_check(&bad), OCC_ERR_ARG);
+    bad.max_distance_cm = OCC_SECTORS_MAX_DISTANCE_CM;
+    assert_int_equal(occ_sectors_config_check(&bad), OCC_OK);
+}
+
 static void test_args(void **state)
 {
     (void)state;
@@ -596,6 +784,9 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_map_edges, setup, teardown),
         cmocka_unit_test_setup_teardown(test_random_maps, setup, teardown),
         cmocka_unit_test_setup_teardown(test_ned_mirror, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_floor_standing, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_band_below_above, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_fail_closed, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -43,7 +43,9 @@ static void usage(FILE *f)
             "A DroneCAN node: ardupilot.equipment.proximity_sensor.Proximity for every sector with an\n"
             "obstacle around the pose (body yaw degrees, 0 forward, clockwise), NodeStatus at 1 Hz,\n"
             "GetNodeInfo answered. --pose is the autopilot's NED pose (metres, yaw degrees from north);\n"
-            "--mavlink-udp listens on HOST:PORT for the autopilot's MAVLink stream and takes live poses.\n"
+            "--mavlink-udp listens on HOST:PORT for the autopilot's MAVLink stream and takes live poses\n"
+            "(only from the system of the first autopilot HEARTBEAT, component 1; it sends nothing, so\n"
+            "the autopilot must stream LOCAL_POSITION_NED and ATTITUDE on that link by itself).\n"
             "--mcast BUS is pydronecan's / ArduPilot SITL's CAN over UDP multicast (239.65.82.BUS:57732,\n"
             "loopback only). Ends after --duration-s (default: until SIGINT) and prints statistics as\n"
             "one JSON line.\n");
@@ -223,6 +225,7 @@ int cmd_can_feed(int argc, char **argv)
         occ_mav_feed_config_t mcfg = occ_mav_feed_config_default();
         mcfg.map_frame = map_ned ? OCC_MAP_FRAME_NED : OCC_MAP_FRAME_ENU;
         mcfg.sectors = scfg;
+        mcfg.pose_interval_us = 0; /* this link only listens: the streams must be set up */
         if (occ_mav_feed_init(&mav, &mcfg) != OCC_OK || (mav_fd = open_udp_listen(mav_udp)) < 0) {
             cli_error(CMD, "cannot listen for MAVLink on %s: %s", mav_udp, strerror(errno));
             free(arena);

@@ -23,16 +23,42 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: occmap feed --map MAP (--udp HOST:PORT | --udp-listen [HOST:]PORT |\n"
             "                   --serial DEV:BAUD) [--rate-hz 10] [--sysid 1] [--compid 196]\n"
+            "                   [--autopilot-sysid N] [--autopilot-compid 1] [--pose-interval-ms 50]\n"
             "                   [--timeout-ms 300] [--autopilot ardupilot|px4] [--map-frame enu|ned]\n"
-            "                   [--min-m 0.2] [--max-m 20] [--band-m 0.5] [--unknown-as-distance]\n"
-            "                   [--duration-s S] [--verbose]\n"
+            "                   [--min-m 0.2] [--max-m 20] [--angle-offset-deg -20]\n"
+            "                   [--band-below-m 0.5] [--band-above-m 0.5] [--band-m B]\n"
+            "                   [--ground-clearance-m 0.1] [--no-ignore-ground]\n"
+            "                   [--unknown no-data|distance] [--duration-s S] [--verbose]\n"
             "Reads the autopilot's pose (LOCAL_POSITION_NED + ATTITUDE, ODOMETRY or\n"
             "ATTITUDE_QUATERNION) and sends MAVLink 2 OBSTACLE_DISTANCE (72 x 5 deg, MAV_FRAME_BODY_FRD)\n"
             "at --rate-hz plus a 1 Hz HEARTBEAT (MAV_TYPE_ONBOARD_CONTROLLER). Nothing is sent while the\n"
-            "pose is older than --timeout-ms. --udp sends to HOST:PORT and takes poses from whoever\n"
-            "answers (an autopilot or SITL listening there); --udp-listen waits for the autopilot to\n"
-            "send first. The map file is fixed for the run, so it never goes stale. Ends after\n"
-            "--duration-s (default: at SIGINT/SIGTERM) and prints statistics as one JSON line.\n");
+            "pose is older than --timeout-ms. --udp sends to HOST:PORT (an autopilot or SITL listening\n"
+            "there); --udp-listen waits for the autopilot to send first. The map file is fixed for the run, so it never goes stale. Ends after\n"
+            "--duration-s (default: at SIGINT/SIGTERM) and prints statistics as one JSON line.\n"
+            "\n"
+            "The autopilot: poses are taken only from system --autopilot-sysid (default: the first\n"
+            "HEARTBEAT of an autopilot, i.e. not MAV_AUTOPILOT_INVALID and not a GCS), component\n"
+            "--autopilot-compid. The feed asks it for LOCAL_POSITION_NED and ATTITUDE every\n"
+            "--pose-interval-ms (MAV_CMD_SET_MESSAGE_INTERVAL), once a second while a stream is\n"
+            "missing, and again after it stops (an autopilot reboot); refusals are logged.\n"
+            "--pose-interval-ms 0: never ask (streams configured on the autopilot).\n"
+            "\n"
+            "What each element says (ArduPilot PRX1_TYPE=2 keeps the nearest valid element of each of\n"
+            "its 8 faces of 45 deg; PX4 bins them into 36 x 10 deg):\n"
+            "  obstacle  distance in cm, clamped to [min, max]: an obstacle to both.\n"
+            "  free      max + 1 (MAVLink's \"no obstacle\"): ArduPilot drops it, an all-free face reads\n"
+            "            \"no obstacle\"; PX4 reads free.\n"
+            "  unknown   --unknown no-data (default): 65535; ArduPilot skips it, so a face of only\n"
+            "            unknown reads \"no obstacle\" (it will fly and arm there); PX4: no data.\n"
+            "            --unknown distance: the distance to the unknown space, an obstacle to both:\n"
+            "            the vehicle stops short of unexplored space, and ArduPilot's arming check\n"
+            "            (> 0.6 m in every face) fails while unknown space is within 0.6 m.\n"
+            "--angle-offset-deg: body angle of element 0's centre; -20 makes each of ArduPilot's faces\n"
+            "one run of 9 elements (with 0 its forward face is overwritten by elements 68-71).\n"
+            "The band: voxels from --band-below-m under the vehicle to --band-above-m over it count;\n"
+            "the ground under the vehicle (the first occupied voxel down its own column) and\n"
+            "anything less than --ground-clearance-m above it do not, so the floor it stands on or\n"
+            "flies over is no obstacle; --no-ignore-ground reports it.\n");
 }
 
 static bool parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
@@ -81,12 +107,31 @@ typedef struct {
     uint64_t n, sum_us, max_us;
 } timing_t;
 
+/* The autopilot the feed listens to, once; every refused SET_MESSAGE_INTERVAL. */
+static void log_autopilot(const occ_mav_feed_t *feed, bool *named, uint32_t *refusals)
+{
+    if (!*named && feed->have_autopilot) {
+        *named = true;
+        fprintf(stderr, "feed: poses from the autopilot at system %u component %u\n",
+                feed->ap_sysid, feed->ap_compid);
+    }
+    if (feed->counters.request_refusals != *refusals) {
+        *refusals = feed->counters.request_refusals;
+        fprintf(stderr, "feed: the autopilot refused SET_MESSAGE_INTERVAL (MAV_RESULT %u, %u "
+                "refusals); set its stream rates for LOCAL_POSITION_NED and ATTITUDE by hand\n",
+                feed->counters.last_refusal_result, *refusals);
+    }
+}
+
 int cmd_feed(int argc, char **argv)
 {
     const char *map_path = NULL, *udp = NULL, *udp_listen = NULL, *serial = NULL;
     occ_mav_feed_config_t cfg = occ_mav_feed_config_default();
     uint32_t rate_hz = 10, timeout_ms = 300, sysid = cfg.sysid, compid = cfg.compid;
-    float duration_s = 0.0f, min_m = 0.2f, max_m = 20.0f, band_m = 0.5f;
+    uint32_t ap_sysid = cfg.autopilot_sysid, ap_compid = cfg.autopilot_compid;
+    uint32_t pose_interval_ms = cfg.pose_interval_us / 1000u;
+    float duration_s = 0.0f, min_m = 0.2f, max_m = 20.0f, band_m = 0.0f;
+    occ_sectors_config_t *const sc = &cfg.sectors;
     bool verbose = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -98,8 +143,11 @@ int cmd_feed(int argc, char **argv)
         } else if (strcmp(a, "--verbose") == 0) {
             verbose = true;
             continue;
-        } else if (strcmp(a, "--unknown-as-distance") == 0) {
-            cfg.sectors.unknown_as_distance = true;
+        } else if (strcmp(a, "--unknown-as-distance") == 0) { /* the old spelling */
+            sc->unknown_as_distance = true;
+            continue;
+        } else if (strcmp(a, "--no-ignore-ground") == 0) {
+            sc->ignore_ground = false;
             continue;
         }
         if (v == NULL) {
@@ -132,6 +180,29 @@ int cmd_feed(int argc, char **argv)
             ok = parse_float(v, 0.02f, 655.0f, &max_m);
         } else if (strcmp(a, "--band-m") == 0) {
             ok = parse_float(v, 0.01f, 100.0f, &band_m);
+            sc->band_below_m = sc->band_above_m = band_m;
+        } else if (strcmp(a, "--band-below-m") == 0) {
+            ok = parse_float(v, 0.0f, 100.0f, &sc->band_below_m);
+        } else if (strcmp(a, "--band-above-m") == 0) {
+            ok = parse_float(v, 0.0f, 100.0f, &sc->band_above_m);
+        } else if (strcmp(a, "--ground-clearance-m") == 0) {
+            ok = parse_float(v, 0.0f, 100.0f, &sc->ground_clearance_m);
+        } else if (strcmp(a, "--angle-offset-deg") == 0) {
+            ok = parse_float(v, -360.0f, 360.0f, &sc->angle_offset_deg);
+        } else if (strcmp(a, "--unknown") == 0) {
+            if (strcmp(v, "no-data") == 0) {
+                sc->unknown_as_distance = false;
+            } else if (strcmp(v, "distance") == 0) {
+                sc->unknown_as_distance = true;
+            } else {
+                ok = false;
+            }
+        } else if (strcmp(a, "--autopilot-sysid") == 0) {
+            ok = parse_u32(v, 1, 255, &ap_sysid);
+        } else if (strcmp(a, "--autopilot-compid") == 0) {
+            ok = parse_u32(v, 1, 255, &ap_compid);
+        } else if (strcmp(a, "--pose-interval-ms") == 0) {
+            ok = parse_u32(v, 0, 60000, &pose_interval_ms);
         } else if (strcmp(a, "--autopilot") == 0) {
             if (strcmp(v, "ardupilot") == 0) {
                 cfg.autopilot = OCC_AUTOPILOT_ARDUPILOT;
@@ -168,14 +239,15 @@ int cmd_feed(int argc, char **argv)
     cfg.compid = (uint8_t)compid;
     cfg.period_us = 1000000u / rate_hz;
     cfg.pose_timeout_us = timeout_ms * 1000u;
-    cfg.sectors.min_distance_cm = (uint16_t)(min_m * 100.0f + 0.5f);
-    cfg.sectors.max_distance_cm = (uint16_t)(max_m * 100.0f + 0.5f);
-    cfg.sectors.band_below_m = band_m;
-    cfg.sectors.band_above_m = band_m;
+    cfg.autopilot_sysid = (uint8_t)ap_sysid;
+    cfg.autopilot_compid = (uint8_t)ap_compid;
+    cfg.pose_interval_us = pose_interval_ms * 1000u;
+    sc->min_distance_cm = (uint16_t)(min_m * 100.0f + 0.5f);
+    sc->max_distance_cm = (uint16_t)(max_m * 100.0f + 0.5f);
     static occ_mav_feed_t feed;
     if (occ_mav_feed_init(&feed, &cfg) != OCC_OK) {
-        cli_error(CMD, "bad feed configuration (min %.2f m must be < max %.2f m)", (double)min_m,
-                  (double)max_m);
+        cli_error(CMD, "bad feed configuration (min %.2f m must be < max %.2f m; the band "
+                  "below + above must be > 0)", (double)min_m, (double)max_m);
         return 2;
     }
 
@@ -226,6 +298,8 @@ int cmd_feed(int argc, char **argv)
     const uint64_t t_end = duration_s > 0.0f ? t0 + (uint64_t)(duration_s * 1e6f) : UINT64_MAX;
     timing_t tm = {0, 0, 0};
     uint64_t next_report = t0 + 1000000u;
+    uint32_t refusals_logged = 0;
+    bool autopilot_logged = false;
     int status = 0;
     while (!stop_requested) {
         uint64_t now = occ_port_clock_us();
@@ -270,6 +344,7 @@ int cmd_feed(int argc, char **argv)
         if (status != 0) {
             break;
         }
+        log_autopilot(&feed, &autopilot_logged, &refusals_logged);
         if (verbose && now >= next_report) {
             next_report += 1000000u;
             occ_pose_t p;
@@ -292,13 +367,14 @@ int cmd_feed(int argc, char **argv)
     const occ_mav_feed_counters_t *c = &feed.counters;
     const occ_mav_counters_t *pc = &feed.parser.counters;
     printf("{\"obstacle_tx\": %u, \"heartbeat_tx\": %u, \"positions_rx\": %u, \"attitudes_rx\": %u, "
-           "\"ignored_rx\": %u, \"stale_skips\": %u, \"sector_errors\": %u, \"frames_ok\": %u, "
+           "\"ignored_rx\": %u, \"foreign_rx\": %u, \"requests_tx\": %u, \"request_acks\": %u, "
+           "\"request_refusals\": %u, \"stale_skips\": %u, \"sector_errors\": %u, \"frames_ok\": %u, "
            "\"bad_crc\": %u, \"bad_len\": %u, \"unknown_id\": %u, \"bad_flags\": %u, "
            "\"junk_bytes\": %u, \"tx_dropped\": %u, \"update_us_mean\": %.1f, "
            "\"update_us_max\": %llu}\n",
            c->obstacle_tx, c->heartbeat_tx, c->positions_rx, c->attitudes_rx, c->ignored_rx,
-           c->stale_skips, c->sector_errors, pc->frames_ok, pc->bad_crc, pc->bad_len,
-           pc->unknown_id, pc->bad_flags, pc->junk_bytes, link.tx_dropped,
+           c->foreign_rx, c->requests_tx, c->request_acks, c->request_refusals, c->stale_skips,
+           c->sector_errors, pc->frames_ok, pc->bad_crc, pc->bad_len, pc->unknown_id, pc->bad_flags, pc->junk_bytes, link.tx_dropped,
            tm.n > 0u ? (double)tm.sum_us / (double)tm.n : 0.0, (unsigned long long)tm.max_us);
     fflush(stdout);
     occ_link_close(&link);

@@ -30,22 +30,35 @@ from sector_ref import OCC, UNK  # noqa: E402
 Z_UP = 0.6
 BAND = 0.15
 MIN_CM, MAX_CM = 20, 600
+OFFSET = -20.0  # the feed's default angle_offset: ArduPilot's faces are contiguous runs
 STEP_M = 0.4
 CLEARANCE_M = 0.15
+AP_TYPE, AP_AUTOPILOT = 2, 3  # the HEARTBEAT of an ArduPilot quad: the feed takes its poses
 
-_SLICE = None
+_BT = None
+_SLICES = {}
 
 
 def _init_worker(path):
-    global _SLICE
-    res, depth, leaves = read_bt(path)
-    _SLICE = sector_ref.Slice(res, depth, leaves, Z_UP - BAND, Z_UP + BAND)
+    global _BT
+    _BT = read_bt(path)
+    res, depth, leaves = _BT
+    _SLICES[(Z_UP - BAND, Z_UP + BAND)] = sector_ref.Slice(res, depth, leaves, Z_UP - BAND, Z_UP + BAND)
 
 
 def _ref(args):
+    """72 x 5 deg reference and the 8 x 45 deg faces' nearest obstacles for one pose, in the band
+    the feed uses there (its ground rule lifts the band over ground under the vehicle)."""
     x, y, yaw = args
-    want, d_occ, d_unk = sector_ref.sectors(_SLICE, x, y, yaw, min_cm=MIN_CM, max_cm=MAX_CM)
-    return want, d_occ, d_unk
+    res, depth, leaves = _BT
+    band = sector_ref.ground_band(res, depth, leaves, x, y, Z_UP, BAND, BAND)
+    if band not in _SLICES:
+        _SLICES[band] = sector_ref.Slice(res, depth, leaves, band[0], band[1])
+    sl = _SLICES[band]
+    want, d_occ, d_unk = sector_ref.sectors(sl, x, y, yaw, off_deg=OFFSET, min_cm=MIN_CM, max_cm=MAX_CM)
+    _, d_occ8, d_unk8 = sector_ref.sectors(sl, x, y, yaw, n=8, inc_deg=45.0, off_deg=0.0,
+                                           min_cm=MIN_CM, max_cm=MAX_CM)
+    return want, d_occ, d_unk, d_occ8, d_unk8
 
 
 # ---- planning ------------------------------------------------------------------------------
@@ -202,11 +215,11 @@ def render(sl, path_pts, shots, out_path):
 
     for (x, y, yaw, dist) in shots:
         for k, d in enumerate(dist):
-            body = math.radians(5.0 * k)
+            body = math.radians(OFFSET + 5.0 * k)
             ang = yaw - body
             if d == 65535:
                 L, c = 0.5, (230, 140, 0)
-            elif d >= MAX_CM:
+            elif d > MAX_CM:
                 L, c = MAX_CM / 100.0, (120, 200, 120)
             else:
                 L, c = d / 100.0, (220, 30, 30)
@@ -286,6 +299,7 @@ def main():
     t0 = time.monotonic()
     next_line = t0 + 1.0
     next_send = t0
+    next_hb = t0
     for k, (x, y, yaw) in enumerate(poses):
         north, east, down, yaw_ned = y, x, -Z_UP, math.pi / 2 - yaw
         n_here = 0
@@ -295,6 +309,9 @@ def main():
             if now > deadline:
                 errors.append("pose %d: no OBSTACLE_DISTANCE within 2 s" % k)
                 break
+            if now >= next_hb:
+                conn.mav.heartbeat_send(AP_TYPE, AP_AUTOPILOT, 0, 0, 4)
+                next_hb = now + 1.0
             if now >= next_send:
                 ms = int((now - t0) * 1000)
                 conn.mav.local_position_ned_send(ms, north, east, down, 0, 0, 0)
@@ -312,7 +329,8 @@ def main():
                 if last is not None:
                     d = list(last.distances)
                     ob = [(v, i) for i, v in enumerate(d) if v < MAX_CM]
-                    near = "nearest %4d cm at %3d deg" % (min(ob)[0], min(ob)[1] * 5) if ob else "nothing within %d cm" % MAX_CM
+                    near = ("nearest %4d cm at %3d deg" % (min(ob)[0], (OFFSET + min(ob)[1] * 5) % 360)
+                            if ob else "nothing within %d cm" % MAX_CM)
                 else:
                     near = "-"
                 print("t=%4.1fs pose %3d/%d at (%6.2f, %5.2f) yaw %6.1f deg | OBSTACLE_DISTANCE %4d HEARTBEAT %3d | %s"
@@ -332,30 +350,47 @@ def main():
     # arrived).
     refs = list(refs_iter)
     pool.shutdown()
-    checked = mismatched = 0
+    checked = mismatched = faces_checked = 0
     classes = collections.Counter()
+    R = MAX_CM / 100.0
+
+    def faces_ok(m, ref):
+        """ArduPilot's face rule on the message: a face whose nearest point is an obstacle holds
+        it (1 cm), a free face reads no obstacle."""
+        faces = sector_ref.ardupilot_faces(m)
+        _, _, _, d_occ8, d_unk8 = ref
+        for f in range(8):
+            if d_occ8[f] <= d_unk8[f] and d_occ8[f] < R:
+                if faces[f] is None or abs(faces[f] - sector_ref.face_m(d_occ8[f], MIN_CM, MAX_CM)) > 0.011:
+                    return False
+            elif d_occ8[f] >= R and d_unk8[f] >= R and faces[f] is not None:
+                return False
+        return True
+
     for k, j, m in got:
         d = list(m.distances)
         h = m.get_header()
         if (h.srcSystem, h.srcComponent, m.frame, m.min_distance, m.max_distance) != (1, 196, 12, MIN_CM, MAX_CM) \
-                or abs(m.increment_f - 5.0) > 0 or 0 in d:
+                or abs(m.increment_f - 5.0) > 0 or m.angle_offset != OFFSET or 0 in d or MAX_CM in d:
             errors.append("pose %d: bad fields %s" % (k, m))
         cands = [k] if j > 0 or k == 0 else [k, k - 1]
         ok = False
         for c in cands:
-            want, d_occ, d_unk = refs[c]
-            if not sector_ref.agree(d, want, d_occ, d_unk, MAX_CM):
+            want, d_occ, d_unk = refs[c][:3]
+            if not sector_ref.agree(d, want, d_occ, d_unk, MAX_CM) and faces_ok(m, refs[c]):
                 ok = True
                 break
         checked += 1
+        faces_checked += 8
         if not ok:
             mismatched += 1
-            want, d_occ, d_unk = refs[k]
+            want, d_occ, d_unk = refs[k][:3]
             badk = sector_ref.agree(d, want, d_occ, d_unk, MAX_CM)
-            errors.append("pose %d message %d: sectors %s got %s want %s" % (
-                k, j, badk[:4], [d[i] for i in badk[:4]], [want[i] for i in badk[:4]]))
+            errors.append("pose %d message %d: sectors %s got %s want %s, faces %s want %s" % (
+                k, j, badk[:4], [d[i] for i in badk[:4]], [want[i] for i in badk[:4]],
+                sector_ref.ardupilot_faces(m), [round(v, 3) for v in refs[k][3]]))
         for v in d:
-            classes["unknown" if v == 65535 else ("free" if v >= MAX_CM else "obstacle")] += 1
+            classes["unknown" if v == 65535 else ("free" if v > MAX_CM else "obstacle")] += 1
     shots_idx = [int(i * (len(poses) - 1) / 7) for i in range(8)]
     last_msg = {}
     for k, j, m in got:
@@ -376,8 +411,9 @@ def main():
         ("path", "%d poses, %.1f m at z = %.1f m, flown in %.1f s" % (len(poses), length, Z_UP, t_flight)),
         ("OBSTACLE_DISTANCE received", "%d (%.1f Hz)" % (n_ob, n_ob / t_flight)),
         ("HEARTBEAT received", "%d (%.2f Hz)" % (len(heartbeats), len(heartbeats) / max(t_flight, 1e-9))),
-        ("messages checked vs .bt", "%d (%d sectors), %d disagree" % (checked, checked * 72, mismatched)),
-        ("sector values", "obstacle %.1f%%  free (max) %.1f%%  unknown %.1f%%" % (
+        ("messages checked vs .bt", "%d (%d sectors, %d ArduPilot faces), %d disagree" % (
+            checked, checked * 72, faces_checked, mismatched)),
+        ("sector values", "obstacle %.1f%%  free (max + 1) %.1f%%  unknown %.1f%%" % (
             100.0 * classes["obstacle"] / total, 100.0 * classes["free"] / total, 100.0 * classes["unknown"] / total)),
         ("closest obstacle", "%d cm (pose %d)" % nearest),
         ("bad frames seen by pymavlink", "%d" % bad_data),

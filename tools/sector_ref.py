@@ -7,7 +7,9 @@ otherwise. For each sector (body angles clockwise from forward), the distance is
 distance from the vehicle to the part of a column's square footprint inside the sector's wedge,
 found by clipping the square against the wedge's two half-planes (Sutherland-Hodgman). The
 reported value follows occ_feed.h: obstacle -> clamp(floor(cm)), unknown nearer -> 65535 (or its
-distance), nothing within max -> max_distance.
+distance), nothing within max -> max_distance + 1 (MAVLink's "no obstacle").
+ground_band() applies occ_feed.h's ground rule to the band; ardupilot_faces() is ArduPilot's
+documented OBSTACLE_DISTANCE handler (8 faces of 45 degrees) applied to a decoded message.
 """
 import math
 
@@ -166,7 +168,7 @@ def sectors(sl, x, y, yaw, n=72, inc_deg=5.0, off_deg=0.0, min_cm=20, max_cm=200
         elif d_unk[k] < R:
             out.append(_cm(d_unk[k], min_cm, max_cm) if unknown_as_distance else 65535)
         else:
-            out.append(max_cm)
+            out.append(max_cm + 1)
     return out, d_occ, d_unk
 
 
@@ -188,3 +190,55 @@ def agree(got, want, d_occ, d_unk, max_cm):
                 continue
         bad.append(k)
     return bad
+
+
+def ground_band(res, depth, leaves, x, y, z, below, above, clearance=0.1):
+    """occ_feed.h's ground rule for an ENU vehicle at (x, y, z): the band [za, zb), its lower edge
+    lifted to clearance above the first occupied voxel down the vehicle's own column."""
+    half = 1 << (depth - 1)
+    za, zb = z - below, z + above
+    kx, ky = math.floor(x / res) + half, math.floor(y / res) + half
+    col = {}
+    for (lx, ly, lz, s, o) in leaves:
+        if lx <= kx < lx + s and ly <= ky < ly + s:
+            for k in range(lz, lz + s):
+                col[k] = o
+    kz = math.floor(z / res) + half
+    while kz >= 0:
+        top = (kz - half + 1) * res
+        if not top > za:
+            break
+        if col.get(kz) == 1:
+            lifted = top + clearance
+            return (lifted, zb) if za < lifted < zb else (za, zb)
+        kz -= 1
+    return za, zb
+
+
+def face_m(d, min_cm, max_cm):
+    """What a face of nearest obstacle d metres must read: d as sent (floor cm, clamped), m."""
+    return _cm(d, min_cm, max_cm) / 100.0
+
+
+def ardupilot_faces(m):
+    """Faces (metres, None = no obstacle) ArduPilot's AP_Proximity_MAV makes of one decoded
+    OBSTACLE_DISTANCE: reset 8 faces of 45 deg centred on 0, 45, ...; walk elements in order,
+    skip 0, 65535, < min, > max; keep the nearest per face; store a face each time a valid
+    element's face differs from the previous valid one's."""
+    faces = [None] * 8
+    inc = m.increment_f if m.increment_f > 0 else m.increment
+    prev, best = None, None
+    for i, d in enumerate(m.distances):
+        if d == 0 or d == 65535 or d < m.min_distance or d > m.max_distance:
+            continue
+        face = int(((i * inc + m.angle_offset) % 360.0 + 22.5) % 360.0 // 45.0) % 8
+        if prev is not None and face != prev:
+            faces[prev] = best
+            prev = None
+        dm = d * 0.01
+        if prev is None or dm < best:
+            best = dm
+        prev = face
+    if prev is not None:
+        faces[prev] = best
+    return faces

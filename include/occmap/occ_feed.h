@@ -16,8 +16,18 @@
  *    OBSTACLE_DISTANCE in its 0-degree pitch layer, PX4 in its horizontal bins).
  *
  * What a sector reports (the exact geometric definition the tests check by brute force)
- *  - The vertical band is [z - band_below_m, z + band_above_m); a voxel takes part when its z
- *    extent overlaps the band. Space outside the map volume counts as UNKNOWN.
+ *  - The vertical band is [z - band_below_m, z + band_above_m) ("below" is -z in an ENU map, +z
+ *    in a NED one); a voxel takes part when its z extent overlaps the band. Space outside the map
+ *    volume counts as UNKNOWN.
+ *  - The ground (ignore_ground, on by default; ArduPilot's proximity library has a rule of the
+ *    same kind): walking down the vehicle's own voxel column from the voxel that holds the
+ *    vehicle to the band's lower edge, the first OCCUPIED voxel is the ground the vehicle stands
+ *    on or flies over. The band's lower edge then rises to ground_clearance_m above that voxel's
+ *    top face, so the floor (and anything lower than ground_clearance_m above it) is not an
+ *    obstacle, while a wall or a step higher than that is. If the lifted edge would reach the
+ *    band's upper edge, the band stays as configured (the ground is then reported: fail safe).
+ *    An unobserved column under the vehicle finds no ground: then the floor around the vehicle
+ *    is inside the band when band_below_m reaches it.
  *  - For each sector: d_occ = the smallest horizontal distance from the vehicle to a point of an
  *    OCCUPIED voxel's footprint that lies inside the sector's wedge; d_unk the same for UNKNOWN
  *    voxels (never observed, or in the band between free_max and occupied_min).
@@ -25,12 +35,18 @@
  *  - d_occ <= d_unk and d_occ < R : obstacle: distance in cm (floor), clamped to
  *    [min_distance_cm, max_distance_cm].
  *  - d_unk < d_occ and d_unk < R  : the view is blocked by unknown space. Unknown space is never
- *    reported as free: unknown_as_distance = false reports UINT16_MAX ("no data" for ArduPilot
- *    and PX4), true reports d_unk clamped like an obstacle (conservative, for vehicles that
- *    must not fly into unexplored space).
- *  - otherwise (everything within R observed free): max_distance_cm.
+ *    reported as free: unknown_as_distance = false reports UINT16_MAX (MAVLink's "unknown"),
+ *    true reports d_unk clamped like an obstacle (conservative: unexplored space is a wall).
+ *    What each autopilot does with them is in occ_mavlink.h and the README.
+ *  - otherwise (everything within R observed free): max_distance_cm + 1, MAVLink's "no obstacle"
+ *    (max_distance itself would be an obstacle at the range limit to ArduPilot).
  *  A value is never 0 (min_distance_cm >= 1). A vehicle standing in unknown space gets
  *  d_unk = 0 in every sector.
+ *
+ * Fail closed: on every error return of occ_sectors_compute() (bad arguments included, when
+ * `out` is not NULL) all OCC_SECTORS_MAX values of out->distance_cm hold the unsafe answer, an
+ * obstacle at cfg->min_distance_cm (1 cm when cfg is NULL or has min 0), d_occ_m / d_unk_m are 0
+ * and out->n is 0. A caller that ignores the error code reads "obstacle", never "clear".
  */
 #ifndef OCC_FEED_H_INCLUDED
 #define OCC_FEED_H_INCLUDED
@@ -58,12 +74,18 @@ occ_pose_t occ_pose_from_ned(float north_m, float east_m, float down_m, float ya
 typedef struct {
     uint8_t n_sectors;             /* 1..72 */
     float increment_deg;           /* (0, 90], n_sectors * increment_deg <= 360 */
-    float angle_offset_deg;        /* body angle of sector 0's centre, clockwise positive */
+    float angle_offset_deg;        /* body angle of sector 0's centre, clockwise positive; 0 by
+                                    * default (the MAVLink feed's default is -20: occ_mavlink.h) */
     float band_below_m, band_above_m; /* vertical band around the vehicle, metres >= 0, sum > 0 */
-    uint16_t min_distance_cm, max_distance_cm; /* 1 <= min < max <= 65534 */
+    uint16_t min_distance_cm, max_distance_cm; /* 1 <= min < max <= 65533 */
     bool unknown_as_distance;      /* see the header comment: false -> UINT16_MAX */
     bool map_ned;                  /* false: ENU map (default); true: NED map and pose */
+    bool ignore_ground;            /* the ground rule above; default true */
+    float ground_clearance_m;      /* >= 0, default 0.1: height above the ground not reported */
 } occ_sectors_config_t;
+
+/* Largest max_distance_cm: max + 1 ("no obstacle") stays below UINT16_MAX ("unknown"). */
+#define OCC_SECTORS_MAX_DISTANCE_CM 65533u
 
 /* Work space of one computation (internal): the depth-first stack of pending nodes (at most 7
  * per level plus the root) and per-sector state. Lives in occ_sectors_t so the call needs only
@@ -76,7 +98,7 @@ typedef struct {
 
 typedef struct {
     uint8_t n;                              /* sectors filled */
-    uint16_t distance_cm[OCC_SECTORS_MAX];  /* obstacle clamped to [min,max]; max = observed
+    uint16_t distance_cm[OCC_SECTORS_MAX];  /* obstacle clamped to [min,max]; max + 1 = observed
                                              * free; UINT16_MAX = unknown; never 0 */
     /* Diagnostics of the last call. */
     uint32_t nodes_read;                    /* nodes visited (popped from the stack) */
@@ -91,7 +113,8 @@ typedef struct {
 
 #define OCC_SECTORS_FAR 1.0e30f
 
-/* Defaults: 72 sectors of 5 degrees, offset 0, band +-0.5 m, 20..2000 cm, unknown -> UINT16_MAX. */
+/* Defaults: 72 sectors of 5 degrees, offset 0 (the MAVLink feed uses -20, see occ_mavlink.h),
+ * band +-0.5 m with the ground rule (clearance 0.1 m), 20..2000 cm, unknown -> UINT16_MAX. */
 occ_sectors_config_t occ_sectors_config_default(void);
 
 /* OCC_OK if `cfg` is usable, else OCC_ERR_ARG (ranges as documented on the fields). O(1). */
@@ -106,8 +129,11 @@ occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg);
  * call with the defaults (make bench); each read is an O(depth) descent from the root.
  * Stack: < 512 bytes (the work space is in `out`). Never writes the map; reads no memory other
  * than map, pose, cfg and out.
+ * The ground rule adds at most band_below_m / resolution + 1 voxel reads.
  * Errors: OCC_ERR_ARG (NULL, non-finite pose, bad cfg), OCC_ERR_RANGE (the vehicle outside the
- * map volume). On error `out` holds n = 0. */
+ * map volume), OCC_ERR_NOMEM (the walk's stack in `out` is full: cannot happen with
+ * OCC_SECTORS_STACK, checked anyway), or the error of occ_map_node_child() (a map written
+ * during the call). On error `out` holds the unsafe answer (see "Fail closed" above). */
 occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
                               const occ_sectors_config_t *cfg, occ_sectors_t *out);
 

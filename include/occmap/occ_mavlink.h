@@ -13,9 +13,37 @@
  *  - MAVLink 2, compid 196 (MAV_COMP_ID_OBSTACLE_AVOIDANCE), a 1 Hz HEARTBEAT as
  *    MAV_TYPE_ONBOARD_CONTROLLER / MAV_AUTOPILOT_INVALID / MAV_STATE_ACTIVE.
  *  - OBSTACLE_DISTANCE with frame 12 (MAV_FRAME_BODY_FRD), increment_f = sector width,
- *    angle_offset = body angle of sector 0, real min/max distances; obstacle = distance clamped
- *    to [min, max], observed free = max_distance, unknown = UINT16_MAX, never 0, elements past
- *    the configured sectors = UINT16_MAX.
+ *    angle_offset = body angle of sector 0's centre (default -20 deg, below), real min/max
+ *    distances; obstacle = distance clamped to [min, max], observed free = max_distance + 1
+ *    (MAVLink's "no obstacle"), unknown = UINT16_MAX (or its distance with
+ *    sectors.unknown_as_distance), never 0, elements past the configured sectors = UINT16_MAX.
+ *  - What the autopilots do with each value (read from their sources, checked in ArduCopter
+ *    SITL 4.7-dev): ArduPilot resets its 8 faces of 45 deg (centred on 0, 45, ..., 315) on each
+ *    message, walks the elements in order, drops 0, UINT16_MAX, < min and > max, keeps the
+ *    nearest valid element per face and writes a face each time the element's face changes.
+ *    So obstacle = that face's distance; max + 1 (free) = dropped, the face reads "no
+ *    obstacle"; UINT16_MAX (unknown) = dropped too: a face of only unknown elements reads "no
+ *    obstacle" and its arming check (> 0.6 m in every face) passes. With
+ *    unknown_as_distance, unknown space is an obstacle at its distance (min_distance when the
+ *    vehicle is in unknown space): ArduPilot then stops short of unexplored space and refuses
+ *    to arm when it is within 0.6 m. PX4 (collision prevention): UINT16_MAX = no data (with
+ *    CP_GO_NO_DATA = 0 it will not move that way), values >= max_distance = free, others
+ *    obstacles.
+ *  - angle_offset: with 0, ArduPilot's forward face (337.5..22.5 deg) is visited twice (elements
+ *    0-4, then 68-71) and the second visit overwrites the first. The default
+ *    OCC_MAV_ANGLE_OFFSET_DEFAULT_DEG = -20 (element centres -20, -15, ..., 335) makes every
+ *    face one contiguous run of 9 elements; for another width w use -22.5 + w / 2.
+ *  - The autopilot's streams: ArduPilot sends no LOCAL_POSITION_NED / ATTITUDE on a companion
+ *    link until asked. The feed asks with COMMAND_LONG MAV_CMD_SET_MESSAGE_INTERVAL (511;
+ *    param1 = message id, param2 = pose_interval_us) for each of LOCAL_POSITION_NED and
+ *    ATTITUDE that is not fresh (ODOMETRY or ATTITUDE_QUATERNION count too), every
+ *    request_period_us until it arrives, and again when it stops (the setting is lost when the
+ *    autopilot reboots). A COMMAND_ACK for 511 with a result other than ACCEPTED is counted in
+ *    request_refusals (the CLI logs it).
+ *  - Poses only from the autopilot: LOCAL_POSITION_NED, ATTITUDE, ATTITUDE_QUATERNION and
+ *    ODOMETRY are taken only from (autopilot_sysid, autopilot_compid). autopilot_sysid 0 (the
+ *    default) learns the sysid from the first autopilot HEARTBEAT (autopilot field not
+ *    MAV_AUTOPILOT_INVALID, type not MAV_TYPE_GCS); until then poses are ignored.
  *  - autopilot ARDUPILOT (PRX1_TYPE = 2): `increment` also carries the rounded width (ArduPilot
  *    uses increment_f when non-zero, so this only helps older firmware). PX4 (CP_DIST > 0):
  *    `increment` = 0; PX4 reads all 72 elements, so the feed refuses configs with
@@ -42,7 +70,15 @@ extern "C" {
 #define OCC_MAV_MSG_DISTANCE_SENSOR 132u
 #define OCC_MAV_MSG_OBSTACLE_DISTANCE 330u
 #define OCC_MAV_MSG_ODOMETRY 331u
+#define OCC_MAV_MSG_COMMAND_LONG 76u
+#define OCC_MAV_MSG_COMMAND_ACK 77u
+#define OCC_MAV_CMD_SET_MESSAGE_INTERVAL 511u
+#define OCC_MAV_RESULT_ACCEPTED 0u
+#define OCC_MAV_COMP_ID_AUTOPILOT1 1u
 #define OCC_MAV_COMP_ID_OBSTACLE_AVOIDANCE 196u
+#define OCC_MAV_TYPE_GCS 6u
+#define OCC_MAV_AUTOPILOT_INVALID 8u
+#define OCC_MAV_ANGLE_OFFSET_DEFAULT_DEG (-20.0f)
 #define OCC_MAV_FRAME_BODY_FRD 12u
 
 /* ---- Parser ----------------------------------------------------------------------------------- */
@@ -127,12 +163,32 @@ typedef struct {
     uint8_t type, autopilot, base_mode, system_status, mavlink_version;
 } occ_mav_heartbeat_t;
 
+typedef struct {
+    uint8_t target_system, target_component;
+    uint16_t command;       /* MAV_CMD */
+    uint8_t confirmation;   /* 0 first transmission, +1 per retransmission */
+    float param[7];         /* param1..param7 */
+} occ_mav_command_long_t;
+
+typedef struct {
+    uint16_t command;       /* MAV_CMD acknowledged */
+    uint8_t result;         /* MAV_RESULT: 0 ACCEPTED, 1 TEMPORARILY_REJECTED, 2 DENIED,
+                             * 3 UNSUPPORTED, 4 FAILED, ... */
+    uint8_t progress;
+    int32_t result_param2;
+    uint8_t target_system, target_component;
+} occ_mav_command_ack_t;
+
 /* Encode as one MAVLink 2 frame into out (cap >= OCC_MAV_FRAME_MAX always suffices); returns
  * the length or 0 (cap too small). O(payload). */
 size_t occ_mav_encode_obstacle_distance(occ_mav_sender_t *tx, const occ_mav_obstacle_distance_t *m,
                                         uint8_t *out, size_t cap);
 size_t occ_mav_encode_heartbeat(occ_mav_sender_t *tx, const occ_mav_heartbeat_t *m, uint8_t *out,
                                 size_t cap);
+size_t occ_mav_encode_command_long(occ_mav_sender_t *tx, const occ_mav_command_long_t *m,
+                                   uint8_t *out, size_t cap);
+size_t occ_mav_encode_command_ack(occ_mav_sender_t *tx, const occ_mav_command_ack_t *m,
+                                  uint8_t *out, size_t cap);
 
 /* ---- Decoding (frames the parser returned as OCC_MAV_OK) ---------------------------------------
  * Each returns OCC_ERR_ARG for NULLs or a frame of another message id. Truncated MAVLink 2
@@ -174,6 +230,8 @@ occ_err_t occ_mav_decode_odometry(const occ_mav_frame_t *f, occ_mav_odometry_t *
 occ_err_t occ_mav_decode_distance_sensor(const occ_mav_frame_t *f, occ_mav_distance_sensor_t *out);
 occ_err_t occ_mav_decode_heartbeat(const occ_mav_frame_t *f, occ_mav_heartbeat_t *out);
 occ_err_t occ_mav_decode_obstacle_distance(const occ_mav_frame_t *f, occ_mav_obstacle_distance_t *out);
+occ_err_t occ_mav_decode_command_long(const occ_mav_frame_t *f, occ_mav_command_long_t *out);
+occ_err_t occ_mav_decode_command_ack(const occ_mav_frame_t *f, occ_mav_command_ack_t *out);
 
 /* Yaw (rad, NED heading) of a w,x,y,z quaternion; roll and pitch (may be NULL). */
 float occ_mav_quat_yaw(const float q[4], float *roll, float *pitch);
@@ -190,13 +248,26 @@ typedef struct {
     occ_autopilot_t autopilot;       /* default ARDUPILOT */
     occ_map_frame_t map_frame;       /* default ENU */
     uint8_t sensor_type;             /* default 0 (MAV_DISTANCE_SENSOR_LASER) */
-    occ_sectors_config_t sectors;    /* default occ_sectors_config_default() */
+    uint8_t autopilot_sysid;         /* poses only from this system; 0 (default): learn it from
+                                      * the first autopilot HEARTBEAT */
+    uint8_t autopilot_compid;        /* poses only from this component; default 1 */
+    uint32_t pose_interval_us;       /* interval asked with SET_MESSAGE_INTERVAL, default 50000
+                                      * (20 Hz); 0: never ask (streams set on the autopilot) */
+    uint32_t request_period_us;      /* resend period while a stream is missing, default 1 s */
+    occ_sectors_config_t sectors;    /* default occ_sectors_config_default() with
+                                      * angle_offset_deg = OCC_MAV_ANGLE_OFFSET_DEFAULT_DEG */
 } occ_mav_feed_config_t;
 
 typedef struct {
     uint32_t positions_rx;           /* LOCAL_POSITION_NED and ODOMETRY taken */
     uint32_t attitudes_rx;           /* ATTITUDE, ATTITUDE_QUATERNION and ODOMETRY taken */
     uint32_t ignored_rx;             /* good frames of other messages, ours echoed, odd frames */
+    uint32_t foreign_rx;             /* pose messages from another system or component (ignored;
+                                      * also counted in ignored_rx) */
+    uint32_t requests_tx;            /* SET_MESSAGE_INTERVAL commands sent */
+    uint32_t request_acks;           /* COMMAND_ACK for them with MAV_RESULT_ACCEPTED */
+    uint32_t request_refusals;       /* COMMAND_ACK for them with another result */
+    uint8_t last_refusal_result;     /* MAV_RESULT of the last refusal */
     uint32_t obstacle_tx, heartbeat_tx;
     uint32_t stale_skips;            /* OBSTACLE_DISTANCE periods skipped: pose stale/missing */
     uint32_t sector_errors;          /* occ_sectors_compute() failures (vehicle off the map) */
@@ -208,7 +279,11 @@ typedef struct {
     occ_mav_sender_t tx;
     occ_mav_feed_counters_t counters;
     bool have_pos, have_att, started;
+    bool have_autopilot;             /* ap_sysid known (given or learned) */
+    uint8_t ap_sysid, ap_compid;
+    uint8_t request_mask;            /* streams still to ask for in this round: 1 pos, 2 att */
     uint64_t pos_us, att_us;         /* receive times */
+    uint64_t next_request_us;
     float north, east, down, yaw_ned, roll, pitch;
     uint64_t next_obstacle_us, next_heartbeat_us;
     occ_sectors_t sectors;           /* last result + scratch */
@@ -217,15 +292,20 @@ typedef struct {
 occ_mav_feed_config_t occ_mav_feed_config_default(void);
 
 /* Initialize (the feed owns nothing else). OCC_ERR_ARG: NULL, bad sector config, period 0,
- * timeout 0, PX4 with fewer than 360 degrees of sectors. O(1). */
+ * timeout 0, request period 0 while pose_interval_us > 0, PX4 with fewer than 360 degrees of
+ * sectors. O(1). */
 occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg);
 
-/* Bytes received from the autopilot at `now_us`: parsed; poses update the pose state. Frames
- * from our own sysid/compid are ignored (a shared bus echoes). O(n). */
+/* Bytes received from the autopilot at `now_us`: parsed; poses from the autopilot (see "Poses
+ * only from the autopilot") update the pose state, its HEARTBEAT names it, COMMAND_ACKs for
+ * SET_MESSAGE_INTERVAL are counted. Frames from our own sysid/compid are ignored (a shared bus
+ * echoes). O(n). */
 void occ_mav_feed_rx(occ_mav_feed_t *f, const uint8_t *data, size_t n, uint64_t now_us);
 
 /* Produce the next due frame into out (cap >= OCC_MAV_FRAME_MAX): a HEARTBEAT when one is due,
- * else an OBSTACLE_DISTANCE when one is due and the pose is fresh. Returns its length, or 0
+ * else a SET_MESSAGE_INTERVAL for a missing pose stream when a request round is due (the
+ * autopilot known, pose_interval_us > 0), else an OBSTACLE_DISTANCE when one is due and the
+ * pose is fresh. Returns its length, or 0
  * when nothing is due. Call until it returns 0. Deadlines advance by whole periods (no burst
  * after a pause). Reads `map` (not kept); pass NULL while the map is stale (being rebuilt, or
  * not updated for too long): like a stale pose, the OBSTACLE_DISTANCE period is then skipped.

@@ -232,6 +232,47 @@ size_t occ_mav_encode_heartbeat(occ_mav_sender_t *tx, const occ_mav_heartbeat_t 
                             MAVLINK_MSG_ID_HEARTBEAT_LEN, out, cap);
 }
 
+size_t occ_mav_encode_command_long(occ_mav_sender_t *tx, const occ_mav_command_long_t *m,
+                                   uint8_t *out, size_t cap)
+{
+    if (m == NULL) {
+        return 0;
+    }
+    mavlink_command_long_t s;
+    memset(&s, 0, sizeof s);
+    s.target_system = m->target_system;
+    s.target_component = m->target_component;
+    s.command = m->command;
+    s.confirmation = m->confirmation;
+    s.param1 = m->param[0];
+    s.param2 = m->param[1];
+    s.param3 = m->param[2];
+    s.param4 = m->param[3];
+    s.param5 = m->param[4];
+    s.param6 = m->param[5];
+    s.param7 = m->param[6];
+    return occ_mav_finalize(tx, MAVLINK_MSG_ID_COMMAND_LONG, (const uint8_t *)&s,
+                            MAVLINK_MSG_ID_COMMAND_LONG_LEN, out, cap);
+}
+
+size_t occ_mav_encode_command_ack(occ_mav_sender_t *tx, const occ_mav_command_ack_t *m,
+                                  uint8_t *out, size_t cap)
+{
+    if (m == NULL) {
+        return 0;
+    }
+    mavlink_command_ack_t s;
+    memset(&s, 0, sizeof s);
+    s.command = m->command;
+    s.result = m->result;
+    s.progress = m->progress;
+    s.result_param2 = m->result_param2;
+    s.target_system = m->target_system;
+    s.target_component = m->target_component;
+    return occ_mav_finalize(tx, MAVLINK_MSG_ID_COMMAND_ACK, (const uint8_t *)&s,
+                            MAVLINK_MSG_ID_COMMAND_ACK_LEN, out, cap);
+}
+
 /* ---- decoding -------------------------------------------------------------------------------- */
 
 /* Copy a payload into a generated struct, zero-filling what MAVLink 2 trimmed. */
@@ -371,6 +412,41 @@ occ_err_t occ_mav_decode_obstacle_distance(const occ_mav_frame_t *f, occ_mav_obs
     out->increment_f = s.increment_f;
     out->angle_offset = s.angle_offset;
     out->frame = s.frame;
+    return OCC_OK;
+}
+
+occ_err_t occ_mav_decode_command_long(const occ_mav_frame_t *f, occ_mav_command_long_t *out)
+{
+    mavlink_command_long_t s;
+    if (out == NULL || !load(f, MAVLINK_MSG_ID_COMMAND_LONG, &s, sizeof s)) {
+        return OCC_ERR_ARG;
+    }
+    out->target_system = s.target_system;
+    out->target_component = s.target_component;
+    out->command = s.command;
+    out->confirmation = s.confirmation;
+    out->param[0] = s.param1;
+    out->param[1] = s.param2;
+    out->param[2] = s.param3;
+    out->param[3] = s.param4;
+    out->param[4] = s.param5;
+    out->param[5] = s.param6;
+    out->param[6] = s.param7;
+    return OCC_OK;
+}
+
+occ_err_t occ_mav_decode_command_ack(const occ_mav_frame_t *f, occ_mav_command_ack_t *out)
+{
+    mavlink_command_ack_t s;
+    if (out == NULL || !load(f, MAVLINK_MSG_ID_COMMAND_ACK, &s, sizeof s)) {
+        return OCC_ERR_ARG;
+    }
+    out->command = s.command;
+    out->result = s.result;
+    out->progress = s.progress;
+    out->result_param2 = s.result_param2;
+    out->target_system = s.target_system;
+    out->target_component = s.target_component;
     return OCC_OK;
 }
 

@@ -26,14 +26,20 @@ occ_mav_feed_config_t occ_mav_feed_config_default(void)
     c.autopilot = OCC_AUTOPILOT_ARDUPILOT;
     c.map_frame = OCC_MAP_FRAME_ENU;
     c.sensor_type = 0u;
+    c.autopilot_sysid = 0u;
+    c.autopilot_compid = OCC_MAV_COMP_ID_AUTOPILOT1;
+    c.pose_interval_us = 50000u;
+    c.request_period_us = 1000000u;
     c.sectors = occ_sectors_config_default();
+    c.sectors.angle_offset_deg = OCC_MAV_ANGLE_OFFSET_DEFAULT_DEG;
     return c;
 }
 
 occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg)
 {
     if (f == NULL || cfg == NULL || cfg->period_us == 0u || cfg->heartbeat_period_us == 0u ||
-        cfg->pose_timeout_us == 0u || occ_sectors_config_check(&cfg->sectors) != OCC_OK) {
+        cfg->pose_timeout_us == 0u || occ_sectors_config_check(&cfg->sectors) != OCC_OK ||
+        (cfg->pose_interval_us > 0u && cfg->request_period_us == 0u)) {
         return OCC_ERR_ARG;
     }
     if (cfg->autopilot != OCC_AUTOPILOT_ARDUPILOT && cfg->autopilot != OCC_AUTOPILOT_PX4) {
@@ -53,12 +59,67 @@ occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg)
     f->tx.sysid = cfg->sysid;
     f->tx.compid = cfg->compid;
     f->tx.seq = 0;
+    f->have_autopilot = cfg->autopilot_sysid != 0u;
+    f->ap_sysid = cfg->autopilot_sysid;
+    f->ap_compid = cfg->autopilot_compid;
     return OCC_OK;
+}
+
+static bool is_pose_message(uint32_t msgid)
+{
+    return msgid == OCC_MAV_MSG_LOCAL_POSITION_NED || msgid == OCC_MAV_MSG_ATTITUDE ||
+           msgid == OCC_MAV_MSG_ATTITUDE_QUATERNION || msgid == OCC_MAV_MSG_ODOMETRY;
+}
+
+static bool from_autopilot(const occ_mav_feed_t *f, const occ_mav_frame_t *fr)
+{
+    return f->have_autopilot && fr->sysid == f->ap_sysid && fr->compid == f->ap_compid;
+}
+
+/* The first autopilot HEARTBEAT names the system whose poses we take (unless configured). */
+static void take_heartbeat(occ_mav_feed_t *f, const occ_mav_frame_t *fr)
+{
+    occ_mav_heartbeat_t hb;
+    if (!f->have_autopilot && occ_mav_decode_heartbeat(fr, &hb) == OCC_OK &&
+        hb.autopilot != OCC_MAV_AUTOPILOT_INVALID && hb.type != OCC_MAV_TYPE_GCS) {
+        f->have_autopilot = true;
+        f->ap_sysid = fr->sysid;
+    }
+}
+
+static void take_ack(occ_mav_feed_t *f, const occ_mav_frame_t *fr)
+{
+    occ_mav_command_ack_t ack;
+    if (!from_autopilot(f, fr) || occ_mav_decode_command_ack(fr, &ack) != OCC_OK ||
+        ack.command != OCC_MAV_CMD_SET_MESSAGE_INTERVAL) {
+        f->counters.ignored_rx++;
+        return;
+    }
+    if (ack.result == OCC_MAV_RESULT_ACCEPTED) {
+        f->counters.request_acks++;
+    } else {
+        f->counters.request_refusals++;
+        f->counters.last_refusal_result = ack.result;
+    }
 }
 
 static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
 {
     if (fr->sysid == f->cfg.sysid && fr->compid == f->cfg.compid) {
+        f->counters.ignored_rx++;
+        return;
+    }
+    if (fr->msgid == OCC_MAV_MSG_HEARTBEAT) {
+        take_heartbeat(f, fr);
+        f->counters.ignored_rx++; /* not a pose */
+        return;
+    }
+    if (fr->msgid == OCC_MAV_MSG_COMMAND_ACK) {
+        take_ack(f, fr);
+        return;
+    }
+    if (is_pose_message(fr->msgid) && !from_autopilot(f, fr)) {
+        f->counters.foreign_rx++;
         f->counters.ignored_rx++;
         return;
     }
@@ -147,14 +208,18 @@ void occ_mav_feed_rx(occ_mav_feed_t *f, const uint8_t *data, size_t n, uint64_t 
     }
 }
 
+static bool fresh_at(const occ_mav_feed_t *f, bool have, uint64_t at_us, uint64_t now_us)
+{
+    return have && now_us >= at_us && now_us - at_us <= f->cfg.pose_timeout_us;
+}
+
 bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose)
 {
     if (f == NULL || !f->have_pos || !f->have_att) {
         return false;
     }
-    const uint64_t t = f->cfg.pose_timeout_us;
-    const bool fresh = now_us >= f->pos_us && now_us >= f->att_us && now_us - f->pos_us <= t &&
-                       now_us - f->att_us <= t;
+    const bool fresh = fresh_at(f, f->have_pos, f->pos_us, now_us) &&
+                       fresh_at(f, f->have_att, f->att_us, now_us);
     if (pose != NULL) {
         if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
             pose->x = f->north;
@@ -175,7 +240,12 @@ uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f)
     if (f == NULL || !f->started) {
         return 0;
     }
-    return f->next_obstacle_us < f->next_heartbeat_us ? f->next_obstacle_us : f->next_heartbeat_us;
+    uint64_t due = f->next_obstacle_us < f->next_heartbeat_us ? f->next_obstacle_us
+                                                               : f->next_heartbeat_us;
+    if (f->have_autopilot && f->cfg.pose_interval_us > 0u && f->next_request_us < due) {
+        due = f->next_request_us;
+    }
+    return due;
 }
 
 /* Advance a deadline past now by whole periods. */
@@ -186,6 +256,37 @@ static uint64_t advance(uint64_t due, uint32_t period, uint64_t now_us)
         due = now_us + period - ((now_us - due) % period);
     }
     return due;
+}
+
+/* One SET_MESSAGE_INTERVAL per call while a request round has streams left: a round starts
+ * every request_period_us and asks for each stream that is not fresh. */
+static size_t poll_request(occ_mav_feed_t *f, uint64_t now_us, uint8_t *out, size_t cap)
+{
+    if (!f->have_autopilot || f->cfg.pose_interval_us == 0u) {
+        return 0;
+    }
+    if (f->request_mask == 0u && now_us >= f->next_request_us) {
+        f->next_request_us = now_us + f->cfg.request_period_us;
+        f->request_mask = (uint8_t)((fresh_at(f, f->have_pos, f->pos_us, now_us) ? 0u : 1u) |
+                                    (fresh_at(f, f->have_att, f->att_us, now_us) ? 0u : 2u));
+    }
+    if (f->request_mask == 0u) {
+        return 0;
+    }
+    const bool pos = (f->request_mask & 1u) != 0u;
+    f->request_mask = (uint8_t)(f->request_mask & (pos ? ~1u : ~2u));
+    occ_mav_command_long_t c;
+    memset(&c, 0, sizeof c);
+    c.target_system = f->ap_sysid;
+    c.target_component = f->ap_compid;
+    c.command = OCC_MAV_CMD_SET_MESSAGE_INTERVAL;
+    c.param[0] = (float)(pos ? OCC_MAV_MSG_LOCAL_POSITION_NED : OCC_MAV_MSG_ATTITUDE);
+    c.param[1] = (float)f->cfg.pose_interval_us;
+    const size_t n = occ_mav_encode_command_long(&f->tx, &c, out, cap);
+    if (n > 0u) {
+        f->counters.requests_tx++;
+    }
+    return n;
 }
 
 size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_us, uint8_t *out,
@@ -213,6 +314,10 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
             f->counters.heartbeat_tx++;
         }
         return n;
+    }
+    const size_t nr = poll_request(f, now_us, out, cap);
+    if (nr > 0u) {
+        return nr;
     }
     if (now_us < f->next_obstacle_us) {
         return 0;

@@ -9,6 +9,11 @@
 
 enum { KIND_OCC = 0, KIND_UNK = 1 };
 
+/* Entries the walk may use; a test build lowers it to reach the overflow path. */
+#ifndef OCC_SECTORS_WALK_LIMIT
+#define OCC_SECTORS_WALK_LIMIT OCC_SECTORS_STACK
+#endif
+
 /* Everything one computation needs besides `out`. Kept small: it lives on the C stack. */
 typedef struct {
     float px, py;          /* vehicle, map metres */
@@ -59,6 +64,8 @@ occ_sectors_config_t occ_sectors_config_default(void)
     c.max_distance_cm = 2000u;
     c.unknown_as_distance = false;
     c.map_ned = false;
+    c.ignore_ground = true;
+    c.ground_clearance_m = 0.1f;
     return c;
 }
 
@@ -77,8 +84,11 @@ occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg)
         !(cfg->band_below_m + cfg->band_above_m > 0.0f)) {
         return OCC_ERR_ARG;
     }
+    if (!isfinite(cfg->ground_clearance_m) || cfg->ground_clearance_m < 0.0f) {
+        return OCC_ERR_ARG;
+    }
     if (cfg->min_distance_cm < 1u || cfg->min_distance_cm >= cfg->max_distance_cm ||
-        cfg->max_distance_cm > 65534u) {
+        cfg->max_distance_cm > OCC_SECTORS_MAX_DISTANCE_CM) {
         return OCC_ERR_ARG;
     }
     return OCC_OK;
@@ -402,13 +412,60 @@ static uint16_t to_cm(float d, const occ_sectors_config_t *cfg)
     return (uint16_t)cm;
 }
 
+/* The unsafe answer every sector holds on an error: an obstacle at the minimum distance (a value
+ * both autopilots act on; 0 and UINT16_MAX would be skipped by ArduPilot). */
+static void fill_unsafe(occ_sectors_t *out, const occ_sectors_config_t *cfg)
+{
+    const uint16_t unsafe =
+        (cfg != NULL && cfg->min_distance_cm >= 1u) ? cfg->min_distance_cm : 1u;
+    out->n = 0;
+    for (unsigned s = 0; s < OCC_SECTORS_MAX; s++) {
+        out->distance_cm[s] = unsafe;
+        out->d_occ_m[s] = 0.0f;
+        out->d_unk_m[s] = 0.0f;
+    }
+}
+
+/* ArduPilot-like ground rule: the first occupied voxel met walking down the vehicle's own column
+ * (from its voxel to the band's lower edge) is the ground it stands on or flies over; the band
+ * then starts ground_clearance_m above that voxel's top face. Heights here are "up" metres
+ * (z in an ENU map, -z in a NED one). Returns the band's lower edge. O(band / resolution). */
+static float ground_lift(const occ_map_t *map, const occ_pose_t *pose,
+                         const occ_sectors_config_t *cfg, float up_lo, float up_hi)
+{
+    const occ_vec3_t at = {pose->x, pose->y, pose->z};
+    occ_key_t k;
+    if (!cfg->ignore_ground || occ_map_key(map, at, &k) != OCC_OK) {
+        return up_lo;
+    }
+    const float res = map->cfg.resolution_m;
+    const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
+    for (;;) {
+        const float z0 = occ_map_key_center(map, k, 0).z - 0.5f * res;
+        const float top = cfg->map_ned ? -z0 : z0 + res; /* the face nearest the vehicle */
+        occ_node_info_t info;
+        if (!(top > up_lo) || occ_map_read_key(map, k, 0, &info) != OCC_OK) {
+            return up_lo;
+        }
+        if (info.observed && info.state == OCC_STATE_OCCUPIED) {
+            const float lifted = top + cfg->ground_clearance_m;
+            /* A ground that would swallow the whole band stays in it (reported: fail safe). */
+            return lifted > up_lo && lifted < up_hi ? lifted : up_lo;
+        }
+        if (cfg->map_ned ? k.k[2] >= kmax : k.k[2] == 0u) {
+            return up_lo;
+        }
+        k.k[2] = cfg->map_ned ? k.k[2] + 1u : k.k[2] - 1u;
+    }
+}
+
 occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
                               const occ_sectors_config_t *cfg, occ_sectors_t *out)
 {
     if (out == NULL) {
         return OCC_ERR_ARG;
     }
-    out->n = 0;
+    fill_unsafe(out, cfg); /* fail closed: every early return leaves the unsafe answer */
     out->nodes_read = 0;
     out->leaves_used = 0;
     if (map == NULL || pose == NULL || occ_sectors_config_check(cfg) != OCC_OK ||
@@ -454,9 +511,15 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
         out->ray_s[k] = sinf(a);
     }
 
+    /* The band, its ground side lifted above the ground under the vehicle. */
+    float za = pose->z - (cfg->map_ned ? cfg->band_above_m : cfg->band_below_m);
+    float zb = pose->z + (cfg->map_ned ? cfg->band_below_m : cfg->band_above_m);
+    if (cfg->map_ned) {
+        zb = -ground_lift(map, pose, cfg, -zb, -za);
+    } else {
+        za = ground_lift(map, pose, cfg, za, zb);
+    }
     /* Space outside the map volume is unknown. */
-    const float za = pose->z - (cfg->map_ned ? cfg->band_above_m : cfg->band_below_m);
-    const float zb = pose->z + (cfg->map_ned ? cfg->band_below_m : cfg->band_above_m);
     const float r = c.range;
     if (za < vol_lo || zb > vol_hi) {
         fold_rect(&c, out, KIND_UNK, c.px - r, c.py - r, c.px + r, c.py + r);
@@ -494,10 +557,11 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
      * read 10% fewer and ran slower), with a stack of at most 7 entries per level. */
     unsigned sp = 0;
     unsigned pops = 0;
+    occ_err_t walk_err = OCC_OK;
     occ_map_node_root(map, &out->stack[0].node);
     out->stack[0].dmin = 0.0f;
     sp = 1;
-    while (sp > 0) {
+    while (sp > 0 && walk_err == OCC_OK) {
         const occ_sectors_item_t it = out->stack[--sp];
         if ((++pops & 15u) == 0u) {
             (void)refresh_bound(&c, out);
@@ -572,11 +636,19 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
             kid[j] = (uint8_t)ci;
             kid_d[j] = dm;
         }
-        for (unsigned j = 0; j < nk && sp < OCC_SECTORS_STACK; j++) {
+        if (nk > OCC_SECTORS_WALK_LIMIT - sp) {
+            walk_err = OCC_ERR_NOMEM; /* a skipped child could hold the nearest obstacle */
+            break;
+        }
+        for (unsigned j = 0; j < nk && walk_err == OCC_OK; j++) {
             occ_sectors_item_t *const ch = &out->stack[sp++];
-            (void)occ_map_node_child(map, info, kid[j], &ch->node);
+            walk_err = occ_map_node_child(map, info, kid[j], &ch->node);
             ch->dmin = kid_d[j];
         }
+    }
+    if (walk_err != OCC_OK) {
+        fill_unsafe(out, cfg);
+        return walk_err;
     }
 
     for (unsigned s = 0; s < c.n; s++) {
@@ -588,7 +660,7 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
         } else if (dU < r) {
             v = cfg->unknown_as_distance ? to_cm(dU, cfg) : OCC_SECTORS_UNKNOWN;
         } else {
-            v = cfg->max_distance_cm;
+            v = (uint16_t)(cfg->max_distance_cm + 1u); /* MAVLink's "no obstacle" */
         }
         out->distance_cm[s] = v;
     }

@@ -129,6 +129,8 @@ def main():
             if n_good < 30 and t < 5.0 and t - last[0] >= 0.05:
                 last[0] = t
                 ms = int(t * 1000)
+                # An autopilot's HEARTBEAT names the system whose poses the feed takes.
+                mav.mav.heartbeat_send(2, 3, 0, 0, 4)
                 mav.mav.local_position_ned_send(ms, 0.0, 0.0, 0.0, 0, 0, 0)
                 mav.mav.attitude_send(ms, 0.0, 0.0, math.radians(90.0), 0, 0, 0)
         cmd = [occmap, "can-feed", "--map", map_path, "--mcast", "0", "--node-id", "100",
