@@ -815,6 +815,35 @@ static void test_key_center_off_map(void **state)
     assert_true(fabs((double)occ_map_key_center(&map, last, 0u).x - 3276.75) < 1e-3);
 }
 
+/* A point read that fails leaves no stale answer behind: out reads an unobserved UNKNOWN node
+ * (first filled with an OCCUPIED read, then the failing call). */
+static void test_point_read_errors_read_unknown(void **state)
+{
+    (void)state;
+    make_map();
+    occ_node_info_t info;
+    const occ_vec3_t off_map = v3(1.0e6f, 0.0f, 0.0f);
+    const occ_vec3_t nan_p = v3(NAN, 0.0f, 0.0f);
+    const occ_err_t want[3] = {OCC_ERR_RANGE, OCC_ERR_ARG, OCC_ERR_ARG};
+    for (unsigned c = 0; c < 3u; c++) {
+        assert_int_equal(occ_map_read(&map, P_OCC, 0u, &info), OCC_OK);
+        assert_int_equal(info.state, OCC_STATE_OCCUPIED);
+        occ_err_t e;
+        if (c == 0u) {
+            e = occ_map_read(&map, off_map, 0u, &info);
+        } else if (c == 1u) {
+            e = occ_map_read(&map, nan_p, 0u, &info);
+        } else {
+            e = occ_map_read_key(&map, key_of(P_OCC), 17u, &info); /* level above depth 16 */
+        }
+        assert_int_equal(e, want[c]);
+        assert_int_equal(info.state, OCC_STATE_UNKNOWN);
+        assert_false(info.observed);
+        assert_true((info.flags & OCC_NODE_HAS_UNKNOWN) != 0u);
+        assert_true((info.flags & OCC_NODE_HAS_OCCUPIED) == 0u);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -839,6 +868,7 @@ int main(void)
         cmocka_unit_test_teardown(test_stale_over_refill, teardown),
         cmocka_unit_test_teardown(test_levels_saturate, teardown),
         cmocka_unit_test_teardown(test_key_center_off_map, teardown),
+        cmocka_unit_test_teardown(test_point_read_errors_read_unknown, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

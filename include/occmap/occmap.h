@@ -241,7 +241,9 @@ typedef struct {
 } occ_node_info_t;
 
 /* Read the node at `level` (0 = voxel) containing voxel `key`. A coarse read returns the max of
- * the voxels below it (OctoMap's inner value) and indicator flags. O(depth), no writes. */
+ * the voxels below it (OctoMap's inner value) and indicator flags. O(depth), no writes. On any
+ * error `out` (when non-NULL) reads an unobserved UNKNOWN node (fail closed), OCC_ERR_ARG for
+ * NULL or level > depth_levels, OCC_ERR_RANGE for a key outside the map. */
 occ_err_t occ_map_read_key(const occ_map_t *map, occ_key_t key, unsigned level,
                            occ_node_info_t *out);
 /* Same for a point in metres. OCC_ERR_ARG / OCC_ERR_RANGE as occ_map_key(). */

@@ -150,9 +150,22 @@ void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const
 
 /* ---- reading ---------------------------------------------------------------------------------- */
 
+/* What a read that failed reports: an unobserved, UNKNOWN node that holds unknown space. */
+static void read_failed(occ_node_info_t *const out)
+{
+    out->logodds = 0.0f;
+    out->observed = false;
+    out->state = OCC_STATE_UNKNOWN;
+    out->flags = (uint8_t)(OCC_NODE_HAS_UNKNOWN | OCC_NODE_UNIFORM);
+    out->level = 0u;
+}
+
 occ_err_t occ_map_read_key(const occ_map_t *const map, const occ_key_t key, const unsigned level,
                            occ_node_info_t *const out)
 {
+    if (out != NULL) {
+        read_failed(out); /* fail closed: an ignored error reads UNKNOWN, never stale or FREE */
+    }
     if (map == NULL || out == NULL || level > map->cfg.depth_levels) {
         return OCC_ERR_ARG;
     }
@@ -185,7 +198,13 @@ occ_err_t occ_map_read(const occ_map_t *const map, const occ_vec3_t p, const uns
 {
     occ_key_t key;
     const occ_err_t e = occ_map_key(map, p, &key);
-    return e != OCC_OK ? e : occ_map_read_key(map, key, level, out);
+    if (e != OCC_OK) {
+        if (out != NULL) {
+            read_failed(out);
+        }
+        return e;
+    }
+    return occ_map_read_key(map, key, level, out);
 }
 
 /* ---- batch updates ---------------------------------------------------------------------------- */
