@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Checks `occmap stats --json` on the real scan against an independent computation in Python:
-distinct endpoint voxels (OctoMap's key rule, double arithmetic), the pruned leaf count, the
+distinct endpoint voxels (OctoMap's key rule for OcTree(res) with the decimal res, double arithmetic), the pruned leaf count, the
 inner node count, the occupied volume and the bounding box."""
 import json
 import math
@@ -18,7 +18,9 @@ def main():
         out = subprocess.run([tool, 'stats', '--scan', scan, '--res', str(res), '--json'],
                              check=True, capture_output=True, text=True).stdout
         got = json.loads(out)
-        r = f32(res)
+        # The map's resolution is the decimal the user wrote (0.1f means 0.1, OcTree(0.1)),
+        # so keys are floor(float(c) * (1 / 0.1)) in double, as OcTree(0.1).coordToKey.
+        r = res
         inv = 1.0 / r
         voxels = set()
         with open(scan) as f:

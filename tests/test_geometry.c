@@ -30,6 +30,12 @@
 #include "occmap/occ_integrate.h"
 #include "occmap/occ_query.h"
 #include "support/oracle_geom.h"
+#if OCC_RAY_DOUBLE
+#include <stdlib.h>
+#include <unistd.h>
+#include "occmap/occ_scan.h"
+#include "support/oracle_rays.h"
+#endif
 
 #define ARENA_BYTES (1u << 20)
 #define SCRATCH_BYTES (4u << 20)
@@ -455,6 +461,85 @@ static void test_fail_closed_rays(void **state)
     assert_true(r.hit);
 }
 
+#if OCC_RAY_DOUBLE
+/* OctoMap's occupied and free volume (m3) of the leaves of an oracle tree at res (decimal). */
+static void octomap_volumes(void *t, double res, double *occ_m3, double *free_m3)
+{
+    const size_t cap = 1u << 21;
+    uint32_t *keys = malloc(3u * cap * sizeof *keys);
+    uint8_t *levels = malloc(cap);
+    float *lo = malloc(cap * sizeof *lo);
+    assert_non_null(keys);
+    assert_non_null(levels);
+    assert_non_null(lo);
+    const size_t n = oracle_ins_leaves(t, keys, levels, lo, cap);
+    assert_true(n <= cap);
+    *occ_m3 = 0.0;
+    *free_m3 = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double edge = res * (double)(1u << levels[i]);
+        *(lo[i] >= 0.0f ? occ_m3 : free_m3) += edge * edge * edge; /* isNodeOccupied: >= */
+    }
+    free(keys);
+    free(levels);
+    free(lo);
+}
+
+/* A number after `"key": ` in a JSON line; -1 when missing. */
+static double json_number(const char *json, const char *key)
+{
+    char pat[64];
+    snprintf(pat, sizeof pat, "\"%s\": ", key);
+    const char *at = strstr(json, pat);
+    return at == NULL ? -1.0 : strtod(at + strlen(pat), NULL);
+}
+
+/* `occmap build` on OctoMap's real scan prints OcTree(0.1)'s and OcTree(0.2)'s occupied and
+ * free volumes (to its 3 printed decimals): the same voxels, not OcTree((double)0.1f)'s. */
+static void test_cli_volumes_vs_octomap(void **state)
+{
+    (void)state;
+    occ_vec3_t *pts = NULL;
+    size_t n = 0;
+    char msg[256] = "";
+    if (access("build/occmap", X_OK) != 0 ||
+        occ_scan_read_xyz("build/data/scan.dat", &pts, &n, msg, sizeof msg) != OCC_OK) {
+        printf("SKIP: build/occmap or build/data/scan.dat missing (make test-build)\n");
+        skip();
+    }
+    const float res_f[2] = {0.1f, 0.2f};
+    for (unsigned r = 0; r < 2u; r++) {
+        void *t = oracle_ins_new((double)res_f[r]); /* builds OcTree(0.1), OcTree(0.2) */
+        const float o[3] = {0.0f, 0.0f, 0.0f};
+        oracle_ins_cloud(t, (const float *)(const void *)pts, n, o, -1.0, 0);
+        double occ_m3 = 0.0;
+        double free_m3 = 0.0;
+        octomap_volumes(t, oracle_geom_user_res((double)res_f[r]), &occ_m3, &free_m3);
+        oracle_ins_delete(t);
+        char cmd[256];
+        snprintf(cmd, sizeof cmd, "build/occmap build --scan build/data/scan.dat --res %g --json",
+                 (double)res_f[r]);
+        FILE *const pipe = popen(cmd, "r");
+        assert_non_null(pipe);
+        static char out[8192];
+        const size_t got = fread(out, 1, sizeof out - 1u, pipe);
+        out[got] = '\0';
+        assert_int_equal(pclose(pipe), 0);
+        const double cli_occ = json_number(out, "occupied_volume_m3");
+        const double cli_free = json_number(out, "free_volume_m3");
+        printf("scan.dat at %g m: occmap build %.3f / %.3f m3 occupied / free, OcTree(%g) %.6f / "
+               "%.6f\n", (double)res_f[r], cli_occ, cli_free, oracle_geom_user_res((double)res_f[r]),
+               occ_m3, free_m3);
+        char a[32];
+        char b[32];
+        snprintf(a, sizeof a, "%.3f %.3f", cli_occ, cli_free);
+        snprintf(b, sizeof b, "%.3f %.3f", occ_m3, free_m3);
+        assert_string_equal(a, b);
+    }
+    free(pts);
+}
+#endif
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -463,6 +548,9 @@ int main(void)
         cmocka_unit_test(test_fail_closed_rays),
         cmocka_unit_test(test_border_points_depth16),
         cmocka_unit_test(test_border_points_depth21),
+#if OCC_RAY_DOUBLE
+        cmocka_unit_test(test_cli_volumes_vs_octomap),
+#endif
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
