@@ -71,15 +71,15 @@ static inline bool occ_geom_key1(const occ_map_t *m, float c, uint32_t *key)
     return occ_geom_key_of(occ_geom_inv(m), occ_geom_half(m), c, key);
 }
 
-/* Centre coordinate (keyToCoord) of the node at `level` holding key k: ((base - half) +
- * 2^level / 2) * res, one rounding, which equals OctoMap's (floor((k - half) / 2^L) + 0.5) *
- * nodeSize(L) (power-of-two scalings are exact). The root (level D) is centred at 0. */
-static inline occ_real_t occ_geom_center_of(occ_real_t res, int32_t half, uint32_t k,
+/* Centre coordinate (keyToCoord) of the node at `level` whose first key is `base` (low
+ * `level` bits clear): ((base - half) + 2^level / 2) * res, one rounding, which equals OctoMap's
+ * (floor((k - half) / 2^L) + 0.5) * nodeSize(L) (power-of-two scalings are exact). The root
+ * (level D, base 0) is centred at 0. */
+static inline occ_real_t occ_geom_center_of(occ_real_t res, int32_t half, uint32_t base,
                                             unsigned level)
 {
-    const uint32_t base = k & ~(((uint32_t)1 << level) - 1u);
     return ((occ_real_t)((int32_t)base - half) +
-            (occ_real_t)0.5 * (occ_real_t)((uint32_t)1 << level)) * res;
+            (occ_real_t)((uint32_t)1 << level) * (occ_real_t)0.5) * res;
 }
 
 /* Low face (metres) of the voxel k, i.e. (k - half) * res: node boxes from k to k + 2^level. */
@@ -88,9 +88,9 @@ static inline float occ_geom_face1(const occ_map_t *m, uint32_t k)
     return (float)((occ_real_t)((int32_t)k - occ_geom_half(m)) * occ_geom_res(m));
 }
 
-static inline float occ_geom_center1(const occ_map_t *m, uint32_t k, unsigned level)
+static inline float occ_geom_center1(const occ_map_t *m, uint32_t base, unsigned level)
 {
-    return (float)occ_geom_center_of(occ_geom_res(m), occ_geom_half(m), k, level);
+    return (float)occ_geom_center_of(occ_geom_res(m), occ_geom_half(m), base, level);
 }
 
 /* Keys [lo, hi] of the voxels holding a coordinate of [lo_m, hi_m] widened by `slack` voxels
@@ -136,10 +136,10 @@ static inline void occ_dda_start(occ_dda_t *d, occ_real_t res, int32_t half, con
 /* OctoMap's axis of the next step: the smallest tMax; a tie goes to the higher axis. */
 static inline unsigned occ_dda_axis(occ_real_t t0, occ_real_t t1, occ_real_t t2)
 {
-    if (t0 < t1) {
-        return t0 < t2 ? 0u : 2u;
+    if (t0 < t1 && t0 < t2) {
+        return 0u;
     }
-    return t1 < t2 ? 1u : 2u;
+    return t1 < t2 ? 1u : 2u; /* (t0 < t1 here means t2 <= t0 < t1: z) */
 }
 
 #endif /* OCC_GEOM_INTERNAL_H_INCLUDED */

@@ -133,9 +133,10 @@ occ_err_t occ_map_key_range(const occ_map_t *const map, const float lo_m, const 
 occ_vec3_t occ_map_key_center(const occ_map_t *const map, const occ_key_t key, const unsigned level)
 {
     const unsigned lv = level > map->cfg.depth_levels ? map->cfg.depth_levels : level;
+    const occ_key_t base = occ_key_at_level(key, lv);
     occ_vec3_t c;
-    c.x = occ_geom_center1(map, key.k[0], lv);
-    c.y = occ_geom_center1(map, key.k[1], lv);
-    c.z = occ_geom_center1(map, key.k[2], lv);
+    c.x = occ_geom_center1(map, base.k[0], lv);
+    c.y = occ_geom_center1(map, base.k[1], lv);
+    c.z = occ_geom_center1(map, base.k[2], lv);
     return c;
 }
