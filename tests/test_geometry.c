@@ -413,6 +413,21 @@ static void test_key_range(void **state)
     assert_int_equal(occ_map_key_range(NULL, 0.0f, 1.0f, &lo, &hi), OCC_ERR_ARG);
 }
 
+/* A level above the depth (also >= 32, an undefined shift before) reads as the root. */
+static void test_level_saturates(void **state)
+{
+    (void)state;
+    init_free_map(0.1f, 16u);
+    const occ_key_t k = {{12345u, 40000u, 7u}};
+    const unsigned levels[] = {17u, 32u, 40u, UINT32_MAX};
+    for (size_t i = 0; i < sizeof levels / sizeof levels[0]; i++) {
+        const occ_vec3_t c = occ_map_key_center(&map, k, levels[i]);
+        assert_true(feq((double)c.x, 0.0) && feq((double)c.y, 0.0) && feq((double)c.z, 0.0));
+        assert_true(feq((double)occ_map_node_size(&map, levels[i]),
+                        (double)occ_map_node_size(&map, 16u)));
+    }
+}
+
 /* Fail closed: a caller that ignores the error code reads "blocked". */
 static void test_fail_closed_rays(void **state)
 {
@@ -546,6 +561,7 @@ int main(void)
         cmocka_unit_test(test_issue_case),
         cmocka_unit_test(test_key_range),
         cmocka_unit_test(test_fail_closed_rays),
+        cmocka_unit_test(test_level_saturates),
         cmocka_unit_test(test_border_points_depth16),
         cmocka_unit_test(test_border_points_depth21),
 #if OCC_RAY_DOUBLE

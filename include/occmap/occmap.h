@@ -211,7 +211,8 @@ occ_err_t occ_map_key_range(const occ_map_t *map, float lo_m, float hi_m, uint32
  * keyToCoord, ((first key - 2^(D-1)) + 2^level / 2) * res in double when OCC_RAY_DOUBLE, rounded
  * to float. A level above depth_levels is taken as depth_levels (the root, centred at 0). */
 occ_vec3_t occ_map_key_center(const occ_map_t *map, occ_key_t key, unsigned level);
-/* Edge length (metres) of a node at `level`: resolution * 2^level. */
+/* Edge length (metres) of a node at `level`: resolution * 2^level (a level above depth_levels
+ * is taken as depth_levels: the root's edge). */
 float occ_map_node_size(const occ_map_t *map, unsigned level);
 /* The key with its lowest `level` bits cleared: the first voxel of the level-`level` node. */
 occ_key_t occ_key_at_level(occ_key_t key, unsigned level);

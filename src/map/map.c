@@ -110,7 +110,8 @@ occ_key_t occ_key_at_level(occ_key_t key, const unsigned level)
 
 float occ_map_node_size(const occ_map_t *const map, const unsigned level)
 {
-    return map->cfg.resolution_m * (float)((uint32_t)1 << level);
+    const unsigned lv = level > map->cfg.depth_levels ? map->cfg.depth_levels : level;
+    return map->cfg.resolution_m * (float)((uint32_t)1 << lv);
 }
 
 occ_err_t occ_map_key_range(const occ_map_t *const map, const float lo_m, const float hi_m,
