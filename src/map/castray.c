@@ -1,7 +1,8 @@
 /*
  * castray.c - OctoMap's castRay (3D-DDA, Amanatides & Woo) and line of sight.
  * The voxel sequence, the tie rule and the arithmetic are OctoMap's (double on hosts when
- * OCC_RAY_DOUBLE); what differs is the lookup: instead of a search from the root per voxel, a
+ * OCC_RAY_DOUBLE), from the DDA set-up and tie rule shared with computeRayKeys (geom_internal.h)
+ * on the map's one key conversion; what differs is the lookup: instead of a search from the root per voxel, a
  * cursor keeps the path to the current voxel and re-descends only below the highest key bit that
  * changed, and not at all while the ray stays inside a node it can pass whole: a uniform (pruned)
  * one, or one whose indicators say nothing below stops the ray (UFOMap's use of the inner nodes).
@@ -351,7 +352,6 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     const uint8_t stop = (uint8_t)occ_q_has_bits(occ_q_blocking_states(policy));
     cursor_t c;
     cursor_init(&c, map, ka.k, stop);
-    *visible = false;
     if (blocks(map, c.val, policy)) {
         set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
         return OCC_OK;
