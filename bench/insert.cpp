@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "../tests/support/oracle_res.hpp"
+
 extern "C" {
 #include "occmap/occmap.h"
 #include "occmap/occ_scan.h"
@@ -231,7 +233,7 @@ static double run_octo(const Dataset &d, float res, bool discretize, int reps, O
     std::vector<double> times;
     for (int r = 0; r < reps; r++) {
         delete keep;
-        keep = new OcTree((double)res);
+        keep = new OcTree(oracle_user_resolution((double)res)); // OcTree(0.1) for 0.1f
         double total = 0;
         for (const Scan &s : d.scans) {
             octomap::Pointcloud pc;

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "../tests/support/oracle_res.hpp"
 #include "occmap/occmap.h"
 #include "occmap/occ_scan.h"
 
@@ -108,8 +109,9 @@ int main(int argc, char **argv)
     std::vector<uint8_t> arena(arena_bytes);
     std::vector<Row> rows;
     for (const float res_f : {0.1f, 0.05f}) {
-        // OctoMap gets exactly occmap's float resolution, so both cut space at the same places.
-        const double res = static_cast<double>(res_f);
+        // OctoMap gets the decimal a user writes for occmap's float (OcTree(0.1) for 0.1f): the
+        // resolution occmap's keys use, so both cut space at the same places.
+        const double res = oracle_user_resolution(static_cast<double>(res_f));
         // ---- content 1: endpoints only ----
         Row r{"endpoints", res, 0, 0, 0, 0, 0, 0, 0, -1.0, -1.0};
         std::vector<double> t_occ, t_om;

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Checks `occmap stats --json` on the real scan against an independent computation in Python:
-distinct endpoint voxels (OctoMap's key rule, double arithmetic), the pruned leaf count, the
-inner node count, the occupied volume and the bounding box. Volumes must round-trip: the JSON
-text reads back as exactly voxels x res^3 in double, with the resolution as written (0.1).
-Then `occmap info --json` on fr_078_tidyup.bt (../shared/data/maps) must give OctoMap's
-volumes (measured against OctoMap itself in tests/test_stats.c): 326.251375 m3 free."""
+distinct endpoint voxels (OctoMap's key rule for OcTree(res) with the decimal res, double
+arithmetic), the pruned leaf count, the inner node count, the occupied volume and the bounding
+box. Volumes must round-trip: the JSON text reads back as exactly voxels x res^3 in double, with
+the resolution as written (0.1). Then `occmap info --json` on fr_078_tidyup.bt
+(../shared/data/maps) must give OctoMap's volumes (measured against OctoMap itself in
+tests/test_stats.c): 326.251375 m3 free."""
 import json
 import math
 import os
@@ -55,7 +56,9 @@ def main():
         out = subprocess.run([tool, 'stats', '--scan', scan, '--res', str(res), '--json'],
                              check=True, capture_output=True, text=True).stdout
         got = json.loads(out)
-        r = f32(res)
+        # The map's resolution is the decimal the user wrote (0.1f means 0.1, OcTree(0.1)),
+        # so keys are floor(float(c) * (1 / 0.1)) in double, as OcTree(0.1).coordToKey.
+        r = res
         inv = 1.0 / r
         voxels = set()
         with open(scan) as f:

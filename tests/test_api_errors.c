@@ -249,8 +249,13 @@ static void test_coordinates(void **state)
             assert_unchanged("out-of-volume coordinate");
         }
     }
-    /* The volume is [-2^(D-1) res, 2^(D-1) res): the low edge is inside. */
-    const occ_vec3_t lo = {-edge, -edge, -edge};
+    /* The volume is [-2^(D-1) res, 2^(D-1) res) with res the decimal 0.1: the low edge
+     * -3276.8 is inside. The float -edge = -32768 * 0.1f = -3276.80005 lies below it (outside,
+     * as in OcTree(0.1)); the next float up, -3276.79980, is inside, in voxel 0. */
+    const occ_vec3_t below = {-edge, 0.0f, 0.0f};
+    assert_int_equal(occ_map_key(&map, below, &k), OCC_ERR_RANGE);
+    const float lo_in = nextafterf(-edge, 0.0f);
+    const occ_vec3_t lo = {lo_in, lo_in, lo_in};
     assert_int_equal(occ_map_key(&map, lo, &k), OCC_OK);
     assert_int_equal(k.k[0], 0u);
     assert_int_equal(k.k[2], 0u);

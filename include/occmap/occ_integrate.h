@@ -6,8 +6,8 @@
  * as occupied (cfg.hit), every other traversed voxel as free (cfg.miss). A ray longer than the
  * max range clears up to max range along its direction and marks no hit. Traversal is the 3D-DDA
  * of Amanatides & Woo with OctoMap's computeRayKeys arithmetic (float direction, double tMax
- * when OCC_RAY_DOUBLE=1), so the keys are bit-for-bit OctoMap's for an octomap::OcTree built with
- * resolution (double)cfg.resolution_m.
+ * when OCC_RAY_DOUBLE=1) on the map's decimal resolution (occmap.h), so the keys are bit-for-bit
+ * OctoMap's for the octomap::OcTree(0.1) a user writes for cfg.resolution_m = 0.1f.
  *
  * Memory: no heap. The per-scan key sets live in the caller's scratch buffer. They are sorted
  * Morton codes (radix sort), de-duplicated and applied with one occ_map_observe_codes() call,

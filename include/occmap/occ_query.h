@@ -295,7 +295,9 @@ typedef struct {
  * stops it (hit = false) at the first voxel whose centre is farther than max_range_m from the
  * origin (<= 0: unbounded, up to the map border). The origin's own voxel is tested first.
  * Same voxels, same ties and the same double arithmetic as OctoMap when OCC_RAY_DOUBLE.
- * OCC_ERR_ARG: NULL, NaN/Inf, zero direction; OCC_ERR_RANGE: origin outside the map.
+ * OCC_ERR_ARG: NULL, NaN/Inf, zero direction; OCC_ERR_RANGE: origin outside the map. Fail
+ * closed: on any error (out non-NULL) *out reads an obstacle at the origin: hit = true,
+ * stop = OCC_RAY_HIT, end = origin as given, key = OCC_NONE on every axis (no voxel).
  * O(voxels crossed); no lookup while the ray is inside a node whose indicators say nothing below
  * can stop it (no OCCUPIED voxel, nor UNKNOWN one unless ignore_unknown), pruned or not. */
 occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
@@ -303,8 +305,10 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
 
 /* Line of sight from a to b: the voxels the segment crosses (3D-DDA from a's voxel to b's, both
  * included) hold nothing OCCUPIED (nor UNKNOWN under OCC_UNKNOWN_UNSAFE). `blocker` (may be NULL)
- * gets the first blocking voxel. OCC_ERR_ARG (NULL, NaN, bad policy), OCC_ERR_RANGE (a or b
- * outside the map). O(voxels crossed), passing whole nodes that hold nothing blocking. */
+ * gets the first blocking voxel (visible: its hit is false, the rest unspecified). OCC_ERR_ARG
+ * (NULL, NaN, bad policy), OCC_ERR_RANGE (a or b outside the map). Fail closed: *visible (if
+ * non-NULL) is false on every error, and blocker (if non-NULL) then reads as occ_cast_ray's error
+ * result (an obstacle at a, key OCC_NONE). O(voxels crossed), passing whole nodes that hold nothing blocking. */
 occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
                             occ_unknown_policy_t policy, bool *visible,
                             occ_ray_result_t *blocker);

@@ -14,8 +14,12 @@
  *    has no child block (pruned or never split). Eight equal children are always pruned.
  *
  * Frames and units: the map frame is right-handed, metres, z up (OctoMap's data is ENU).
- * Log-odds are natural-log odds. Keys follow OctoMap: key = floor(x / res) + 2^(depth_levels-1),
- * so a voxel here is the same voxel in an octomap::OcTree of the same resolution and depth 16.
+ * Log-odds are natural-log odds. Keys follow OctoMap: key = floor(x * (1 / res)) + 2^(depth_levels-1)
+ * where res is the shortest decimal that rounds to cfg.resolution_m (0.1f means 0.1, 0.08f 0.08),
+ * so a voxel here is the same voxel in the octomap::OcTree(res) a user writes (OcTree(0.1) for
+ * 0.1f) or reads from a file whose header says that resolution, at depth 16. Every call (keys,
+ * reads, lookups, integration, rays, volumes, collision, nearest, sectors, eviction, readers)
+ * uses this one conversion. Float-only builds (OCC_RAY_DOUBLE=0) use the same formulas in float.
  *
  * Memory: no heap. occ_map_init() carves a caller arena into two pools that grow towards each
  * other: leaf blocks (8 voxel values, 16 bytes) from the bottom, inner blocks (8 nodes with
@@ -181,8 +185,11 @@ typedef struct {
     uint32_t block_budget;    /* arena_bytes / OCC_LEAF_BLOCK_BYTES: leaf-sized units */
     occ_pool_t inner, leaf;   /* inner blocks grow down from the top, leaves up from the bottom */
     uint32_t oom_count;       /* operations refused with OCC_ERR_NOMEM */
-    float inv_res;            /* 1 / resolution_m */
-    double inv_res_d;         /* 1 / (double)resolution_m, only set when OCC_RAY_DOUBLE */
+    /* Voxel geometry (internal), set once by occ_map_init(): the resolution as the shortest
+     * decimal that rounds to cfg.resolution_m (0.1f -> 0.1, what OcTree(0.1) holds) and its
+     * inverse, in double when OCC_RAY_DOUBLE (0 in the float build), and as floats. */
+    double geo_res, geo_inv;
+    float geo_res_f, geo_inv_f;
     /* The root node (level depth_levels) lives here, not in a block. */
     uint32_t root_child;
     occ_value_t root_value;
@@ -211,12 +218,24 @@ occ_err_t occ_map_init(occ_map_t *map, const occ_map_config_t *cfg, void *arena,
 void occ_map_clear(occ_map_t *map);
 
 /* ---- Coordinates and keys --------------------------------------------------------------------- */
-/* Voxel key of a point. OCC_ERR_ARG for NaN/Inf, OCC_ERR_RANGE outside the map volume
- * [-2^(D-1) res, 2^(D-1) res) per axis. */
+/* Voxel key of a point, per axis OctoMap's coordToKeyChecked: floor(p * (1 / res)) + 2^(D-1),
+ * res the decimal resolution (see the top of this header), in double when OCC_RAY_DOUBLE
+ * (bit-for-bit OcTree(res).coordToKey), else in float (a point within ~1e-7 relative of a voxel
+ * border may then get the neighbour's key, the same in every call of this build).
+ * OCC_ERR_ARG for NULL or NaN/Inf, OCC_ERR_RANGE outside the map volume [-2^(D-1) res,
+ * 2^(D-1) res) per axis. O(1), no writes. */
 occ_err_t occ_map_key(const occ_map_t *map, occ_vec3_t p, occ_key_t *key);
-/* Centre (metres) of the node at `level` that contains voxel `key`. A level above depth_levels
- * saturates to depth_levels: the root's centre, the map origin (0, 0, 0). A key >= 2^depth_levels
- * (no voxel of the map) gets the centre it would have, outside the map volume. */
+/* Keys [*lo, *hi] on one axis (all axes are alike) of the voxels that hold a coordinate of the
+ * closed interval [lo_m, hi_m], clamped to the map: the keys occ_map_key gives lo_m and hi_m
+ * when they are inside it. OCC_ERR_ARG for NULL, NaN or lo_m > hi_m, OCC_ERR_RANGE when the
+ * interval misses the map (outputs then unchanged). O(1). */
+occ_err_t occ_map_key_range(const occ_map_t *map, float lo_m, float hi_m, uint32_t *lo,
+                            uint32_t *hi);
+/* Centre (metres) of the node at `level` that contains voxel `key`: per axis OctoMap's
+ * keyToCoord, ((first key - 2^(D-1)) + 2^level / 2) * res in double when OCC_RAY_DOUBLE, rounded
+ * to float. A level above depth_levels saturates to depth_levels: the root's centre, the map
+ * origin (0, 0, 0). A key >= 2^depth_levels (no voxel of the map) gets the centre it would
+ * have, outside the map volume. */
 occ_vec3_t occ_map_key_center(const occ_map_t *map, occ_key_t key, unsigned level);
 /* Edge length (metres) of a node at `level`: resolution * 2^level. A level above depth_levels
  * saturates to depth_levels (the root's edge, the whole map); NULL map: 0. */

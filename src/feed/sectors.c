@@ -390,14 +390,19 @@ static float refresh_bound(ctx_t *c, const occ_sectors_t *out)
     return c->bound;
 }
 
-static int32_t key_of(float v, float inv_res, int32_t half)
+/* Keys [lo, hi] of the voxels holding [a, b] on one axis, clamped to the map: the map's own
+ * conversion (occ_map_key_range), so a voxel read here is the one every map call names. */
+static void key_range(const occ_map_t *map, float a, float b, int32_t *lo, int32_t *hi)
 {
-    return (int32_t)floorf(v * inv_res) + half;
-}
-
-static int32_t clamp_key(int32_t k, int32_t hi)
-{
-    return k < 0 ? 0 : (k > hi ? hi : k);
+    uint32_t l = 0u;
+    uint32_t h = 0u;
+    if (occ_map_key_range(map, a, b, &l, &h) != OCC_OK) {
+        /* misses the map: its edge voxel on that side (space beyond is folded in as unknown) */
+        l = a > 0.0f ? ((uint32_t)1 << map->cfg.depth_levels) - 1u : 0u;
+        h = l;
+    }
+    *lo = (int32_t)l;
+    *hi = (int32_t)h;
 }
 
 static uint16_t to_cm(float d, const occ_sectors_config_t *cfg)
@@ -475,9 +480,7 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
     }
     const unsigned depth = map->cfg.depth_levels;
     const float res = map->cfg.resolution_m;
-    const float inv_res = 1.0f / res;
     const int32_t half = (int32_t)1 << (depth - 1u);
-    const int32_t kmax = ((int32_t)1 << depth) - 1;
     const float vol_lo = -(float)half * res;
     const float vol_hi = (float)half * res;
     if (pose->x < vol_lo || pose->x >= vol_hi || pose->y < vol_lo || pose->y >= vol_hi ||
@@ -543,12 +546,10 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
 
     /* Key box of the search cylinder; the band is half-open [za, zb). */
     int32_t lo[3], hi[3];
-    lo[0] = clamp_key(key_of(c.px - r, inv_res, half), kmax);
-    hi[0] = clamp_key(key_of(c.px + r, inv_res, half), kmax);
-    lo[1] = clamp_key(key_of(c.py - r, inv_res, half), kmax);
-    hi[1] = clamp_key(key_of(c.py + r, inv_res, half), kmax);
-    lo[2] = clamp_key(key_of(za, inv_res, half), kmax);
-    hi[2] = clamp_key((int32_t)ceilf(zb * inv_res) - 1 + half, kmax);
+    key_range(map, c.px - r, c.px + r, &lo[0], &hi[0]);
+    key_range(map, c.py - r, c.py + r, &lo[1], &hi[1]);
+    /* [za, zb) is [za, the float below zb]. */
+    key_range(map, za, nextafterf(zb, za), &lo[2], &hi[2]);
     if (hi[2] < lo[2]) {
         hi[2] = lo[2];
     }

@@ -1,21 +1,18 @@
 /*
  * castray.c - OctoMap's castRay (3D-DDA, Amanatides & Woo) and line of sight.
  * The voxel sequence, the tie rule and the arithmetic are OctoMap's (double on hosts when
- * OCC_RAY_DOUBLE); what differs is the lookup: instead of a search from the root per voxel, a
+ * OCC_RAY_DOUBLE), from the DDA set-up and tie rule shared with computeRayKeys (geom_internal.h)
+ * on the map's one key conversion; what differs is the lookup: instead of a search from the root per voxel, a
  * cursor keeps the path to the current voxel and re-descends only below the highest key bit that
  * changed, and not at all while the ray stays inside a node it can pass whole: a uniform (pruned)
  * one, or one whose indicators say nothing below stops the ray (UFOMap's use of the inner nodes).
  */
-#include <float.h>
 #include "map/query_internal.h"
 
+typedef occ_real_t real_t;
 #if OCC_RAY_DOUBLE
-typedef double real_t;
-#define REAL_MAX DBL_MAX
 #define RSQRT sqrt
 #else
-typedef float real_t;
-#define REAL_MAX FLT_MAX
 #define RSQRT sqrtf
 #endif
 
@@ -92,52 +89,13 @@ static inline void cursor_moved(cursor_t *c, unsigned dim, uint32_t old)
     descend(c, occ_bit_length32(x)); /* from the node above the highest changed bit */
 }
 
-/* The resolution as OctoMap holds it: a double. A float resolution read from a file or typed as
- * 0.04 is taken to mean the shortest decimal that rounds to it (0.04, not 0.0399999991), so keys
- * and voxel borders are bit-identical to an octomap::OcTree of that resolution. */
-static real_t ray_resolution(const occ_map_t *m)
+/* The origin's key: the map's one conversion (geom_internal.h). */
+static occ_err_t ray_key(const occ_map_t *m, occ_vec3_t p, uint32_t key[3])
 {
-    const float rf = m->cfg.resolution_m;
-#if OCC_RAY_DOUBLE
-    const double r = (double)rf;
-    double p = 1.0;
-    while (r * p < 1.0 && p < 1e12) {
-        p *= 10.0;
-    }
-    for (unsigned d = 0; d < 9u; d++, p *= 10.0) {
-        const double cand = (double)(int64_t)(r * p + 0.5) / p; /* round half up, r * p > 0 */
-        const float back = (float)cand;
-        if (!(back < rf) && !(back > rf)) {
-            return cand;
-        }
-    }
-    return r;
-#else
-    return rf;
-#endif
-}
-
-/* OctoMap's coordToKeyChecked with that resolution. */
-static occ_err_t ray_key(const occ_map_t *m, real_t res, occ_vec3_t p, uint32_t key[3])
-{
-    const real_t factor = (real_t)1 / res;
-    const int32_t tmv = (int32_t)1 << (m->cfg.depth_levels - 1u);
-    const float c[3] = {p.x, p.y, p.z};
-    for (unsigned i = 0; i < 3u; i++) {
-        const real_t scaled = factor * (real_t)c[i];
-        if (!(scaled >= -(real_t)tmv) || !(scaled < (real_t)tmv)) {
-            return OCC_ERR_RANGE;
-        }
-        /* floor() by truncation (scaled is within +-2^20 here), no libm call. */
-        int32_t fl = (int32_t)scaled;
-        fl -= (real_t)fl > scaled ? 1 : 0;
-        const int32_t k = fl + tmv;
-        if (k < 0 || k >= 2 * tmv) {
-            return OCC_ERR_RANGE;
-        }
-        key[i] = (uint32_t)k;
-    }
-    return OCC_OK;
+    return occ_geom_key1(m, p.x, &key[0]) && occ_geom_key1(m, p.y, &key[1]) &&
+                   occ_geom_key1(m, p.z, &key[2])
+               ? OCC_OK
+               : OCC_ERR_RANGE;
 }
 
 static occ_err_t check_policy(occ_unknown_policy_t policy)
@@ -148,7 +106,7 @@ static occ_err_t check_policy(occ_unknown_policy_t policy)
 /* OctoMap's keyToCoord for one axis. */
 static inline real_t key_coord(real_t res, int32_t tmv, uint32_t k)
 {
-    return ((real_t)((int32_t)k - tmv) + (real_t)0.5) * res;
+    return occ_geom_center_of(res, tmv, k, 0u);
 }
 
 static void set_result(const cursor_t *c, real_t res, int32_t tmv, occ_ray_result_t *out,
@@ -164,35 +122,26 @@ static void set_result(const cursor_t *c, real_t res, int32_t tmv, occ_ray_resul
     out->end.z = (float)key_coord(res, tmv, c->key[2]);
 }
 
-/* DDA set-up, as OctoMap: direction normalized in float, borders from voxel centres. */
-typedef struct {
-    int step[3];
-    real_t tmax[3], tdelta[3];
-} dda_t;
+/* The shared DDA set-up (geom_internal.h); castRay keeps the half-voxel step in double. */
+typedef occ_dda_t dda_t;
 
 static inline void dda_init(dda_t *d, const cursor_t *c, real_t res, int32_t tmv, const float o[3],
-                     const float dir[3])
+                            const float dir[3])
 {
-    for (unsigned i = 0; i < 3u; i++) {
-        if (dir[i] > 0.0f) {
-            d->step[i] = 1;
-        } else if (dir[i] < 0.0f) {
-            d->step[i] = -1;
-        } else {
-            d->step[i] = 0;
-        }
-        if (d->step[i] != 0) {
-            real_t border = key_coord(res, tmv, c->key[i]);
-            border += (real_t)d->step[i] * res * (real_t)0.5;
-            d->tmax[i] = (border - (real_t)o[i]) / (real_t)dir[i];
-            d->tdelta[i] = res / (real_t)fabsf(dir[i]);
-        } else {
-            d->tmax[i] = REAL_MAX;
-            d->tdelta[i] = REAL_MAX;
-        }
-    }
+    occ_dda_start(d, res, tmv, o, dir, c->key, false);
 }
 
+/* The unsafe answer an error leaves in a caller's result: an obstacle at the origin, in no voxel
+ * (key OCC_NONE on every axis). */
+static void set_unsafe(occ_ray_result_t *out, occ_vec3_t origin)
+{
+    out->hit = true;
+    out->stop = OCC_RAY_HIT;
+    out->key.k[0] = OCC_NONE;
+    out->key.k[1] = OCC_NONE;
+    out->key.k[2] = OCC_NONE;
+    out->end = origin;
+}
 
 /* The ray is in a node of level lu >= 1 that it passes through (passable or uniform): step on
  * without looking anything up while the next voxel is still in the node and (when the range is
@@ -214,18 +163,19 @@ static inline void dda_coast(dda_t *d, uint32_t key[3], unsigned lu, bool bounde
     const real_t dt0 = d->tdelta[0];
     const real_t dt1 = d->tdelta[1];
     const real_t dt2 = d->tdelta[2];
-    const real_t stop = bounded ? safe_t : REAL_MAX;
+    const real_t stop = bounded ? safe_t : OCC_REAL_MAX;
     int32_t n0 = 0;
     int32_t n1 = 0;
     int32_t n2 = 0;
     for (;;) {
-        if (t0 < t1 && t0 < t2) {
+        const unsigned dim = occ_dda_axis(t0, t1, t2);
+        if (dim == 0u) {
             if (n0 == room[0] || !(t0 < stop)) {
                 break;
             }
             n0++;
             t0 += dt0;
-        } else if (t1 < t2) {
+        } else if (dim == 1u) {
             if (n1 == room[1] || !(t1 < stop)) {
                 break;
             }
@@ -264,7 +214,11 @@ static bool normalize(const occ_vec3_t v, float out[3])
 occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
                        bool ignore_unknown, float max_range_m, occ_ray_result_t *out)
 {
-    if (map == NULL || out == NULL || !occ_q_finite3(origin) || !occ_q_finite3(direction) ||
+    if (out == NULL) {
+        return OCC_ERR_ARG;
+    }
+    set_unsafe(out, origin); /* until the walk decides */
+    if (map == NULL || !occ_q_finite3(origin) || !occ_q_finite3(direction) ||
         !occ_q_finite(max_range_m)) {
         return OCC_ERR_ARG;
     }
@@ -272,13 +226,13 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
     if (!normalize(direction, dir)) {
         return OCC_ERR_ARG;
     }
-    const real_t res = ray_resolution(map);
+    const real_t res = occ_geom_res(map);
     occ_key_t k0;
-    const occ_err_t e = ray_key(map, res, origin, k0.k);
+    const occ_err_t e = ray_key(map, origin, k0.k);
     if (e != OCC_OK) {
         return e;
     }
-    const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
+    const int32_t tmv = occ_geom_half(map);
     const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
     cursor_t c;
     const unsigned states = OCC_PRED_OCCUPIED | (ignore_unknown ? 0u : OCC_PRED_UNKNOWN);
@@ -316,17 +270,8 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
             dda_coast(&d, c.key, c.lu, range_set, safe_t);
         }
         entered = false;
-        /* OctoMap's choice of axis (smallest tMax, ties to the higher axis), on locals. */
-        unsigned dim;
-        real_t t_entry;
-        if (d.tmax[0] < d.tmax[1] && d.tmax[0] < d.tmax[2]) {
-            dim = 0u;
-        } else if (d.tmax[1] < d.tmax[2]) {
-            dim = 1u;
-        } else {
-            dim = 2u;
-        }
-        t_entry = d.tmax[dim];
+        const unsigned dim = occ_dda_axis(d.tmax[0], d.tmax[1], d.tmax[2]);
+        const real_t t_entry = d.tmax[dim];
         const uint32_t old = c.key[dim];
         if (old == lim[dim]) {
             set_result(&c, res, tmv, out, false, OCC_RAY_MAP_EDGE);
@@ -364,6 +309,16 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
     }
 }
 
+/* Nothing blocks: the blocker (if asked for) names no voxel. */
+static occ_err_t set_visible(bool *visible, occ_ray_result_t *blocker)
+{
+    if (blocker != NULL) {
+        blocker->hit = false;
+    }
+    *visible = true;
+    return OCC_OK;
+}
+
 static bool blocks(const occ_map_t *map, occ_value_t v, occ_unknown_policy_t policy)
 {
     return (occ_q_state_bit(occ_q_state(map, v)) & occ_q_blocking_states(policy)) != 0u;
@@ -373,27 +328,33 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
                             occ_unknown_policy_t policy, bool *visible,
                             occ_ray_result_t *blocker)
 {
+    /* Fail closed: not visible, blocked at a, until the walk says otherwise. */
+    if (visible != NULL) {
+        *visible = false;
+    }
+    if (blocker != NULL) {
+        set_unsafe(blocker, a);
+    }
     if (map == NULL || visible == NULL || check_policy(policy) != OCC_OK || !occ_q_finite3(a) ||
         !occ_q_finite3(b)) {
         return OCC_ERR_ARG;
     }
-    const real_t res = ray_resolution(map);
+    const real_t res = occ_geom_res(map);
     occ_key_t ka;
     occ_key_t kb;
-    occ_err_t e = ray_key(map, res, a, ka.k);
+    occ_err_t e = ray_key(map, a, ka.k);
     if (e == OCC_OK) {
-        e = ray_key(map, res, b, kb.k);
+        e = ray_key(map, b, kb.k);
     }
     if (e != OCC_OK) {
         return e;
     }
-    const int32_t tmv = (int32_t)1 << (map->cfg.depth_levels - 1u);
+    const int32_t tmv = occ_geom_half(map);
     occ_ray_result_t scratch;
     occ_ray_result_t *const res_out = blocker != NULL ? blocker : &scratch;
     const uint8_t stop = (uint8_t)occ_q_has_bits(occ_q_blocking_states(policy));
     cursor_t c;
     cursor_init(&c, map, ka.k, stop);
-    *visible = false;
     if (blocks(map, c.val, policy)) {
         set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
         return OCC_OK;
@@ -401,8 +362,7 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     const occ_vec3_t dv = {b.x - a.x, b.y - a.y, b.z - a.z};
     float dir[3];
     if (!normalize(dv, dir) || (ka.k[0] == kb.k[0] && ka.k[1] == kb.k[1] && ka.k[2] == kb.k[2])) {
-        *visible = true;
-        return OCC_OK;
+        return set_visible(visible, blocker);
     }
     bool reached_b = false; /* b's voxel checked on the way (else looked up at the end) */
     const float o[3] = {a.x, a.y, a.z};
@@ -427,14 +387,7 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
             dda_coast(&d, c.key, c.lu, false, (real_t)0);
         }
         entered = false;
-        unsigned dim;
-        if (d.tmax[0] < d.tmax[1] && d.tmax[0] < d.tmax[2]) {
-            dim = 0u;
-        } else if (d.tmax[1] < d.tmax[2]) {
-            dim = 1u;
-        } else {
-            dim = 2u;
-        }
+        const unsigned dim = occ_dda_axis(d.tmax[0], d.tmax[1], d.tmax[2]);
         if (d.tmax[dim] > len) {
             break; /* past b (its voxel was checked above) */
         }
@@ -472,6 +425,5 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
             return OCC_OK;
         }
     }
-    *visible = true;
-    return OCC_OK;
+    return set_visible(visible, blocker);
 }

@@ -124,14 +124,12 @@ static void node_distance(const ctx_t *const x, const occ_code_t code, const uns
 {
     const occ_map_t *const m = x->m;
     const occ_key_t k = occ_morton_decode(code);
-    const int32_t half = (int32_t)1 << (m->cfg.depth_levels - 1u);
-    const float res = m->cfg.resolution_m;
-    const float size = res * (float)((uint32_t)1 << level);
+    const uint32_t size = (uint32_t)1 << level;
     const float cc[3] = {x->c.x, x->c.y, x->c.z};
     float gap[3], far[3];
     for (unsigned a = 0; a < 3u; a++) {
-        const float lo = (float)((int32_t)k.k[a] - half) * res;
-        const float hi = lo + size;
+        const float lo = occ_geom_face1(m, k.k[a]);
+        const float hi = occ_geom_face1(m, k.k[a] + size);
         gap[a] = maxf(maxf(lo - cc[a], cc[a] - hi), 0.0f);
         far[a] = maxf(absf(cc[a] - lo), absf(cc[a] - hi));
     }

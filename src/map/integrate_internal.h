@@ -6,17 +6,14 @@
 #define OCC_INTEGRATE_INTERNAL_H_INCLUDED
 
 #include "occmap/occmap.h"
+#include "geom_internal.h"
 
-#if OCC_RAY_DOUBLE
-typedef double occ_rr_t;
-#else
-typedef float occ_rr_t;
+typedef occ_real_t occ_rr_t;
 
-#endif
-
-/* Key arithmetic of one map, as OctoMap's: key = (int)floor(x * (1/res)) + 2^(D-1). */
+/* The map's geometry (geom_internal.h) copied to locals for the hot loops:
+ * key = floor(x * (1/res)) + 2^(D-1) with the map's decimal resolution. */
 typedef struct {
-    occ_rr_t res;      /* resolution */
+    occ_rr_t res;      /* the decimal resolution */
     occ_rr_t rf;       /* 1 / res */
     occ_rr_t tmv_r;    /* 2^(D-1) as a real */
     int32_t tmv;       /* 2^(D-1) */

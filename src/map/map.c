@@ -1,4 +1,4 @@
-/* map.c - configuration, init/clear, and coordinate <-> key arithmetic. */
+/* map.c - configuration, init/clear, and the public coordinate <-> key calls (geom_internal.h). */
 #include "tree_internal.h"
 
 occ_map_config_t occ_map_config_default(void)
@@ -49,12 +49,7 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
     map->q_clamp_max = occ_value_from_logodds(cfg->clamp_max);
     map->q_free_max = occ_value_from_logodds(cfg->free_max);
     map->q_occ_min = occ_value_from_logodds(cfg->occupied_min);
-    map->inv_res = 1.0f / cfg->resolution_m;
-#if OCC_RAY_DOUBLE
-    map->inv_res_d = 1.0 / (double)cfg->resolution_m;
-#else
-    map->inv_res_d = 0;
-#endif
+    occ_geom_init(map);
     /* Align the start and the size to 8 so both block kinds stay aligned from either end. */
     uintptr_t start = (uintptr_t)arena;
     size_t bytes = arena_bytes;
@@ -129,16 +124,41 @@ float occ_map_node_size(const occ_map_t *const map, const unsigned level)
     return map->cfg.resolution_m * (float)((uint32_t)1 << node_level(map, level));
 }
 
+occ_err_t occ_map_key_range(const occ_map_t *const map, const float lo_m, const float hi_m,
+                            uint32_t *const lo, uint32_t *const hi)
+{
+    if (map == NULL || lo == NULL || hi == NULL || !finite_f(lo_m) || !finite_f(hi_m) ||
+        lo_m > hi_m) {
+        return OCC_ERR_ARG;
+    }
+    uint32_t l;
+    uint32_t h;
+    if (!occ_geom_key_range(map, lo_m, hi_m, (occ_real_t)0, &l, &h)) {
+        return OCC_ERR_RANGE;
+    }
+    *lo = l;
+    *hi = h;
+    return OCC_OK;
+}
+
 occ_vec3_t occ_map_key_center(const occ_map_t *const map, const occ_key_t key, const unsigned level)
 {
-    /* Above depth_levels both the key mask and occ_map_node_size saturate: the root's centre. */
-    const occ_key_t base = occ_key_at_level(key, level);
-    /* 64-bit: a caller key >= 2^31 (off the map) must not overflow; it gets the centre it
-     * would have, outside the map. */
+    /* Above depth_levels both the key mask and the level saturate: the root's centre. */
+    const unsigned lv = node_level(map, level);
+    const occ_key_t base = occ_key_at_level(key, lv);
+    const uint32_t kmax = (uint32_t)1 << map->cfg.depth_levels;
+    occ_vec3_t c;
+    if (base.k[0] < kmax && base.k[1] < kmax && base.k[2] < kmax) {
+        c.x = occ_geom_center1(map, base.k[0], lv);
+        c.y = occ_geom_center1(map, base.k[1], lv);
+        c.z = occ_geom_center1(map, base.k[2], lv);
+        return c;
+    }
+    /* A caller key off the map (up to 2^32 - 1) gets the centre it would have, outside the map,
+     * in 64-bit key arithmetic so that nothing overflows. */
     const int64_t half = (int64_t)1 << (map->cfg.depth_levels - 1u);
     const float res = map->cfg.resolution_m;
-    const float offset = 0.5f * occ_map_node_size(map, level);
-    occ_vec3_t c;
+    const float offset = 0.5f * occ_map_node_size(map, lv);
     c.x = (float)((int64_t)base.k[0] - half) * res + offset;
     c.y = (float)((int64_t)base.k[1] - half) * res + offset;
     c.z = (float)((int64_t)base.k[2] - half) * res + offset;

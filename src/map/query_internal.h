@@ -79,12 +79,10 @@ static inline unsigned occ_q_blocking_states(occ_unknown_policy_t policy)
 }
 
 /* Centre coordinate (metres) of the node at `level` whose first voxel key on an axis is `k`
- * (the same arithmetic as occ_map_key_center). */
+ * (the map's one geometry, as occ_map_key_center). */
 static inline float occ_q_center1(const occ_map_t *m, uint32_t k, unsigned level)
 {
-    const int32_t half = (int32_t)1 << (m->cfg.depth_levels - 1u);
-    const float res = m->cfg.resolution_m;
-    return (float)((int32_t)k - half) * res + 0.5f * (res * (float)((uint32_t)1 << level));
+    return occ_geom_center1(m, k, level);
 }
 
 static inline occ_vec3_t occ_q_center(const occ_map_t *m, occ_key_t k, unsigned level)

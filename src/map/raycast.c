@@ -1,40 +1,26 @@
 /*
  * raycast.c - OctoMap's computeRayKeys (Amanatides & Woo 3D-DDA), bit for bit: float direction
- * and length, tMax/tDelta in occ_rr_t (double on hosts), the same tie-breaking (x before y
- * before z only on strict <) and the same "passed the end by rounding" stop.
+ * and length, the DDA set-up and tie rule every ray walk shares (geom_internal.h: occ_dda_start,
+ * occ_dda_axis), and computeRayKeys' stop: at the end key, or when min(tMax) passes the length.
+ * castray.c walks from the same set-up with castRay's stops (blocking voxel, range, map edge).
  */
 #include <float.h>
 #include <math.h>
 
 #include "integrate_internal.h"
 
-#if OCC_RAY_DOUBLE
-#define RR_MAXV DBL_MAX
-#else
-#define RR_MAXV FLT_MAX
-#endif
-
 void occ_raygeo_init(occ_raygeo_t *const g, const occ_map_t *const map)
 {
     g->depth = map->cfg.depth_levels;
     g->tmv = (int32_t)1 << (g->depth - 1u);
     g->tmv_r = (occ_rr_t)g->tmv;
-    g->res = (occ_rr_t)map->cfg.resolution_m;
-    g->rf = (occ_rr_t)1 / g->res;
+    g->res = occ_geom_res(map);
+    g->rf = occ_geom_inv(map);
 }
 
 bool occ_raygeo_key1(const occ_raygeo_t *const g, const float c, uint32_t *const k)
 {
-    const occ_rr_t s = g->rf * (occ_rr_t)c;
-    /* Same test as OctoMap's 0 <= floor(s) + tmv < 2 tmv, without overflowing the int cast. */
-    if (!(s >= -g->tmv_r && s < g->tmv_r)) {
-        return false;
-    }
-    /* floor() without a libm call: |s| < 2^20, so the truncation is exact. */
-    int32_t i = (int32_t)s;
-    i -= (occ_rr_t)i > s ? 1 : 0;
-    *k = (uint32_t)(i + g->tmv);
-    return true;
+    return occ_geom_key_of(g->rf, g->tmv, c, k);
 }
 
 bool occ_raygeo_key(const occ_raygeo_t *const g, const float p[3], uint32_t k[3])
@@ -45,7 +31,7 @@ bool occ_raygeo_key(const occ_raygeo_t *const g, const float p[3], uint32_t k[3]
 
 float occ_raygeo_center(const occ_raygeo_t *const g, const uint32_t k)
 {
-    return (float)(((occ_rr_t)((int32_t)k - g->tmv) + (occ_rr_t)0.5) * g->res);
+    return (float)occ_geom_center_of(g->res, g->tmv, k, 0u);
 }
 
 occ_rr_t occ_raygeo_dist(const float o[3], const float p[3])
@@ -87,7 +73,7 @@ size_t occ_dda_bound(const uint32_t ko[3], const uint32_t ke[3])
 typedef struct {
     occ_rr_t tmax[3], tdelta[3];
     int32_t key[3];
-    int step[3];
+    int32_t step[3];
     int32_t kmax;
     float length;
     occ_code_t c;
@@ -103,18 +89,14 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
     d[0] /= s->length;
     d[1] /= s->length;
     d[2] /= s->length;
+    /* computeRayKeys rounds the half-voxel step to float. */
+    occ_dda_t dd;
+    occ_dda_start(&dd, g->res, g->tmv, o, d, ko, true);
     for (unsigned i = 0; i < 3u; i++) {
         s->key[i] = (int32_t)ko[i];
-        s->step[i] = d[i] > 0.0f ? 1 : (d[i] < 0.0f ? -1 : 0);
-        if (s->step[i] != 0) {
-            occ_rr_t border = ((occ_rr_t)((int32_t)ko[i] - g->tmv) + (occ_rr_t)0.5) * g->res;
-            border += (occ_rr_t)(float)((occ_rr_t)s->step[i] * g->res * (occ_rr_t)0.5);
-            s->tmax[i] = (border - (occ_rr_t)o[i]) / (occ_rr_t)d[i];
-            s->tdelta[i] = g->res / (occ_rr_t)fabsf(d[i]);
-        } else {
-            s->tmax[i] = RR_MAXV;
-            s->tdelta[i] = RR_MAXV;
-        }
+        s->step[i] = dd.step[i];
+        s->tmax[i] = dd.tmax[i];
+        s->tdelta[i] = dd.tdelta[i];
     }
     const occ_key_t k0 = {{ko[0], ko[1], ko[2]}};
     s->c = occ_morton_encode(k0);
@@ -148,15 +130,11 @@ void occ_dda_setup(const occ_raygeo_t *const g, const float o[3], const float e[
         const uint32_t kmax = (uint32_t)(s).kmax;                                                 \
         size_t left = (s).limit - 1u;                                                             \
         for (;;) {                                                                                \
-            if (t0 < t1) {                                                                        \
-                if (t0 < t2) {                                                                    \
-                    k0 += s0;                                                                     \
-                    t0 += d0;                                                                     \
-                } else {                                                                          \
-                    k2 += s2;                                                                     \
-                    t2 += d2;                                                                     \
-                }                                                                                 \
-            } else if (t1 < t2) {                                                                 \
+            const unsigned dim_ = occ_dda_axis(t0, t1, t2);                                       \
+            if (dim_ == 0u) {                                                                     \
+                k0 += s0;                                                                         \
+                t0 += d0;                                                                         \
+            } else if (dim_ == 1u) {                                                              \
                 k1 += s1;                                                                         \
                 t1 += d1;                                                                         \
             } else {                                                                              \
@@ -266,15 +244,8 @@ size_t occ_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e
      * happen at the top of the next iteration. Leaving the map means leaving the box (which
      * lies inside it): the caller then redoes the scan on the sorted path, which stops there. */
     for (;;) {
-        unsigned dim;
-        occ_rr_t tsel;
-        if (t0 < t1) {
-            dim = t0 < t2 ? 0u : 2u;
-            tsel = t0 < t2 ? t0 : t2;
-        } else {
-            dim = t1 < t2 ? 1u : 2u;
-            tsel = t1 < t2 ? t1 : t2;
-        }
+        const unsigned dim = occ_dda_axis(t0, t1, t2);
+        const occ_rr_t tsel = dim == 0u ? t0 : (dim == 1u ? t1 : t2);
         if (pending) {
             if (tsel > len) {
                 break;

@@ -1,24 +1,16 @@
 /* stats.c - pool counters and content statistics. */
 #include "tree_internal.h"
 
-/* The resolution as a user writes it (0.1f -> 0.1, 0.05f -> 0.05): the shortest decimal that
- * rounds back to the float, as octomap::OcTree(0.1) and a .bt header hold it. Volumes built on
- * (double)0.1f would be 1.3e-7 relative too large. */
-static double decimal_resolution(const float rf)
+/* The resolution as a user writes it (0.1f -> 0.1), as octomap::OcTree(0.1) and a .bt header
+ * hold it: volumes built on (double)0.1f would be 1.3e-7 relative too large. The float build
+ * keeps no double copy in the map, so it is worked out here. */
+static double volume_resolution(const occ_map_t *const map)
 {
-    const double r = (double)rf;
-    double scale = 1.0;
-    while (r * scale < 1.0 && scale < 1e12) {
-        scale *= 10.0;
-    }
-    for (unsigned digits = 0; digits < 9u; digits++, scale *= 10.0) {
-        const double cand = (double)(int64_t)(r * scale + 0.5) / scale;
-        const float back = (float)cand;
-        if (!(back < rf) && !(back > rf)) {
-            return cand;
-        }
-    }
-    return r;
+#if OCC_RAY_DOUBLE
+    return map->geo_res;
+#else
+    return occ_geom_decimal(map->cfg.resolution_m);
+#endif
 }
 
 void occ_map_pool_stats(const occ_map_t *const map, occ_map_stats_t *const out)
@@ -84,7 +76,7 @@ void occ_map_stats(const occ_map_t *const map, occ_map_stats_t *const out)
         }
     }
     /* Counts are exact integers: one multiplication each, no float accumulation. */
-    const double res = decimal_resolution(map->cfg.resolution_m);
+    const double res = volume_resolution(map);
     const double voxel_m3 = res * res * res;
     out->occupied_volume_m3 = (double)out->occupied_voxels * voxel_m3;
     out->free_volume_m3 = (double)out->free_voxels * voxel_m3;

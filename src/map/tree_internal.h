@@ -13,6 +13,7 @@
 #define OCC_TREE_INTERNAL_H_INCLUDED
 
 #include "occmap/occmap.h"
+#include "geom_internal.h"
 
 typedef struct {
     uint32_t child[8];
@@ -97,28 +98,10 @@ static inline occ_nodep_t occ_inner_node(const occ_map_t *m, uint32_t block, uns
     return n;
 }
 
-/* One axis of occ_map_key: OctoMap's coordToKeyChecked, floor(c / res) + 2^(D-1) in OctoMap's
- * arithmetic (double when OCC_RAY_DOUBLE). False off the map; NaN and Inf fail the range test. */
+/* One axis of occ_map_key: the map's one conversion (geom_internal.h). False off the map. */
 static inline bool occ_coord_to_key(const occ_map_t *m, float c, uint32_t *key)
 {
-    const int32_t half = (int32_t)1 << (m->cfg.depth_levels - 1u);
-#if OCC_RAY_DOUBLE
-    const double scaled = (double)c * m->inv_res_d;
-    if (!(scaled >= -(double)half) || !(scaled < (double)half)) {
-        return false;
-    }
-    double fl = (double)(int32_t)scaled;
-    fl -= fl > scaled ? 1.0 : 0.0;
-#else
-    const float scaled = c * m->inv_res;
-    if (!(scaled >= -(float)half) || !(scaled < (float)half)) {
-        return false;
-    }
-    float fl = (float)(int32_t)scaled;
-    fl -= fl > scaled ? 1.0f : 0.0f;
-#endif
-    *key = (uint32_t)((int32_t)fl + half);
-    return true;
+    return occ_geom_key1(m, c, key);
 }
 
 static inline bool occ_is_observed(occ_value_t v)

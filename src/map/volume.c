@@ -469,31 +469,17 @@ bool occ_volume_holds_box(const occ_volume_t *v, occ_vec3_t c, float h)
  * for faces lying exactly on a border); false when the bounds miss the map. */
 bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3])
 {
-    const float inv = 1.0f / m->cfg.resolution_m;
-    const float half = (float)(1u << (m->cfg.depth_levels - 1u));
-    const float top = 2.0f * half - 1.0f;
-    /* Slack for rounding, in voxels: the exact tests and this conversion work in float, whose
-     * step at the map's far corners is half * 2^-23 voxels; four of those, and a lower face on a
-     * border (bmin an integer) still takes in the voxel below, whose upper face it touches. */
-    const float eps = 4.0f * half * (1.0f / 8388608.0f) + 1e-3f;
+    /* Slack for rounding, in voxels: the exact tests work on float node boxes, whose step at the
+     * map's far corners is half * 2^-23 voxels; four of those, and a lower face on a border
+     * still takes in the voxel below, whose upper face it touches. The keys themselves come
+     * from the map's one conversion. */
+    const occ_real_t half = (occ_real_t)occ_geom_half(m);
+    const occ_real_t slack = (occ_real_t)4 * half * ((occ_real_t)1 / (occ_real_t)8388608) +
+                             (occ_real_t)1e-3;
     const float bmin[3] = {v->bmin.x, v->bmin.y, v->bmin.z};
     const float bmax[3] = {v->bmax.x, v->bmax.y, v->bmax.z};
     for (unsigned i = 0; i < 3u; i++) {
-        /* Clamp first (keeps the integer conversion in range), then floor by truncation. */
-        float l = bmin[i] * inv + half - eps;
-        float h = bmax[i] * inv + half + eps;
-        if (!(h >= 0.0f) || !(l < top + 1.0f)) {
-            return false;
-        }
-        l = l < 0.0f ? 0.0f : l;
-        h = h > top ? top : h;
-        int32_t li = (int32_t)l;
-        int32_t hi_i = (int32_t)h;
-        li -= (float)li > l ? 1 : 0;
-        hi_i -= (float)hi_i > h ? 1 : 0;
-        lo[i] = (uint32_t)li;
-        hi[i] = (uint32_t)hi_i;
-        if (lo[i] > hi[i]) {
+        if (!occ_geom_key_range(m, bmin[i], bmax[i], slack, &lo[i], &hi[i])) {
             return false;
         }
     }

@@ -1,4 +1,5 @@
 // oracle_io.cpp - OctoMap as the reference for the file tests (see oracle_io.h).
+#include "oracle_res.hpp"
 #include "oracle_io.h"
 
 #include <octomap/ColorOcTree.h>
@@ -56,12 +57,12 @@ static oracle_io *wrap(octomap::AbstractOcTree *a)
 extern "C" oracle_io_t *oracle_io_new(oracle_io_kind_t kind, double res)
 {
     if (kind == ORACLE_COLOR) {
-        return wrap(new octomap::ColorOcTree(res));
+        return wrap(new octomap::ColorOcTree(oracle_user_resolution(res)));
     }
     if (kind == ORACLE_STAMPED) {
-        return wrap(new octomap::OcTreeStamped(res));
+        return wrap(new octomap::OcTreeStamped(oracle_user_resolution(res)));
     }
-    return wrap(new octomap::OcTree(res));
+    return wrap(new octomap::OcTree(oracle_user_resolution(res)));
 }
 
 extern "C" void oracle_io_free(oracle_io_t *t)

@@ -19,7 +19,7 @@ typedef struct oracle_io oracle_io_t;
 
 typedef enum { ORACLE_OCTREE = 0, ORACLE_COLOR = 1, ORACLE_STAMPED = 2 } oracle_io_kind_t;
 
-/* A new empty tree of the given kind. */
+/* A new empty tree of the given kind, of the decimal a user writes for (float)resolution_m. */
 oracle_io_t *oracle_io_new(oracle_io_kind_t kind, double resolution_m);
 void oracle_io_free(oracle_io_t *t);
 /* OcTree::readBinary on the bytes (any id, as OctoMap does). NULL when OctoMap refuses. */

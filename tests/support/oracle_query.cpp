@@ -1,5 +1,6 @@
 // oracle_query.cpp - brute-force references for the query tests: Eigen geometry in double,
 // one cell at a time, and OctoMap's castRay. Shares no code with the core's query math.
+#include "oracle_res.hpp"
 #include "oracle_query.h"
 
 #include <Eigen/Dense>
@@ -291,7 +292,7 @@ static int cube_test(const oracle_q_shape *s, const Vector3d &cc, double h)
 
 static Vector3d cell_center(const occ_map_t *map, const uint32_t k[3], unsigned level)
 {
-    const double res = (double)map->cfg.resolution_m;
+    const double res = oracle_user_resolution((double)map->cfg.resolution_m);
     const double half = std::ldexp(1.0, map->cfg.depth_levels - 1);
     const double side = std::ldexp(1.0, (int)level);
     Vector3d c;
@@ -305,7 +306,7 @@ static Vector3d cell_center(const occ_map_t *map, const uint32_t k[3], unsigned 
 extern "C" int oracle_q_cell(const oracle_q_shape_t *s, const occ_map_t *map, occ_key_t key,
                              unsigned level)
 {
-    const double h = std::ldexp(1.0, (int)level) * (double)map->cfg.resolution_m / 2;
+    const double h = std::ldexp(1.0, (int)level) * oracle_user_resolution((double)map->cfg.resolution_m) / 2;
     return cube_test(s, cell_center(map, key.k, level), h);
 }
 
@@ -339,7 +340,7 @@ static unsigned voxel_state_bit(const occ_map_t *map, const uint32_t k[3])
 static bool cell_range(const occ_map_t *map, const oracle_q_shape *s, unsigned level,
                        int64_t lo[3], int64_t hi[3])
 {
-    const double res = (double)map->cfg.resolution_m;
+    const double res = oracle_user_resolution((double)map->cfg.resolution_m);
     const double side = std::ldexp(1.0, (int)level) * res;
     const int64_t half = (int64_t)1 << (map->cfg.depth_levels - 1);
     const int64_t ncell = ((int64_t)1 << map->cfg.depth_levels) >> level;
@@ -423,7 +424,7 @@ extern "C" void oracle_q_count(const occ_map_t *map, const oracle_q_shape_t *s,
 extern "C" double oracle_q_nearest_d2(const occ_map_t *map, const double p[3], unsigned states)
 {
     const uint32_t n = 1u << map->cfg.depth_levels;
-    const double h = (double)map->cfg.resolution_m / 2;
+    const double h = oracle_user_resolution((double)map->cfg.resolution_m) / 2;
     double best = -1;
     const Vector3d pp = v3(p);
     for (uint32_t z = 0; z < n; z++) {
@@ -473,7 +474,7 @@ extern "C" oracle_q_octo_t *oracle_q_octo_random(uint64_t seed, double res_m)
 {
     std::mt19937_64 rng(seed);
     auto r = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
-    auto *t = new octomap::OcTree(res_m);
+    auto *t = new octomap::OcTree(oracle_user_resolution(res_m));
     const int half = 32; /* voxels: the scene spans [-32, 32) per axis */
     auto box = [&](int size, bool occupied) {
         const int x0 = r(-half, half - size), y0 = r(-half, half - size), z0 = r(-half, half - size);

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "oracle_res.hpp"
 #include "oracle_rays.h"
 
 using octomap::OcTree;
@@ -16,9 +17,10 @@ extern "C" int oracle_ray_keys(double res, const float o[3], const float e[3], u
                                size_t cap, size_t *n)
 {
     static OcTree *tree = nullptr;
-    if (tree == nullptr || tree->getResolution() != res) {
+    const double user_res = oracle_user_resolution(res);
+    if (tree == nullptr || tree->getResolution() != user_res) {
         delete tree;
-        tree = new OcTree(res);
+        tree = new OcTree(user_res);
     }
     static octomap::KeyRay ray;
     const bool ok = tree->computeRayKeys(point3d(o[0], o[1], o[2]), point3d(e[0], e[1], e[2]), ray);
@@ -36,7 +38,7 @@ extern "C" void oracle_ray_free_static(void) {}
 
 extern "C" void *oracle_ins_new(double res)
 {
-    return new OcTree(res);
+    return new OcTree(oracle_user_resolution(res));
 }
 
 extern "C" void oracle_ins_delete(void *t)

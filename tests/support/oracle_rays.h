@@ -1,5 +1,6 @@
 /* oracle_rays.h - OctoMap as the reference for ray keys and point-cloud integration (C API of
- * oracle_rays.cpp). Resolution is passed as a double: use (double)cfg.resolution_m. */
+ * oracle_rays.cpp). Resolution: pass (double)cfg.resolution_m; the tree is built with the decimal
+ * a user writes for that float (OcTree(0.1) for 0.1f, tests/support/oracle_res.hpp). */
 #ifndef OCC_ORACLE_RAYS_H_INCLUDED
 #define OCC_ORACLE_RAYS_H_INCLUDED
 

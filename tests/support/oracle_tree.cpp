@@ -1,4 +1,5 @@
 // oracle_tree.cpp - octomap::OcTree behind the C API of oracle_tree.h (test/bench reference).
+#include "oracle_res.hpp"
 #include "oracle_tree.h"
 
 #include <octomap/OcTree.h>
@@ -6,7 +7,7 @@
 #include <new>
 
 struct oracle_tree {
-    explicit oracle_tree(double res) : tree(res) {}
+    explicit oracle_tree(double res) : tree(oracle_user_resolution(res)) {}
     octomap::OcTree tree;
 };
 

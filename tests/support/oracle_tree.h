@@ -16,7 +16,8 @@ extern "C" {
 
 typedef struct oracle_tree oracle_tree_t;
 
-/* A new OcTree of `resolution_m` with OctoMap's default sensor model. NULL on failure.
+/* A new OcTree of the decimal a user writes for (float)resolution_m (OcTree(0.1) for 0.1f,
+ * oracle_res.hpp) with OctoMap's default sensor model. NULL on failure.
  * Free with oracle_tree_free(). */
 oracle_tree_t *oracle_tree_new(double resolution_m);
 void oracle_tree_free(oracle_tree_t *t);
