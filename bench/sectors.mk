@@ -1,4 +1,4 @@
-# sectors.mk - cost of one 72-sector update (src/feed/sectors.c) on OctoMap's geb079.bt:
+# sectors.mk - cost of one 72-sector update (src/sectors/sectors.c) on OctoMap's geb079.bt:
 # wall-clock median over corridor poses, and callgrind instructions per update.
 SECT_BENCH := $(BUILD)/bench/sectors_bench
 SECT_BENCH_MAP := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt

@@ -21,14 +21,14 @@ TEST_BUILD_EXTRA += $(FOUNDATION_SCAN)
 FOUNDATION_DIR := $(BUILD)/asan/foundation
 MORTON_BMI2_BIN := $(FOUNDATION_DIR)/bin/test_morton_bmi2
 
-$(FOUNDATION_DIR)/morton_bmi2.o: src/map/morton.c include/occmap/occmap.h
+$(FOUNDATION_DIR)/morton_bmi2.o: src/core/morton.c include/occmap/occmap.h
 	@mkdir -p $(dir $@)
 	$(CC) $(ASAN_CFLAGS) -DOCC_USE_BMI2=1 -mbmi2 -c $< -o $@.raw.o
 	@syms=$$(nm --defined-only -g $@.raw.o | awk '{print $$3}'); args=""; \
 	for s in $$syms; do args="$$args --redefine-sym $$s=bmi2_$$s"; done; \
 	objcopy $$args $@.raw.o $@ && rm -f $@.raw.o
 
-$(FOUNDATION_DIR)/test_morton_bmi2.o: tests/test_morton.c include/occmap/occmap.h src/map/tree_internal.h
+$(FOUNDATION_DIR)/test_morton_bmi2.o: tests/test_morton.c include/occmap/occmap.h src/core/tree_internal.h
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 -DTEST_MORTON_BMI2=1 -c $< -o $@
 

@@ -52,10 +52,10 @@ TEST_STEPS += test-mavlink-roundtrip test-mavlink-udp
 
 # ---- fuzzing (clang libFuzzer) ------------------------------------------------------------------
 FUZZ_MAV := $(BUILD)/fuzz/fuzz_mavlink
-$(FUZZ_MAV): tests/mavlink/fuzz_mavlink.c src/feed/mavlink.c include/occmap/occ_mavlink.h $(MAVGEN_STAMP)
+$(FUZZ_MAV): tests/mavlink/fuzz_mavlink.c src/mavlink/mavlink.c include/occmap/occ_mavlink.h $(MAVGEN_STAMP)
 	@mkdir -p $(dir $@)
 	clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-	  $(INC) -isystem $(MAVGEN_DIR) -o $@ tests/mavlink/fuzz_mavlink.c src/feed/mavlink.c
+	  $(INC) -isystem $(MAVGEN_DIR) -o $@ tests/mavlink/fuzz_mavlink.c src/mavlink/mavlink.c
 fuzz-mavlink: $(FUZZ_MAV) $(MAV_REF)/py_frames.bin
 	@mkdir -p $(BUILD)/fuzz/corpus-mavlink
 	@cp -f $(MAV_REF)/py_frames.bin $(BUILD)/fuzz/corpus-mavlink/seed-pymavlink.bin

@@ -18,8 +18,8 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "map/tree_internal.h"
-#include "map/io_internal.h"
+#include "core/tree_internal.h"
+#include "io/io_internal.h"
 
 /* expect_assert_failure(call), and the assert that fired is the one named (its expression as
  * written in src/): another assert on the way would mean the path broke somewhere else first. */

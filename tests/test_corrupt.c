@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "map/tree_internal.h"
+#include "core/tree_internal.h"
 #include "support/leak_check.h"
 
 #define ARENA_SIZE OCC_ARENA_BYTES(64, 64)

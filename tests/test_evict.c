@@ -33,7 +33,7 @@
 #include "occmap/occ_evict.h"
 #include "occmap/occ_integrate.h"
 #include "occmap/occ_scan.h"
-#include "map/tree_internal.h"
+#include "core/tree_internal.h"
 #include "support/leak_check.h"
 
 #define VOL 64u                     /* shadow volume edge, voxels */

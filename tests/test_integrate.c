@@ -15,7 +15,7 @@
 #include "occmap/occmap.h"
 #include "occmap/occ_scan.h"
 #include "occmap/occ_evict.h"
-#include "map/coarse_internal.h"
+#include "integrate/coarse_internal.h"
 #include "support/oracle_rays.h"
 #include "support/leak_check.h"
 

@@ -16,7 +16,7 @@
 #include <time.h>
 
 #include "occmap/occmap.h"
-#include "map/tree_internal.h"
+#include "core/tree_internal.h"
 
 #ifdef TEST_MORTON_BMI2
 occ_code_t bmi2_occ_morton_encode(occ_key_t key);

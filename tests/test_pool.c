@@ -19,7 +19,7 @@
 #include <time.h>
 
 #include "occmap/occmap.h"
-#include "map/tree_internal.h"
+#include "core/tree_internal.h"
 #include "support/shadow_grid.h"
 #include "support/leak_check.h"
 

@@ -9,7 +9,7 @@
 #include <cmocka.h>
 
 #define OCC_SECTORS_WALK_LIMIT 9u
-#include "feed/sectors.c" /* this binary's occ_sectors_compute; libocc's copy is not linked */
+#include "sectors/sectors.c" /* this binary's occ_sectors_compute; libocc's copy is not linked */
 
 static uint8_t arena[1u << 20];
 static occ_map_t map;

@@ -1,5 +1,5 @@
 /*
- * test_stats.c - occ_map_stats() (src/map/stats.c) against OctoMap's own numbers and against
+ * test_stats.c - occ_map_stats() (src/core/stats.c) against OctoMap's own numbers and against
  * values worked out by hand:
  *  - OctoMap's example map geb079.bt (Debian liboctomap-dev) and fr_078_tidyup.bt
  *    (../shared/data/maps): node, leaf, occupied and free leaf counts equal octomap::OcTree's;

@@ -55,7 +55,7 @@ def parse_map(path):
 
 
 def core_paths(root):
-    """Archive member name -> source-relative object path (src/map/x.o, src/feed/y.o)."""
+    """Archive member name -> source-relative object path (src/core/x.o, src/sectors/y.o)."""
     paths = {}
     for d, _, files in os.walk(os.path.join(root, "src")):
         for f in files:
@@ -167,7 +167,7 @@ def main():
         if name.startswith("src/"):
             core = [core[i] + mods[name][i] for i in range(3)]
     total = [sum(m[i] for m in mods.values()) for i in range(3)]
-    print("%-36s %8d %8d %8d" % ("core (src/map + src/feed) in image", *core))
+    print("%-36s %8d %8d %8d" % ("core (src/*: map + front ends) in image", *core))
     print("%-36s %8d %8d %8d" % ("image total", *total))
     print("core .text %d bytes: %s the 32 KB target" % (core[0], "within" if core[0] <= 32768
                                                           else "OVER"))

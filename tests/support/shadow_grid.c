@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "map/tree_internal.h"
+#include "core/tree_internal.h"
 
 #if OCC_VALUE_FLOAT
 typedef float acc_t;

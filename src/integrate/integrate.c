@@ -9,7 +9,7 @@
 #include "occmap/occ_evict.h"
 #include "coarse_internal.h"
 #include "integrate_internal.h"
-#include "sat_internal.h"
+#include "../core/sat_internal.h"
 
 #define FILTER_N ((size_t)1 << OCC_INSERT_FILTER_BITS)
 /* The filter and the histograms, carved at the aligned start of the scratch. */

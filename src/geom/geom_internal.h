@@ -1,5 +1,5 @@
 /*
- * geom_internal.h - the one voxel geometry of src/map: coordinate -> key, key -> centre, key
+ * geom_internal.h - the one voxel geometry of the map: coordinate -> key, key -> centre, key
  * ranges, and the 3D-DDA set-up every ray walk starts from (integration and castRay alike).
  *
  * The resolution is the map's decimal resolution (geom.c: the shortest decimal that rounds to

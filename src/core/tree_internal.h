@@ -1,5 +1,5 @@
 /*
- * tree_internal.h - the octree's storage, shared by the modules in src/map/ only
+ * tree_internal.h - the octree's storage, shared by the map modules under src/ only
  * (integrate, query, io, evict). Feeds and tools use the public header.
  *
  * A node at level >= 1 lives in an inner block (8 siblings: child block index, value, indicator
@@ -13,7 +13,7 @@
 #define OCC_TREE_INTERNAL_H_INCLUDED
 
 #include "occmap/occmap.h"
-#include "geom_internal.h"
+#include "../geom/geom_internal.h"
 
 typedef struct {
     uint32_t child[8];

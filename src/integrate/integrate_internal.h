@@ -1,12 +1,12 @@
 /*
- * integrate_internal.h - what raycast.c, keyset.c, integrate.c and superray.c share (src/map
+ * integrate_internal.h - what raycast.c, keyset.c, integrate.c and superray.c share (src/integrate
  * only): OctoMap's key arithmetic, the exact DDA writing Morton codes, the key-set sort.
  */
 #ifndef OCC_INTEGRATE_INTERNAL_H_INCLUDED
 #define OCC_INTEGRATE_INTERNAL_H_INCLUDED
 
 #include "occmap/occmap.h"
-#include "geom_internal.h"
+#include "../geom/geom_internal.h"
 
 typedef occ_real_t occ_rr_t;
 

@@ -1,5 +1,5 @@
 /*
- * sat_internal.h - saturating size arithmetic for src/map (scratch sizes, brick counts, strides,
+ * sat_internal.h - saturating size arithmetic for the map (scratch sizes, brick counts, strides,
  * n * sizeof, capacity sums, arena splits). A result that does not fit is SIZE_MAX, which no
  * buffer holds, so on a 32-bit size_t "too big" becomes an error and never a wrapped small size.
  */

@@ -2,7 +2,7 @@
  * infogain.c - information gain of a sensor volume: the unknown cells at a chosen level, found by
  * the volume iterator (branches without unknown space are skipped through the indicators).
  */
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 static float entropy_bits(const occ_map_t *m, occ_value_t v)
 {

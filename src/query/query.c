@@ -3,7 +3,7 @@
  * order on a fixed stack; a branch is skipped as soon as its cube misses the volume (volume.c) or
  * its max value / indicators rule the predicate out.
  */
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
                      uint8_t flags, bool uniform, occ_query_node_t *out)

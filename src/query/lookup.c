@@ -3,7 +3,7 @@
  * path cache for streams of nearby points (a trajectory, a sensor footprint), which walks again
  * only the levels below the highest key bit that changed.
  */
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 static inline bool point_key(const occ_map_t *m, occ_vec3_t p, occ_key_t *k)
 {

@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "integrate_internal.h"
-#include "sat_internal.h"
+#include "../core/sat_internal.h"
 
 #define SR_MAX_GROUP 4096u  /* rays handled together (a bigger cell is done in parts) */
 #define SR_MAX_EDGES 4096u  /* grid edges per projection inside one bundle */

@@ -15,7 +15,7 @@
 #include <float.h>
 #include <string.h>
 
-#include "tree_internal.h"
+#include "../core/tree_internal.h"
 
 #define EVICT_SHRINK 0.75f    /* threshold factor per pass */
 #define EVICT_FORGET_MARK 0xFFu /* cursor.coarse_level while forgetting */

@@ -3,7 +3,7 @@
  * distance from the query point to the node cube, in a caller buffer. A node is reported when it
  * reaches the top of the heap; a child is never closer than its parent, so the order is exact.
  */
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 static float box_d2(occ_vec3_t p, occ_vec3_t c, float h)
 {

@@ -7,7 +7,7 @@
 
 #include <math.h>
 #include <string.h>
-#include "map/tree_internal.h"
+#include "../core/tree_internal.h"
 
 static inline occ_state_t occ_q_state(const occ_map_t *m, occ_value_t v)
 {

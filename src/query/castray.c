@@ -7,7 +7,7 @@
  * changed, and not at all while the ray stays inside a node it can pass whole: a uniform (pruned)
  * one, or one whose indicators say nothing below stops the ray (UFOMap's use of the inner nodes).
  */
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 typedef occ_real_t real_t;
 #if OCC_RAY_DOUBLE

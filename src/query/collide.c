@@ -5,7 +5,7 @@
  * volume iterator (query.c) asked for those states, without its generality (splitting, min
  * level, resuming), which is most of its cost on a check this small.
  */
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 /* One open block: the children of the node whose first voxel is `key`. */
 typedef struct {

@@ -1,12 +1,12 @@
 /*
- * io_internal.h - what the readers and writers in src/map/io_*.c share: the tree builder (one
+ * io_internal.h - what the readers and writers in src/io/io_*.c share: the tree builder (one
  * code path for the validating dry run and the real build), the buffered byte sink, the
  * OctoMap text header, and the per-format parsers/emitters.
  */
 #ifndef OCC_IO_INTERNAL_H_INCLUDED
 #define OCC_IO_INTERNAL_H_INCLUDED
 
-#include "tree_internal.h"
+#include "../core/tree_internal.h"
 
 /* ---- builder (io_build.c) ----------------------------------------------------------------
  * Parsers describe a tree in preorder: open the root, set each child of the open node to a

@@ -3,7 +3,7 @@
  * range a volume can touch and which children of a node it touches. Shared by the iterator
  * (query.c) and the collision checks (collide.c).
  */
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 /* ---- small vector helpers ------------------------------------------------------------------ */
 static occ_vec3_t v3(float x, float y, float z)

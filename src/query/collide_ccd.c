@@ -3,7 +3,7 @@
  */
 #include <ccd/ccd.h>
 #include "occmap/occ_collide_ccd.h"
-#include "map/query_internal.h"
+#include "query_internal.h"
 
 typedef struct {
     occ_vec3_t c;

@@ -1,8 +1,8 @@
-/* coarse_internal.h - whole-node updates for FAST_DISCRETE (coarse.c), src/map only. */
+/* coarse_internal.h - whole-node updates for FAST_DISCRETE (coarse.c), src/integrate only. */
 #ifndef OCC_COARSE_INTERNAL_H_INCLUDED
 #define OCC_COARSE_INTERNAL_H_INCLUDED
 
-#include "tree_internal.h"
+#include "../core/tree_internal.h"
 
 /* Upper bound of the blocks that updating the nodes at `level` named by `codes` (sorted voxel
  * codes of their first voxels; hit bit ignored) can allocate: one child block per distinct node
