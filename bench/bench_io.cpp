@@ -14,7 +14,7 @@
 
 extern "C" {
 #include "occmap/occmap.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 }
 
 static double now_ms()

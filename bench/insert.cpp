@@ -19,7 +19,7 @@
 
 extern "C" {
 #include "occmap/occmap.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 }
 
 using octomap::OcTree;

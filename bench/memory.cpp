@@ -19,7 +19,7 @@
 
 #include "../tests/support/oracle_res.hpp"
 #include "occmap/occmap.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 
 namespace {
 

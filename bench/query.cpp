@@ -22,7 +22,7 @@
 
 extern "C" {
 #include "occmap/occmap.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 }
 
 using octomap::OcTree;

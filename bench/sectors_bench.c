@@ -11,8 +11,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "occmap/occ_feed.h"
-#include "occmap/occ_file.h"
+#include "occmap/occ_sectors.h"
+#include "occmap/host/occ_file.h"
 
 static double now_us(void)
 {

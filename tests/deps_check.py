@@ -148,9 +148,54 @@ def selftest(root):
     return ok
 
 
+CHAPTERS = ["occ_core.h", "occ_integrate.h", "occ_query.h", "occ_io.h", "occ_evict.h"]
+
+
+def check_headers(root):
+    """The public headers: occmap.h only includes the chapters, a chapter includes only
+    occ_core.h, no portable header includes occmap/host/, and no include cycle anywhere."""
+    inc = os.path.join(root, "include", "occmap")
+    edges, bad = {}, []
+    for folder in (inc, os.path.join(inc, "host")):
+        for f in sorted(os.listdir(folder)):
+            if not f.endswith(".h"):
+                continue
+            name = os.path.relpath(os.path.join(folder, f), inc)
+            with open(os.path.join(folder, f), encoding="utf-8") as fh:
+                deps = [m.group(1)[len("occmap/"):] for m in map(INCLUDE.match, fh) if m]
+            edges[name] = deps
+            allowed = (set(CHAPTERS) if name == "occmap.h" else
+                       {"occ_core.h"} if name in CHAPTERS else None)
+            for d in deps:
+                if allowed is not None and d not in allowed:
+                    bad.append("include/occmap/%s includes %s (allowed: %s)" % (name, d, ", ".join(sorted(allowed))))
+                if not name.startswith("host/") and d.startswith("host/"):
+                    bad.append("include/occmap/%s (portable) includes %s" % (name, d))
+
+    def cycle_from(node, path):
+        for d in edges.get(node, []):
+            if d in path:
+                return path[path.index(d):] + [d]
+            found = cycle_from(d, path + [d])
+            if found:
+                return found
+        return None
+
+    for h in sorted(edges):
+        found = cycle_from(h, [h])
+        if found:
+            bad.append("include cycle: " + " -> ".join(found))
+            break
+    return bad
+
+
 def main():
     root = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else ".")
     graph, bad, nfiles, nincs = check(root)
+    header_bad = check_headers(root)
+    print("deps_check: public headers: occmap.h -> %s; %s"
+          % (", ".join(CHAPTERS), "chapters include only occ_core.h, no cycle" if not header_bad else "PROBLEMS below"))
+    bad += header_bad
     print("deps_check: module graph of src/ (%d files, %d includes), module -> what it includes:"
           % (nfiles, nincs))
     for module in [m for m in MAP + FRONT if m in graph]:

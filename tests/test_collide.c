@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_collide_ccd.h"
+#include "occmap/host/occ_collide_ccd.h"
 #include "support/oracle_query.h"
 #include "support/query_shapes.h"
 

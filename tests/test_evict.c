@@ -32,7 +32,7 @@
 #include "occmap/occmap.h"
 #include "occmap/occ_evict.h"
 #include "occmap/occ_integrate.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 #include "core/tree_internal.h"
 #include "support/leak_check.h"
 

@@ -17,7 +17,7 @@
 
 #include "../tools/cli.c"
 #include "../tools/evict_cli.c"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 
 #define SCAN_DAT "build/data/scan.dat"
 #ifndef ARENA_DIV

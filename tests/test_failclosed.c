@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_collide_ccd.h"
+#include "occmap/host/occ_collide_ccd.h"
 #include "occmap/occ_evict.h"
 #include "support/query_shapes.h"
 

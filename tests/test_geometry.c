@@ -26,14 +26,14 @@
 
 #include "occmap/occmap.h"
 #include "occmap/occ_evict.h"
-#include "occmap/occ_feed.h"
+#include "occmap/occ_sectors.h"
 #include "occmap/occ_integrate.h"
 #include "occmap/occ_query.h"
 #include "support/oracle_geom.h"
 #if OCC_RAY_DOUBLE
 #include <stdlib.h>
 #include <unistd.h>
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 #include "support/oracle_rays.h"
 #endif
 

@@ -13,7 +13,7 @@
 #include <time.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 #include "occmap/occ_evict.h"
 #include "integrate/coarse_internal.h"
 #include "support/oracle_rays.h"

@@ -16,7 +16,7 @@
 #include <unistd.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 #include "support/iotest.h"
 
 #define GEB079 "/usr/share/doc/liboctomap-dev/examples/data/geb079.bt"

@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 
 #define GRAPH "/usr/share/doc/liboctomap-dev/examples/data/spherical_scan.graph"
 #define TUM_DIR "../shared/data/depth/tum_fr2_pioneer_slam2"

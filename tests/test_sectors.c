@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "occmap/occ_feed.h"
+#include "occmap/occ_sectors.h"
 #include "support/leak_check.h"
 
 #define ARENA_BYTES (8u << 20)
@@ -158,7 +158,7 @@ typedef struct {
     uint16_t cm[OCC_SECTORS_MAX];
 } ref_t;
 
-/* The ground rule of occ_feed.h, in double: the first occupied voxel down the vehicle's column
+/* The ground rule of occ_sectors.h, in double: the first occupied voxel down the vehicle's column
  * (from its own voxel while the voxel reaches above za) lifts za to its top + clearance. */
 static double ref_band_lo(const occ_pose_t *p, const occ_sectors_config_t *cfg, double za,
                           double zb)

@@ -27,7 +27,7 @@
 #include <sys/stat.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 #include "support/oracle_tree.h"
 #include "support/leak_check.h"
 

@@ -6,8 +6,8 @@
 
 #include "cli.h"
 #include "evict_cli.h"
-#include "occmap/occ_file.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_file.h"
+#include "occmap/host/occ_scan.h"
 
 static void usage(void)
 {

@@ -13,7 +13,7 @@
 
 #include "cli.h"
 #include "occmap/occ_can.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 #include "occmap/occ_mavlink.h"
 
 #define CMD "can-feed"

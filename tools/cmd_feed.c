@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 #include "occmap/occ_mavlink.h"
 #include "occmap/occ_port.h"
 

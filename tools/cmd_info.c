@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 
 static const char *format_name(const occ_format_t f)
 {

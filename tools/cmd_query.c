@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 
 #define DEFAULT_HEAP 65536u /* --distance: nearest-search heap entries */
 

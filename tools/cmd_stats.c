@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 
 static void usage(void)
 {

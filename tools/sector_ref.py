@@ -6,9 +6,9 @@ is OCC if any voxel of it in the band is occupied, UNK if any is unknown (never 
 otherwise. For each sector (body angles clockwise from forward), the distance is the smallest
 distance from the vehicle to the part of a column's square footprint inside the sector's wedge,
 found by clipping the square against the wedge's two half-planes (Sutherland-Hodgman). The
-reported value follows occ_feed.h: obstacle -> clamp(floor(cm)), unknown nearer -> 65535 (or its
+reported value follows occ_sectors.h: obstacle -> clamp(floor(cm)), unknown nearer -> 65535 (or its
 distance), nothing within max -> max_distance + 1 (MAVLink's "no obstacle").
-ground_band() applies occ_feed.h's ground rule to the band; ardupilot_faces() is ArduPilot's
+ground_band() applies occ_sectors.h's ground rule to the band; ardupilot_faces() is ArduPilot's
 documented OBSTACLE_DISTANCE handler (8 faces of 45 degrees) applied to a decoded message.
 """
 import math
@@ -193,7 +193,7 @@ def agree(got, want, d_occ, d_unk, max_cm):
 
 
 def ground_band(res, depth, leaves, x, y, z, below, above, clearance=0.1):
-    """occ_feed.h's ground rule for an ENU vehicle at (x, y, z): the band [za, zb), its lower edge
+    """occ_sectors.h's ground rule for an ENU vehicle at (x, y, z): the band [za, zb), its lower edge
     lifted to clearance above the first occupied voxel down the vehicle's own column."""
     half = 1 << (depth - 1)
     za, zb = z - below, z + above

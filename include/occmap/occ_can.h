@@ -13,7 +13,7 @@
  *    transfer per sector with an obstacle; one NO_DATA reading when the data is stale; one
  *    NOT_CONNECTED reading when there is no map), NodeStatus at 1 Hz, GetNodeInfo answered.
  *  - occ_dronecan_poll_map() (dronecan_map.c): the same fed straight from a map and a pose through
- *    the sector module (occ_feed.h).
+ *    the sector module (occ_sectors.h).
  *
  * Only classic CAN (8-byte) frames are emitted by the node; the frame type carries FD frames for
  * the ports. Bit-exact with pydronecan 1.0.27 (tests/can_golden.py checks it byte for byte).
@@ -26,8 +26,8 @@
 #include <stdint.h>
 #include <stdbool.h>
 
-#include "occmap/occmap.h"
-#include "occmap/occ_feed.h"
+#include "occmap/occ_core.h"
+#include "occmap/occ_sectors.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -54,7 +54,7 @@
 #ifndef OCC_OCC_EVICT_H_INCLUDED
 #define OCC_OCC_EVICT_H_INCLUDED
 
-#include "occmap/occmap.h"
+#include "occmap/occ_core.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -22,7 +22,7 @@
 #ifndef OCC_INTEGRATE_H_INCLUDED
 #define OCC_INTEGRATE_H_INCLUDED
 
-#include "occmap/occmap.h"
+#include "occmap/occ_core.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -49,7 +49,7 @@
 #ifndef OCC_IO_H_INCLUDED
 #define OCC_IO_H_INCLUDED
 
-#include "occmap/occmap.h"
+#include "occmap/occ_core.h"
 
 #ifdef __cplusplus
 extern "C" {

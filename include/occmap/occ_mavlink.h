@@ -54,7 +54,7 @@
 #ifndef OCC_MAVLINK_H_INCLUDED
 #define OCC_MAVLINK_H_INCLUDED
 
-#include "occmap/occ_feed.h"
+#include "occmap/occ_sectors.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -309,7 +309,7 @@ void occ_mav_feed_rx(occ_mav_feed_t *f, const uint8_t *data, size_t n, uint64_t 
  * when nothing is due. Call until it returns 0. Deadlines advance by whole periods (no burst
  * after a pause). Reads `map` (not kept); pass NULL while the map is stale (being rebuilt, or
  * not updated for too long): like a stale pose, the OBSTACLE_DISTANCE period is then skipped.
- * One occ_sectors_compute() per OBSTACLE_DISTANCE (see occ_feed.h for its cost). */
+ * One occ_sectors_compute() per OBSTACLE_DISTANCE (see occ_sectors.h for its cost). */
 size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_us, uint8_t *out,
                          size_t cap);
 

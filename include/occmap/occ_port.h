@@ -15,7 +15,7 @@
 #include <stdint.h>
 #include <stdbool.h>
 
-#include "occmap/occmap.h"
+#include "occmap/occ_core.h"
 
 #ifdef __cplusplus
 extern "C" {

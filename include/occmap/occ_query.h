@@ -20,7 +20,7 @@
 #ifndef OCC_QUERY_H_INCLUDED
 #define OCC_QUERY_H_INCLUDED
 
-#include "occmap/occmap.h"
+#include "occmap/occ_core.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -9,7 +9,7 @@
 
 #include "occmap/occmap.h"
 #include "occmap/occ_can.h"
-#include "occmap/occ_feed.h"
+#include "occmap/occ_sectors.h"
 #include "occ_bm_can.h"
 
 #define ARENA_BYTES (96u * 1024u)    /* what a 192 KB STM32F4 can spare */

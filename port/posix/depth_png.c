@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 
 occ_depth_camera_t occ_depth_camera_tum_fr2(void)
 {

@@ -10,7 +10,7 @@
 #include <unistd.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 
 static void say(char *const msg, const size_t msg_len, const char *const fmt, ...)
 {

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 
 typedef struct {
     const unsigned char *p;

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 
 static void set_msg(char *msg, size_t len, const char *path, unsigned long line, const char *what)
 {

@@ -25,6 +25,11 @@ typedef struct {
     occ_value_t value[8];
 } occ_leaf_block_t;
 
+/* The public block sizes (OCC_ARENA_BYTES sizes static arenas with them) are these structs'
+ * sizes: a C99 static assertion, an array of size -1 when they drift apart. */
+typedef char occ_inner_block_bytes_match[sizeof(occ_inner_block_t) == OCC_INNER_BLOCK_BYTES ? 1 : -1];
+typedef char occ_leaf_block_bytes_match[sizeof(occ_leaf_block_t) == OCC_LEAF_BLOCK_BYTES ? 1 : -1];
+
 /* The unobserved value: below every value a voxel can hold. */
 #if OCC_VALUE_FLOAT
 #define OCC_VALUE_UNOBSERVED (-3.0e38f)

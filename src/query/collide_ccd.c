@@ -2,7 +2,7 @@
  * collide_ccd.c - convex shapes against the map with libccd (host only, see sources.mk).
  */
 #include <ccd/ccd.h>
-#include "occmap/occ_collide_ccd.h"
+#include "occmap/host/occ_collide_ccd.h"
 #include "query_internal.h"
 
 typedef struct {

@@ -1,5 +1,5 @@
-/* sectors.c - nearest occupied / unknown footprint per horizontal sector (see occ_feed.h). */
-#include "occmap/occ_feed.h"
+/* sectors.c - nearest occupied / unknown footprint per horizontal sector (see occ_sectors.h). */
+#include "occmap/occ_sectors.h"
 
 #include <math.h>
 

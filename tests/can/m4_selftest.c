@@ -9,7 +9,7 @@
 
 #include "occmap/occmap.h"
 #include "occmap/occ_can.h"
-#include "occmap/occ_feed.h"
+#include "occmap/occ_sectors.h"
 
 static unsigned checks, failed;
 

@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 
 int main(int argc, char **argv)
 {

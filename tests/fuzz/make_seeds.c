@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_file.h"
+#include "occmap/host/occ_file.h"
 
 static uint8_t crop_arena[1u << 20];
 

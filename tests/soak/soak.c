@@ -25,7 +25,7 @@
 #include "occmap/occmap.h"
 #include "occmap/occ_evict.h"
 #include "occmap/occ_integrate.h"
-#include "occmap/occ_scan.h"
+#include "occmap/host/occ_scan.h"
 #include "../support/occ_assert_abort.h" /* the sanitizer build has live asserts: fail loudly */
 
 #define TUM_DIR "../shared/data/depth/tum_fr2_pioneer_slam2"

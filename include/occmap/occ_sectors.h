@@ -1,5 +1,5 @@
 /*
- * occ_feed.h - what the vehicle is told: the nearest obstacle per horizontal sector (src/feed/sectors.c).
+ * occ_sectors.h - what the vehicle is told: the nearest obstacle per horizontal sector (src/feed/sectors.c).
  * Pure C99, no OS, no heap; uses the public map API only.
  *
  * Frames
@@ -48,10 +48,10 @@
  * obstacle at cfg->min_distance_cm (1 cm when cfg is NULL or has min 0), d_occ_m / d_unk_m are 0
  * and out->n is 0. A caller that ignores the error code reads "obstacle", never "clear".
  */
-#ifndef OCC_FEED_H_INCLUDED
-#define OCC_FEED_H_INCLUDED
+#ifndef OCC_OCC_SECTORS_H_INCLUDED
+#define OCC_OCC_SECTORS_H_INCLUDED
 
-#include "occmap/occmap.h"
+#include "occmap/occ_core.h"
 
 #ifdef __cplusplus
 extern "C" {
