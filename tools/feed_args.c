@@ -186,8 +186,11 @@ static void on_stop_signal(int sig)
 
 void feed_stop_install(void)
 {
-    signal(SIGINT, on_stop_signal);
-    signal(SIGTERM, on_stop_signal);
+    struct sigaction sa; /* no SA_RESTART: a blocking call returns at once */
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    (void)sigaction(SIGINT, &sa, NULL);
+    (void)sigaction(SIGTERM, &sa, NULL);
 }
 
 bool feed_stop_requested(void)
