@@ -218,8 +218,8 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
         return OCC_ERR_ARG;
     }
     set_unsafe(out, origin); /* until the walk decides */
-    if (map == NULL || !occ_q_finite3(origin) || !occ_q_finite3(direction) ||
-        !occ_q_finite(max_range_m)) {
+    if (map == NULL || !occ_finite3(origin) || !occ_finite3(direction) ||
+        !occ_finite(max_range_m)) {
         return OCC_ERR_ARG;
     }
     float dir[3];
@@ -238,7 +238,7 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
     const unsigned states = OCC_PRED_OCCUPIED | (ignore_unknown ? 0u : OCC_PRED_UNKNOWN);
     cursor_init(&c, map, k0.k, (uint8_t)occ_q_has_bits(states));
     {
-        const occ_state_t s = occ_q_state(map, c.val);
+        const occ_state_t s = occ_value_state(map, c.val);
         if (s == OCC_STATE_OCCUPIED) {
             set_result(&c, res, tmv, out, true, OCC_RAY_HIT);
             return OCC_OK;
@@ -321,7 +321,7 @@ static occ_err_t set_visible(bool *visible, occ_ray_result_t *blocker)
 
 static bool blocks(const occ_map_t *map, occ_value_t v, occ_unknown_policy_t policy)
 {
-    return (occ_q_state_bit(occ_q_state(map, v)) & occ_q_blocking_states(policy)) != 0u;
+    return (occ_q_state_bit(occ_value_state(map, v)) & occ_q_blocking_states(policy)) != 0u;
 }
 
 occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
@@ -335,8 +335,8 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     if (blocker != NULL) {
         set_unsafe(blocker, a);
     }
-    if (map == NULL || visible == NULL || check_policy(policy) != OCC_OK || !occ_q_finite3(a) ||
-        !occ_q_finite3(b)) {
+    if (map == NULL || visible == NULL || check_policy(policy) != OCC_OK || !occ_finite3(a) ||
+        !occ_finite3(b)) {
         return OCC_ERR_ARG;
     }
     const real_t res = occ_geom_res(map);

@@ -110,7 +110,7 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
         const bool wanted = occ_q_node_wanted(m, val, flags, uniform, states);
         const occ_key_t nk = occ_key_at_level(key, level);
         if (!wanted ||
-            !occ_volume_hits_box(v, occ_q_center(m, nk, level), occ_q_half(m, level))) {
+            !occ_volume_hits_box(v, occ_geom_center(m, nk, level), occ_q_half(m, level))) {
             continue;
         }
         if (uniform) {

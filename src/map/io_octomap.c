@@ -123,7 +123,7 @@ static occ_err_t ot_record(occ_cursor_t *const c, const size_t extra, occ_value_
         return occ_cursor_fail(c, c->pos, "truncated .ot data");
     }
     const float f = occ_rd_f32(c->buf + c->pos);
-    if (!occ_f32_finite(f)) {
+    if (!occ_finite(f)) {
         return occ_cursor_fail(c, c->pos, "non-finite log-odds");
     }
     *v = ot_value(c, f);
