@@ -536,6 +536,7 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
                                const size_t scratch_bytes, occ_insert_result_t *const out)
 {
     occ_insert_result_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_insert_result_t *const r = out != NULL ? out : &local;
     memset(r, 0, sizeof *r);
     if (map == NULL || origin == NULL || params == NULL || (points == NULL && n_points > 0u) ||

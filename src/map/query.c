@@ -62,6 +62,7 @@ unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsign
     }
     unsigned rank[3] = {0u, 0u, 0u};
     for (unsigned j = 0; j < na; j++) {
+        /* cppcheck-suppress uninitvar ; ax[0..na) were written by the loop above, j < na */
         const uint32_t x = c0[ax[j]] ^ (c0[ax[j]] + 1u);
         rank[j] = (occ_bit_length32(x) - 1u) * 3u + ax[j];
     }
