@@ -64,7 +64,11 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
 }
 
 /* The start cells (query.c) in Morton order, each reached from the root along the path of the
- * previous one (only the levels below their highest differing key bit are walked again). */
+ * previous one (only the levels below their highest differing key bit are walked again).
+ * -fanalyzer reads blk[level] as uninitialised: blk[stopped + 1 .. depth] always hold the path
+ * of the last cell descended (the first starts at the root, each later one rewrites from its
+ * common ancestor down), and a jump reads only level = hb + 1 > stopped. */
+OCC_ANALYZER_UNINIT_OFF
 static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_query_node_t *out)
 {
     occ_key_t start[8];
@@ -110,7 +114,7 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
         const bool wanted = occ_q_node_wanted(m, val, flags, uniform, states);
         const occ_key_t nk = occ_key_at_level(key, level);
         if (!wanted ||
-            !occ_volume_hits_box(v, occ_q_center(m, nk, level), occ_q_half(m, level))) {
+            !occ_volume_hits_box(v, occ_geom_center(m, nk, level), occ_q_half(m, level))) {
             continue;
         }
         if (uniform) {
@@ -123,6 +127,7 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
     }
     return false;
 }
+OCC_ANALYZER_UNINIT_ON
 
 void occ_q_collision_unsafe(occ_collision_t *out)
 {

@@ -12,6 +12,7 @@
 #define OCC_GEOM_INTERNAL_H_INCLUDED
 
 #include <float.h>
+#include <string.h>
 #include "occmap/occmap.h"
 
 #if OCC_RAY_DOUBLE
@@ -21,6 +22,21 @@ typedef double occ_real_t;
 typedef float occ_real_t;
 #define OCC_REAL_MAX FLT_MAX
 #endif
+
+/* THE "is finite" test of src/map for every float a caller gives (coordinates, ranges, angles,
+ * log-odds, file fields): false for NaN and +-Inf. On the bit pattern (exponent all ones), so it
+ * holds under -ffinite-math-only and costs no float compare on a soft-float Cortex-M0+. */
+static inline bool occ_finite(float x)
+{
+    uint32_t u;
+    memcpy(&u, &x, sizeof u);
+    return (u & 0x7F800000u) != 0x7F800000u;
+}
+
+static inline bool occ_finite3(occ_vec3_t v)
+{
+    return occ_finite(v.x) && occ_finite(v.y) && occ_finite(v.z);
+}
 
 /* The map's decimal resolution and its inverse (OctoMap's resolution / resolution_factor). */
 static inline occ_real_t occ_geom_res(const occ_map_t *m)
@@ -91,6 +107,17 @@ static inline float occ_geom_face1(const occ_map_t *m, uint32_t k)
 static inline float occ_geom_center1(const occ_map_t *m, uint32_t base, unsigned level)
 {
     return (float)occ_geom_center_of(occ_geom_res(m), occ_geom_half(m), base, level);
+}
+
+/* Centre (metres) of the node at `level` whose first voxel key is `base` (in the map; off-map
+ * keys: occ_map_key_center). */
+static inline occ_vec3_t occ_geom_center(const occ_map_t *m, occ_key_t base, unsigned level)
+{
+    occ_vec3_t c;
+    c.x = occ_geom_center1(m, base.k[0], level);
+    c.y = occ_geom_center1(m, base.k[1], level);
+    c.z = occ_geom_center1(m, base.k[2], level);
+    return c;
 }
 
 /* Keys [lo, hi] of the voxels holding a coordinate of [lo_m, hi_m] widened by `slack` voxels

@@ -44,7 +44,7 @@ size_t occ_insert_scratch_bytes(const occ_map_t *const map, const size_t n_point
     }
     const float res = map->cfg.resolution_m;
     const float edge = (float)((uint32_t)1 << map->cfg.depth_levels);
-    float cells = isfinite(max_ray_m) && max_ray_m > 0.0f ? ceilf(max_ray_m / res) : edge;
+    float cells = occ_finite(max_ray_m) && max_ray_m > 0.0f ? ceilf(max_ray_m / res) : edge;
     if (!(cells < edge)) {
         cells = edge;
     }
@@ -158,7 +158,7 @@ void occ_ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 
 int occ_ictx_point(occ_ictx_t *const x, const float p[3])
 {
-    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
+    if (!occ_finite(p[0]) || !occ_finite(p[1]) || !occ_finite(p[2])) {
         return 1;
     }
     uint32_t ke[3];
@@ -295,10 +295,10 @@ static size_t box_bricks(occ_ictx_t *const x, const occ_vec3_t *const points,
 {
     uint32_t lo[3] = {x->ko[0], x->ko[1], x->ko[2]}, hi[3] = {x->ko[0], x->ko[1], x->ko[2]};
     for (size_t i = 0; i < n; i++) {
-        float q[3] = {points[i].x, points[i].y, points[i].z};
-        if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
+        if (!occ_finite3(points[i])) {
             continue;
         }
+        float q[3] = {points[i].x, points[i].y, points[i].z};
         if (x->max_range > 0.0f && occ_raygeo_dist(x->o, q) > x->max_range_r) {
             float c[3];
             occ_raygeo_clip(x->o, q, x->max_range, c);
@@ -536,6 +536,7 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
                                const size_t scratch_bytes, occ_insert_result_t *const out)
 {
     occ_insert_result_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_insert_result_t *const r = out != NULL ? out : &local;
     memset(r, 0, sizeof *r);
     if (map == NULL || origin == NULL || params == NULL || (points == NULL && n_points > 0u) ||
@@ -547,7 +548,7 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         params->fast_d >= map->cfg.depth_levels || isnan(params->max_range_m)) {
         return OCC_ERR_ARG;
     }
-    if (!isfinite(origin->x) || !isfinite(origin->y) || !isfinite(origin->z)) {
+    if (!occ_finite3(*origin)) {
         return OCC_ERR_ARG;
     }
     occ_ictx_t x;

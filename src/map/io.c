@@ -208,6 +208,7 @@ occ_err_t occ_io_load(occ_map_t *const map, const occ_map_config_t *const base_c
                       occ_io_info_t *const info)
 {
     occ_io_info_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_io_info_t *const inf = info != NULL ? info : &local;
     if (map == NULL || arena == NULL) {
         info_reset(inf);
@@ -235,6 +236,7 @@ occ_err_t occ_io_read(occ_map_t *const map, const void *const buf, const size_t 
                       occ_io_info_t *const info)
 {
     occ_io_info_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_io_info_t *const inf = info != NULL ? info : &local;
     if (map == NULL) {
         info_reset(inf);

@@ -240,7 +240,7 @@ occ_err_t occ_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
     if (h->id[0] == '\0') {
         return occ_cursor_fail(c, c->pos, "header without id");
     }
-    if (!have_res || !occ_f32_finite(h->res) || !(h->res > 0.0f)) {
+    if (!have_res || !occ_finite(h->res) || !(h->res > 0.0f)) {
         return occ_cursor_fail(c, c->pos, "header without a positive res");
     }
     if (h->res < 1e-6f || h->res >= 1e6f) {
@@ -270,7 +270,7 @@ static uint64_t scaled_round(const uint32_t m, const unsigned p, const unsigned 
 occ_err_t occ_om_header_write(occ_sink_t *const s, const occ_format_t format, const uint64_t size,
                               const float res)
 {
-    if (!occ_f32_finite(res) || !(res >= 1e-6f) || !(res < 1e6f)) {
+    if (!occ_finite(res) || !(res >= 1e-6f) || !(res < 1e6f)) {
         return OCC_ERR_UNSUPPORTED;
     }
     uint32_t bits;

@@ -89,7 +89,6 @@ uint16_t occ_rd_u16(const uint8_t *p);
 uint32_t occ_rd_u32(const uint8_t *p);
 uint64_t occ_rd_u64(const uint8_t *p);
 float occ_rd_f32(const uint8_t *p);
-bool occ_f32_finite(float x);
 
 /* ---- OctoMap text header (io_header.c) ---------------------------------------------------- */
 typedef struct {

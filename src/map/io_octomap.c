@@ -123,7 +123,7 @@ static occ_err_t ot_record(occ_cursor_t *const c, const size_t extra, occ_value_
         return occ_cursor_fail(c, c->pos, "truncated .ot data");
     }
     const float f = occ_rd_f32(c->buf + c->pos);
-    if (!occ_f32_finite(f)) {
+    if (!occ_finite(f)) {
         return occ_cursor_fail(c, c->pos, "non-finite log-odds");
     }
     *v = ot_value(c, f);
@@ -141,6 +141,10 @@ static unsigned popcount8(const uint8_t m)
     return n;
 }
 
+/* -fanalyzer reads st[top] as uninitialised: st[] mirrors the builder's stack, frame for frame
+ * (occ_build_open_root / occ_build_open push b->sp exactly where st[0] / st[top + 1] are
+ * written, occ_build_close pops), which it cannot see across the calls. */
+OCC_ANALYZER_UNINIT_OFF
 occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64_t header_size,
                        const size_t extra)
 {
@@ -208,6 +212,7 @@ occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
     }
     return OCC_OK;
 }
+OCC_ANALYZER_UNINIT_ON
 
 /* ---- emitters ------------------------------------------------------------------------------- */
 

@@ -117,13 +117,6 @@ float occ_rd_f32(const uint8_t *const p)
     return f;
 }
 
-bool occ_f32_finite(const float x)
-{
-    uint32_t u;
-    memcpy(&u, &x, sizeof u);
-    return (u & 0x7F800000u) != 0x7F800000u;
-}
-
 occ_err_t occ_io_buf_write(void *const ctx, const void *const data, const size_t len)
 {
     occ_io_buf_t *const b = (occ_io_buf_t *)ctx;

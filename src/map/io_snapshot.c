@@ -94,7 +94,7 @@ static occ_err_t read_value(occ_cursor_t *const c, const uint8_t kind, occ_value
 #endif
     } else {
         const float f = occ_rd_f32(c->buf + c->pos);
-        if (!occ_f32_finite(f)) {
+        if (!occ_finite(f)) {
             return occ_cursor_fail(c, c->pos, "non-finite value");
         }
         *v = occ_value_from_logodds(f);

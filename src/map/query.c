@@ -13,10 +13,10 @@ void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_valu
     out->uniform = uniform;
     out->inside = false;
     out->observed = occ_is_observed(v);
-    out->state = occ_q_state(m, v);
-    out->flags = uniform ? occ_q_uniform_flags(m, v) : flags;
+    out->state = occ_value_state(m, v);
+    out->flags = uniform ? (uint8_t)(occ_value_flags(m, v) | OCC_NODE_UNIFORM) : flags;
     out->logodds = out->observed ? occ_value_to_logodds(v) : 0.0f;
-    out->center = occ_q_center(m, out->key, level);
+    out->center = occ_geom_center(m, out->key, level);
     out->size_m = occ_map_node_size(m, level);
 }
 
@@ -62,6 +62,7 @@ unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsign
     }
     unsigned rank[3] = {0u, 0u, 0u};
     for (unsigned j = 0; j < na; j++) {
+        /* cppcheck-suppress uninitvar ; ax[0..na) were written by the loop above, j < na */
         const uint32_t x = c0[ax[j]] ^ (c0[ax[j]] + 1u);
         rank[j] = (occ_bit_length32(x) - 1u) * 3u + ax[j];
     }
@@ -175,7 +176,7 @@ static inline bool take(occ_query_iter_t *it, occ_key_t key, unsigned level, occ
             return false;
         }
         if ((it->pred.options & OCC_ITER_SPLIT) != 0u) {
-            inside = occ_volume_holds_box(it->vol, occ_q_center(it->map, key, level),
+            inside = occ_volume_holds_box(it->vol, occ_geom_center(it->map, key, level),
                                           occ_q_half(it->map, level));
             if (!inside) {
                 push(it, key, level - 1u, OCC_NONE, v, i);
@@ -193,7 +194,7 @@ static bool enter(occ_query_iter_t *it, occ_key_t key, unsigned level, occ_value
                   uint8_t flags, uint32_t child, unsigned i, occ_query_node_t *out)
 {
     if (!pred_match(it, v, flags, child == OCC_NONE) ||
-        !occ_volume_hits_box(it->vol, occ_q_center(it->map, key, level), occ_q_half(it->map, level))) {
+        !occ_volume_hits_box(it->vol, occ_geom_center(it->map, key, level), occ_q_half(it->map, level))) {
         return false;
     }
     return take(it, key, level, v, flags, child, i, out);

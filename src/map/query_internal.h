@@ -9,17 +9,6 @@
 #include <string.h>
 #include "map/tree_internal.h"
 
-static inline occ_state_t occ_q_state(const occ_map_t *m, occ_value_t v)
-{
-    if (!occ_is_observed(v)) {
-        return OCC_STATE_UNKNOWN;
-    }
-    if (v >= m->q_occ_min) {
-        return OCC_STATE_OCCUPIED;
-    }
-    return (v < m->q_free_max) ? OCC_STATE_FREE : OCC_STATE_UNKNOWN;
-}
-
 static inline uint8_t occ_q_state_bit(occ_state_t s)
 {
     switch (s) {
@@ -31,20 +20,6 @@ static inline uint8_t occ_q_state_bit(occ_state_t s)
         return (uint8_t)OCC_PRED_UNKNOWN;
     default:
         return 0u;
-    }
-}
-
-/* Flags of a uniform value. */
-static inline uint8_t occ_q_uniform_flags(const occ_map_t *m, occ_value_t v)
-{
-    switch (occ_q_state(m, v)) {
-    case OCC_STATE_OCCUPIED:
-        return (uint8_t)(OCC_NODE_HAS_OCCUPIED | OCC_NODE_UNIFORM);
-    case OCC_STATE_FREE:
-        return (uint8_t)(OCC_NODE_HAS_FREE | OCC_NODE_UNIFORM);
-    case OCC_STATE_UNKNOWN:
-    default:
-        return (uint8_t)(OCC_NODE_HAS_UNKNOWN | OCC_NODE_UNIFORM);
     }
 }
 
@@ -68,7 +43,7 @@ static inline bool occ_q_contains(uint8_t flags, unsigned states)
 static inline bool occ_q_node_wanted(const occ_map_t *m, occ_value_t v, uint8_t flags,
                                      bool uniform, unsigned states)
 {
-    return uniform ? (states & occ_q_state_bit(occ_q_state(m, v))) != 0u
+    return uniform ? (states & occ_q_state_bit(occ_value_state(m, v))) != 0u
                    : occ_q_contains(flags, states);
 }
 
@@ -78,35 +53,9 @@ static inline unsigned occ_q_blocking_states(occ_unknown_policy_t policy)
     return OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u);
 }
 
-/* Centre coordinate (metres) of the node at `level` whose first voxel key on an axis is `k`
- * (the map's one geometry, as occ_map_key_center). */
-static inline float occ_q_center1(const occ_map_t *m, uint32_t k, unsigned level)
-{
-    return occ_geom_center1(m, k, level);
-}
-
-static inline occ_vec3_t occ_q_center(const occ_map_t *m, occ_key_t k, unsigned level)
-{
-    occ_vec3_t c;
-    c.x = occ_q_center1(m, k.k[0], level);
-    c.y = occ_q_center1(m, k.k[1], level);
-    c.z = occ_q_center1(m, k.k[2], level);
-    return c;
-}
-
 static inline float occ_q_half(const occ_map_t *m, unsigned level)
 {
     return (float)(1u << level) * 0.5f * m->cfg.resolution_m;
-}
-
-static inline bool occ_q_finite(float f)
-{
-    return isfinite(f) != 0;
-}
-
-static inline bool occ_q_finite3(occ_vec3_t v)
-{
-    return occ_q_finite(v.x) && occ_q_finite(v.y) && occ_q_finite(v.z);
 }
 
 /* Little-endian targets test the 8 flag bytes of a block as one 64-bit word. */
@@ -238,10 +187,10 @@ static inline unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *
                                         unsigned level)
 {
     if (v->kind == OCC_VOL_SPHERE) {
-        return occ_q_sphere_touch(v, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
+        return occ_q_sphere_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
     }
     if (v->kind == OCC_VOL_AABB) {
-        return occ_q_aabb_touch(v, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
+        return occ_q_aabb_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
     }
     return occ_q_touch_mask_cubes(m, v, pkey, level);
 }

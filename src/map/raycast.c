@@ -286,10 +286,6 @@ size_t occ_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */
-static bool finite3(const occ_vec3_t p)
-{
-    return isfinite(p.x) && isfinite(p.y) && isfinite(p.z);
-}
 
 size_t occ_ray_max_keys(const occ_map_t *const map, const occ_vec3_t origin, const occ_vec3_t end)
 {
@@ -314,7 +310,7 @@ occ_err_t occ_ray_keys(const occ_map_t *const map, const occ_vec3_t origin, cons
         return OCC_ERR_ARG;
     }
     *n_keys = 0;
-    if (!finite3(origin) || !finite3(end)) {
+    if (!occ_finite3(origin) || !occ_finite3(end)) {
         return OCC_ERR_ARG;
     }
     occ_raygeo_t g;

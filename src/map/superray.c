@@ -322,11 +322,11 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
     const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
-        const float q[3] = {points[i].x, points[i].y, points[i].z};
-        if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
+        if (!occ_finite3(points[i])) {
             x->r->points_skipped++;
             continue;
         }
+        const float q[3] = {points[i].x, points[i].y, points[i].z};
         uint32_t k[3];
         if ((x->max_range > 0.0f && occ_raygeo_dist(x->o, q) > x->max_range_r) ||
             !occ_raygeo_key(&x->g, q, k)) {

@@ -472,14 +472,9 @@ occ_err_t occ_map_observe_need(const occ_map_t *const map, const occ_code_t *con
     return OCC_OK;
 }
 
-static bool finite_f(const float x)
-{
-    return x - x < 1.0f;
-}
-
 occ_err_t occ_map_update_key(occ_map_t *const map, const occ_key_t key, const float delta_logodds)
 {
-    if (map == NULL || !finite_f(delta_logodds)) {
+    if (map == NULL || !occ_finite(delta_logodds)) {
         return OCC_ERR_ARG;
     }
     if (!key_in_range(map, key)) {
@@ -580,7 +575,7 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
 occ_err_t occ_map_set_key(occ_map_t *const map, const occ_key_t key, const unsigned level,
                           const float logodds)
 {
-    if (map == NULL || !finite_f(logodds)) {
+    if (map == NULL || !occ_finite(logodds)) {
         return OCC_ERR_ARG;
     }
     return set_raw(map, key, level, occ_value_from_logodds(logodds));
