@@ -186,12 +186,42 @@ def rename_files(root, renames):
             if os.path.abspath(path) == os.path.abspath(__file__):
                 continue
             text = read(path)
-            new = pattern.sub(lambda m: renames[m.group(1)], text)
+            new = "\n".join(realigned(text.split("\n"), pattern, renames))
             if new != text:
                 with open(path, "w", encoding="utf-8", errors="surrogateescape") as fh:
                     fh.write(new)
                 changed.append(os.path.relpath(path, root))
     return changed
+
+
+def realigned(lines, pattern, renames):
+    """Rename in each line, and keep continuation lines aligned to an open parenthesis that a
+    longer name moved (`f(a,\n  b)`): only a line indented exactly one past that parenthesis."""
+    open_parens = []                      # (old column, new column) of each unclosed '('
+    for line in lines:
+        if not line.strip() or line.lstrip().startswith("#"):
+            open_parens = []
+        indent = len(line) - len(line.lstrip(" "))
+        new_indent = indent
+        if open_parens and indent == open_parens[-1][0] + 1:
+            new_indent = open_parens[-1][1] + 1
+        shift, col_map, pos = new_indent - indent, [], indent
+        out = [" " * new_indent]
+        for m in pattern.finditer(line, indent):
+            out.append(line[pos:m.start()])
+            out.append(renames[m.group(1)])
+            col_map.append((m.end(), shift))
+            shift += len(renames[m.group(1)]) - len(m.group(1))
+            pos = m.end()
+        out.append(line[pos:])
+        col_map.append((len(line) + 1, shift))
+        for col, ch in enumerate(line):
+            if ch == "(":
+                moved = next(s for end, s in col_map if col < end)
+                open_parens.append((col, col + moved))
+            elif ch == ")" and open_parens:
+                open_parens.pop()
+        yield "".join(out)
 
 
 def single_file_internals(root):
