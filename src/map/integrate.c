@@ -128,7 +128,8 @@ static inline size_t filt_slot(const occ_code_t c)
     return (size_t)((c * 0x9E3779B97F4A7C15ull) >> (64u - OCC_INSERT_FILTER_BITS));
 }
 
-void occi_ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+/* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
+static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 {
     if (x->cbs != NULL) {
         occi_fast_ray(x, e, ke);
@@ -171,7 +172,7 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3])
         if (x->bs == NULL && !occi_ictx_reserve(x, occi_dda_bound(x->ko, ke))) {
             return -1;
         }
-        occi_ictx_ray(x, e, ke);
+        ictx_ray(x, e, ke);
         x->r->rays_clipped++;
         return 0;
     }
@@ -181,7 +182,7 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3])
     if (!occi_ictx_reserve(x, (x->bs == NULL ? occi_dda_bound(x->ko, ke) : 0u) + 1u)) {
         return -1;
     }
-    occi_ictx_ray(x, p, ke);
+    ictx_ray(x, p, ke);
     const occ_key_t k = {{ke[0], ke[1], ke[2]}};
     const occ_code_t c = occ_morton_encode(k);
     if (x->bs == NULL) {

@@ -21,8 +21,6 @@ typedef struct {
 } occ_raygeo_t;
 
 void occi_raygeo_init(occ_raygeo_t *g, const occ_map_t *map);
-/* Key of one coordinate; false when NaN/Inf or outside [0, 2^D). */
-bool occi_raygeo_key1(const occ_raygeo_t *g, float c, uint32_t *k);
 /* Key of a point (all three axes valid). */
 bool occi_raygeo_key(const occ_raygeo_t *g, const float p[3], uint32_t k[3]);
 /* Centre coordinate of key k, as OctoMap's float(keyToCoord(k)). */
@@ -31,15 +29,6 @@ float occi_raygeo_center(const occ_raygeo_t *g, uint32_t k);
 occ_rr_t occi_raygeo_dist(const float o[3], const float p[3]);
 /* OctoMap's origin + normalized(p - o) * (float)range. */
 void occi_raygeo_clip(const float o[3], const float p[3], float range, float out[3]);
-
-/* What the DDA decides with: OctoMap's float direction and length, tMax / tDelta per axis. */
-typedef struct {
-    occ_rr_t tmax[3], tdelta[3];
-    int32_t step[3];
-    float length;
-} occ_dda_param_t;
-void occi_dda_setup(const occ_raygeo_t *g, const float o[3], const float e[3], const uint32_t ko[3],
-                    occ_dda_param_t *out);
 
 /* Upper bound of the codes occi_dda_codes() writes for keys ko -> ke. */
 size_t occi_dda_bound(const uint32_t ko[3], const uint32_t ke[3]);
@@ -182,8 +171,6 @@ static inline void occ_ictx_note(occ_ictx_t *x, size_t na, size_t nb)
 
 /* Make room for `need` more codes in a (sorting and collapsing what is there if needed). */
 bool occi_ictx_reserve(occ_ictx_t *x, size_t need);
-/* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
-void occi_ictx_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
 /* Emit one voxel code (free, or hit with OCC_CODE_HIT_BIT); room must have been reserved. */
 static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
 {

@@ -18,15 +18,16 @@ void occi_raygeo_init(occ_raygeo_t *const g, const occ_map_t *const map)
     g->rf = occ_geom_inv(map);
 }
 
-bool occi_raygeo_key1(const occ_raygeo_t *const g, const float c, uint32_t *const k)
+/* Key of one coordinate; false when NaN/Inf or outside [0, 2^D). */
+static bool raygeo_key1(const occ_raygeo_t *const g, const float c, uint32_t *const k)
 {
     return occ_geom_key_of(g->rf, g->tmv, c, k);
 }
 
 bool occi_raygeo_key(const occ_raygeo_t *const g, const float p[3], uint32_t k[3])
 {
-    return occi_raygeo_key1(g, p[0], &k[0]) && occi_raygeo_key1(g, p[1], &k[1]) &&
-           occi_raygeo_key1(g, p[2], &k[2]);
+    return raygeo_key1(g, p[0], &k[0]) && raygeo_key1(g, p[1], &k[1]) &&
+           raygeo_key1(g, p[2], &k[2]);
 }
 
 float occi_raygeo_center(const occ_raygeo_t *const g, const uint32_t k)
@@ -102,19 +103,6 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
     s->c = occ_morton_encode(k0);
     s->kmax = 2 * g->tmv;
     s->limit = occi_dda_bound(ko, ke);
-}
-
-void occi_dda_setup(const occ_raygeo_t *const g, const float o[3], const float e[3],
-                    const uint32_t ko[3], occ_dda_param_t *const out)
-{
-    dda_t s;
-    dda_init(&s, g, o, e, ko, ko);
-    for (unsigned i = 0; i < 3u; i++) {
-        out->tmax[i] = s.tmax[i];
-        out->tdelta[i] = s.tdelta[i];
-        out->step[i] = s.step[i];
-    }
-    out->length = s.length;
 }
 
 /* The hot loop, with the state in scalars so that it stays in registers. EMIT(kx, ky, kz) is
