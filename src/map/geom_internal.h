@@ -123,13 +123,13 @@ static inline occ_vec3_t occ_geom_center(const occ_map_t *m, occ_key_t base, uns
 /* Keys [lo, hi] of the voxels holding a coordinate of [lo_m, hi_m] widened by `slack` voxels
  * on each side, clamped to the map: the same conversion as occ_geom_key_of (slack 0: exactly
  * the keys of lo_m and hi_m). False when the interval misses the map or is empty / NaN. */
-bool occ_geom_key_range(const occ_map_t *m, float lo_m, float hi_m, occ_real_t slack,
-                        uint32_t *lo, uint32_t *hi);
+bool occi_geom_key_range(const occ_map_t *m, float lo_m, float hi_m, occ_real_t slack,
+                         uint32_t *lo, uint32_t *hi);
 
 /* Shortest decimal (as a double, OCC_RAY_DOUBLE) that rounds to the float r > 0. */
-double occ_geom_decimal(float r);
+double occi_geom_decimal(float r);
 /* Set the map's geometry fields from cfg.resolution_m (occ_map_init). */
-void occ_geom_init(occ_map_t *m);
+void occi_geom_init(occ_map_t *m);
 
 /* ---- 3D-DDA (Amanatides & Woo, as OctoMap) ---------------------------------------------------
  * The set-up both walks share: from the origin o (in voxel key[]) along the float unit vector

@@ -44,7 +44,7 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
     map->q_clamp_max = occ_value_from_logodds(cfg->clamp_max);
     map->q_free_max = occ_value_from_logodds(cfg->free_max);
     map->q_occ_min = occ_value_from_logodds(cfg->occupied_min);
-    occ_geom_init(map);
+    occi_geom_init(map);
     /* Align the start and the size to 8 so both block kinds stay aligned from either end. */
     uintptr_t start = (uintptr_t)arena;
     size_t bytes = arena_bytes;
@@ -123,7 +123,7 @@ occ_err_t occ_map_key_range(const occ_map_t *const map, const float lo_m, const 
     }
     uint32_t l;
     uint32_t h;
-    if (!occ_geom_key_range(map, lo_m, hi_m, (occ_real_t)0, &l, &h)) {
+    if (!occi_geom_key_range(map, lo_m, hi_m, (occ_real_t)0, &l, &h)) {
         return OCC_ERR_RANGE;
     }
     *lo = l;

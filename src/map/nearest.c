@@ -119,7 +119,7 @@ occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist
         pop(it, &top);
         const bool uniform = top.child == OCC_NONE;
         if (uniform || top.level <= it->pred.min_level) {
-            occ_q_fill_node(m, top.key, top.level, top.value, top.flags, uniform, out);
+            occi_q_fill_node(m, top.key, top.level, top.value, top.flags, uniform, out);
             if (dist_m != NULL) {
                 *dist_m = sqrtf(top.dist2);
             }

@@ -5,8 +5,8 @@
  */
 #include "map/query_internal.h"
 
-void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
-                     uint8_t flags, bool uniform, occ_query_node_t *out)
+void occi_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
+                      uint8_t flags, bool uniform, occ_query_node_t *out)
 {
     out->key = occ_key_at_level(key, level);
     out->level = (uint8_t)level;
@@ -26,14 +26,14 @@ static bool same_above(occ_key_t a, occ_key_t b, unsigned level)
            ((a.k[2] ^ b.k[2]) >> level) == 0u;
 }
 
-unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
-                           occ_key_t start[8], unsigned *level)
+unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                            occ_key_t start[8], unsigned *level)
 {
     const unsigned depth = map->cfg.depth_levels;
     *level = depth;
     uint32_t lo[3];
     uint32_t hi[3];
-    if (!occ_q_bounds_keys(map, vol, lo, hi)) {
+    if (!occi_q_bounds_keys(map, vol, lo, hi)) {
         return 0u; /* nothing of the map is near the volume */
     }
     /* Smallest level whose cells are at least as wide as the key range: the range then spans
@@ -117,7 +117,7 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
     it->istart = 0;
     it->gen = map->write_gen;
     unsigned lc = depth;
-    it->nstart = (uint8_t)occ_q_start_cells(map, vol, pred.min_level, it->start, &lc);
+    it->nstart = (uint8_t)occi_q_start_cells(map, vol, pred.min_level, it->start, &lc);
     it->start_level = (uint8_t)lc;
     return OCC_OK;
 }
@@ -184,7 +184,7 @@ static inline bool take(occ_query_iter_t *it, occ_key_t key, unsigned level, occ
             }
         }
     }
-    occ_q_fill_node(it->map, key, level, v, flags, uniform, out);
+    occi_q_fill_node(it->map, key, level, v, flags, uniform, out);
     out->inside = inside;
     return true;
 }

@@ -175,10 +175,10 @@ static inline unsigned occ_q_aabb_touch(const occ_volume_t *v, occ_vec3_t pc, fl
 
 /* volume.c: key range [lo, hi] per axis of the voxels that can touch the volume's closed bounds
  * (one voxel of slack for faces on a border); false when the bounds miss the map. */
-bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
+bool occi_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
 /* volume.c: occ_q_touch_mask for the other kinds, child by child with the exact cube tests. */
-unsigned occ_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                                unsigned level);
+unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                 unsigned level);
 
 /* Which of the 8 children (at `level`) of the node with first voxel `pkey` touch the volume
  * (bit s for child slot s; exact, as occ_volume_hits_box). Spheres and boxes inline: they are
@@ -192,21 +192,21 @@ static inline unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *
     if (v->kind == OCC_VOL_AABB) {
         return occ_q_aabb_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
     }
-    return occ_q_touch_mask_cubes(m, v, pkey, level);
+    return occi_q_touch_mask_cubes(m, v, pkey, level);
 }
 
 /* query.c: the cells a walk over the volume starts from: at most 8, at the smallest level
  * (>= min_level) whose cells are as wide as the volume's key range, in Morton order; *level gets
  * that level (depth_levels with the root as the one start). 0 when the volume misses the map. */
-unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
-                           occ_key_t start[8], unsigned *level);
+unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                            occ_key_t start[8], unsigned *level);
 
 /* collide.c: the answer of a collision check that has not decided yet or failed: not safe,
  * not outside, an unobserved UNKNOWN node. Every collision entry point starts with it. */
-void occ_q_collision_unsafe(occ_collision_t *out);
+void occi_q_collision_unsafe(occ_collision_t *out);
 
 /* Fill a reported node. */
-void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
-                     uint8_t flags, bool uniform, occ_query_node_t *out);
+void occi_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
+                      uint8_t flags, bool uniform, occ_query_node_t *out);
 
 #endif /* OCC_QUERY_INTERNAL_H_INCLUDED */

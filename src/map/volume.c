@@ -467,7 +467,7 @@ bool occ_volume_holds_box(const occ_volume_t *v, occ_vec3_t c, float h)
 /* ---- what a volume can touch ---------------------------------------------------------------- */
 /* Key range [lo, hi] per axis of the voxels that can touch the closed bounds (one voxel of slack
  * for faces lying exactly on a border); false when the bounds miss the map. */
-bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3])
+bool occi_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3])
 {
     /* Slack for rounding, in voxels: the exact tests work on float node boxes, whose step at the
      * map's far corners is half * 2^-23 voxels; four of those, and a lower face on a border
@@ -479,15 +479,15 @@ bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3]
     const float bmin[3] = {v->bmin.x, v->bmin.y, v->bmin.z};
     const float bmax[3] = {v->bmax.x, v->bmax.y, v->bmax.z};
     for (unsigned i = 0; i < 3u; i++) {
-        if (!occ_geom_key_range(m, bmin[i], bmax[i], slack, &lo[i], &hi[i])) {
+        if (!occi_geom_key_range(m, bmin[i], bmax[i], slack, &lo[i], &hi[i])) {
             return false;
         }
     }
     return true;
 }
 
-unsigned occ_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                                unsigned level)
+unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                 unsigned level)
 {
     const float h = occ_q_half(m, level);
     const occ_vec3_t pc = occ_geom_center(m, pkey, level + 1u);
