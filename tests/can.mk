@@ -5,7 +5,7 @@
 #                    with vcan0, candump capturing, pydronecan decoding (tests/can/qemu_socketcan.sh)
 #   test-can-mcast   occmap can-feed on pydronecan's mcast: bus inside a network namespace with only
 #                    loopback: fixed pose, then live MAVLink poses and NO_DATA (tests/can/mcast_peer.py)
-# The CMocka unit tests are tests/test_dronecan.c (built by the top Makefile).
+# The CMocka unit tests are tests/test_dronecan.c and tests/test_dronecan_node.c (built by the top Makefile).
 APT_PKGS += qemu-system-x86 busybox-static cpio can-utils
 
 CAN_BUILD := $(BUILD)/can

@@ -221,7 +221,7 @@ static void test_pool_alloc_leaf_foreign_link(void **state)
     const uint32_t bad = map.leaf.hwm + 5u;
     memcpy(occ_leaf_at(&map, map.leaf.free_head)->value, &bad, sizeof bad);
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
-    expect_assert_on(occ_pool_alloc_leaf(&map),
+    expect_assert_on(occi_pool_alloc_leaf(&map),
                      "m->leaf.free_head == OCC_NONE || m->leaf.free_head < m->leaf.hwm");
 }
 
@@ -231,7 +231,7 @@ static void test_pool_alloc_inner_without_free_mark(void **state)
     /* The inner free list's head does not carry the free mark: a used block is on the list. */
     occ_inner_at(&map, map.inner.free_head)->flags[7] = 0u;
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
-    expect_assert_on(occ_pool_alloc_inner(&map),
+    expect_assert_on(occi_pool_alloc_inner(&map),
                      "occ_inner_at(m, idx)->flags[7] == OCC_INNER_FREE_MARK");
 }
 
@@ -242,7 +242,7 @@ static void test_pool_alloc_counters_broken(void **state)
     map.leaf.free_head = OCC_NONE;
     map.leaf.free_count = 0u;
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
-    expect_assert_on(occ_pool_alloc_leaf(&map), "p->used + p->free_count == p->hwm");
+    expect_assert_on(occi_pool_alloc_leaf(&map), "p->used + p->free_count == p->hwm");
 }
 
 static void test_release_stack_bound(void **state)
@@ -254,7 +254,7 @@ static void test_release_stack_bound(void **state)
     root_block->child[0] = map.root_child;
     map.cfg.depth_levels = 30u;
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
-    expect_assert_on(occ_tree_release_children(&map, occ_root(&map), 30u),
+    expect_assert_on(occi_tree_release_children(&map, occ_root(&map), 30u),
                      "sp < OCC_MAX_DEPTH && lvl[sp] > 1u");
 }
 
@@ -262,7 +262,7 @@ static void test_release_level_out_of_range(void **state)
 {
     (void)state;
     /* A level above the root's is no node of this map. */
-    expect_assert_on(occ_tree_release_children(&map, occ_root(&map), DEPTH + 1u),
+    expect_assert_on(occi_tree_release_children(&map, occ_root(&map), DEPTH + 1u),
                      "level >= 1u && level <= m->cfg.depth_levels");
 }
 
@@ -272,23 +272,23 @@ static void test_builder_stack_bound(void **state)
     /* The file readers drive the tree builder and guarantee it a depth <= 21; a builder told 30
      * levels (the dry run: no map, no block touched) stops at its frame stack's bound. */
     static occ_build_t b;
-    occ_build_begin(&b, NULL, 30u);
-    occ_build_open_root(&b);
+    occi_build_begin(&b, NULL, 30u);
+    occi_build_open_root(&b);
     for (unsigned i = 0; i < OCC_MAX_DEPTH; i++) {
-        occ_build_open(&b, 0u);
+        occi_build_open(&b, 0u);
     }
     assert_int_equal(b.sp, OCC_MAX_DEPTH + 1u); /* every frame in use */
-    expect_assert_on(occ_build_open(&b, 0u), "level >= 1u && b->sp <= OCC_MAX_DEPTH");
+    expect_assert_on(occi_build_open(&b, 0u), "level >= 1u && b->sp <= OCC_MAX_DEPTH");
 }
 
 static void test_builder_slot_range(void **state)
 {
     (void)state;
     static occ_build_t b;
-    occ_build_begin(&b, NULL, DEPTH);
-    occ_build_open_root(&b);
-    expect_assert_on(occ_build_leaf(&b, 8u, 0), "b->sp >= 1u && slot < 8u");
-    occ_build_leaf(&b, 7u, 0); /* slot 7 is the last one */
+    occi_build_begin(&b, NULL, DEPTH);
+    occi_build_open_root(&b);
+    expect_assert_on(occi_build_leaf(&b, 8u, 0), "b->sp >= 1u && slot < 8u");
+    occi_build_leaf(&b, 7u, 0); /* slot 7 is the last one */
     assert_int_equal(b.st[0].set, 0x80u);
 }
 

@@ -213,9 +213,9 @@ static void test_leaked_block(void **state)
 {
     (void)state;
     /* Taken from the pool, never linked. */
-    (void)occ_pool_alloc_leaf(&map);
+    (void)occi_pool_alloc_leaf(&map);
     expect_corrupt("leaked leaf block (from the free list)");
-    (void)occ_pool_alloc_inner(&map);
+    (void)occi_pool_alloc_inner(&map);
     expect_corrupt("leaked inner block (from the free list)");
     map.leaf.free_head = OCC_NONE;
     map.leaf.free_count = 0u;
@@ -274,11 +274,11 @@ static void test_unpruned_equal_block(void **state)
     (void)state;
     /* Expand a uniform node without refreshing: 8 equal children that should have been pruned. */
     occ_nodep_t n = node_at(mk(8, 8, 8), 2u);
-    assert_true(occ_pool_can_supply(&map, 1u, 0u));
-    occ_tree_expand(&map, n, 2u);
+    assert_true(occi_pool_can_supply(&map, 1u, 0u));
+    occi_tree_expand(&map, n, 2u);
     expect_corrupt("level-2 node expanded into 8 equal uniform children");
     n = node_at(mk(0, 8, 0), 1u);
-    occ_tree_expand(&map, n, 1u);
+    occi_tree_expand(&map, n, 1u);
     expect_corrupt("level-1 node expanded into a leaf block of 8 equal voxels");
     /* Make a real leaf block all equal by hand. */
     n = node_at(mk(0, 0, 0), 1u);
@@ -324,9 +324,9 @@ static void test_shared_and_freed_blocks(void **state)
     *b.flags = *a.flags;
     expect_corrupt("leaf block owned by two nodes");
     /* A block in the tree and on the free list (freed while still linked). */
-    assert_true(occ_pool_free_leaf(&map, *node_at(mk(0, 0, 0), 1u).child));
+    assert_true(occi_pool_free_leaf(&map, *node_at(mk(0, 0, 0), 1u).child));
     expect_corrupt("linked leaf block on the free list");
-    assert_true(occ_pool_free_inner(&map, *node_at(mk(0, 0, 0), 2u).child));
+    assert_true(occi_pool_free_inner(&map, *node_at(mk(0, 0, 0), 2u).child));
     expect_corrupt("linked inner block on the free list");
 }
 

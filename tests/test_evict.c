@@ -331,7 +331,7 @@ static void shadow_case(const occ_evict_mode_t mode, const occ_evict_shape_t sha
     occ_map_pool_stats(&m, &st);
     const uint32_t used = st.inner_used + st.leaf_used;
     /* A target that needs about half the blocks back, or everything. */
-    const uint32_t free_now = occ_pool_can_supply(&m, 1u, 1u) ? 1u : 0u;
+    const uint32_t free_now = occi_pool_can_supply(&m, 1u, 1u) ? 1u : 0u;
     (void)free_now;
     uint32_t target = to_exhaustion ? (1u << 28) : 0u;
     if (!to_exhaustion) {
@@ -469,7 +469,7 @@ static void test_coarsen_rule(void **state)
                        (size_t)m.leaf.hwm * sizeof(occ_leaf_block_t);
     const uint32_t want_leaf = m.leaf.free_count + (uint32_t)(gap / sizeof(occ_leaf_block_t)) + 24u;
     const uint32_t want_inner = m.inner.free_count + 3u;
-    assert_false(occ_pool_can_supply(&m, want_inner, want_leaf));
+    assert_false(occi_pool_can_supply(&m, want_inner, want_leaf));
     occ_evict_out_init(&out);
     assert_int_equal(occ_map_evict_for(&m, &c, &p, want_inner, want_leaf, &out), OCC_OK);
     assert_int_equal(out.last_blocks_freed, 27u);

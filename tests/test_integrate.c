@@ -651,9 +651,9 @@ static void test_coarse_apply(void **state)
     for (unsigned round = 0; round < 3u; round++) {
         const float delta = round == 1u ? 0.6f : -0.35f;
         uint64_t in, lf;
-        occ_coarse_need(codes, u, level, a.cfg.depth_levels, &in, &lf);
-        assert_true(occ_pool_can_supply(&a, (uint32_t)in, (uint32_t)lf));
-        occ_coarse_apply(&a, codes, u, level, occ_value_from_logodds(delta));
+        occi_coarse_need(codes, u, level, a.cfg.depth_levels, &in, &lf);
+        assert_true(occi_pool_can_supply(&a, (uint32_t)in, (uint32_t)lf));
+        occi_coarse_apply(&a, codes, u, level, occ_value_from_logodds(delta));
         for (size_t i = 0; i < u; i++) {
             const occ_key_t k0 = occ_morton_decode(codes[i]);
             for (uint32_t dz = 0; dz < 4u; dz++) {

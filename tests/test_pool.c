@@ -96,7 +96,7 @@ static void test_alloc_free_inner(void **state)
     (void)state;
     uint32_t idx[6];
     for (unsigned i = 0; i < 6u; i++) {
-        idx[i] = occ_pool_alloc_inner(&map);
+        idx[i] = occi_pool_alloc_inner(&map);
         assert_int_equal(idx[i], i);
     }
     assert_pool(&map.inner, 6, 6, 0);
@@ -107,27 +107,27 @@ static void test_alloc_free_inner(void **state)
         assert_true(b >= map.arena && b + sizeof(occ_inner_block_t) <= map.arena + map.arena_bytes);
         assert_true(((uintptr_t)b % 4u) == 0u);
     }
-    assert_true(occ_pool_free_inner(&map, idx[2]));
-    assert_true(occ_pool_free_inner(&map, idx[4]));
+    assert_true(occi_pool_free_inner(&map, idx[2]));
+    assert_true(occi_pool_free_inner(&map, idx[4]));
     assert_pool(&map.inner, 4, 6, 2);
     /* Double free (head of the list and deeper) and foreign indices: rejected, nothing changes. */
     const occ_pool_t before = map.inner;
-    assert_false(occ_pool_free_inner(&map, idx[4]));
-    assert_false(occ_pool_free_inner(&map, idx[2]));
-    assert_false(occ_pool_free_inner(&map, 6u));
-    assert_false(occ_pool_free_inner(&map, 1000u));
-    assert_false(occ_pool_free_inner(&map, OCC_NONE));
+    assert_false(occi_pool_free_inner(&map, idx[4]));
+    assert_false(occi_pool_free_inner(&map, idx[2]));
+    assert_false(occi_pool_free_inner(&map, 6u));
+    assert_false(occi_pool_free_inner(&map, 1000u));
+    assert_false(occi_pool_free_inner(&map, OCC_NONE));
     assert_memory_equal(&before, &map.inner, sizeof before);
     /* Free blocks are reused before the arena is carved further. */
-    const uint32_t r1 = occ_pool_alloc_inner(&map), r2 = occ_pool_alloc_inner(&map);
+    const uint32_t r1 = occi_pool_alloc_inner(&map), r2 = occi_pool_alloc_inner(&map);
     assert_true((r1 == 2u && r2 == 4u) || (r1 == 4u && r2 == 2u));
     assert_pool(&map.inner, 6, 6, 0);
-    assert_int_equal(occ_pool_alloc_inner(&map), 6u);
+    assert_int_equal(occi_pool_alloc_inner(&map), 6u);
     for (unsigned i = 0; i <= 6u; i++) {
-        assert_true(occ_pool_free_inner(&map, i));
+        assert_true(occi_pool_free_inner(&map, i));
     }
     assert_pool(&map.inner, 0, 7, 7);
-    assert_false(occ_pool_free_inner(&map, 3u));
+    assert_false(occi_pool_free_inner(&map, 3u));
     assert_int_equal(map.inner.peak, 7u);
     assert_int_equal(occ_map_check(&map), OCC_OK);
 }
@@ -136,40 +136,40 @@ static void test_alloc_free_leaf(void **state)
 {
     (void)state;
     for (unsigned i = 0; i < 5u; i++) {
-        assert_int_equal(occ_pool_alloc_leaf(&map), i);
+        assert_int_equal(occi_pool_alloc_leaf(&map), i);
     }
     for (unsigned i = 0; i < 5u; i++) {
         const uint8_t *const b = (const uint8_t *)occ_leaf_at(&map, i);
         assert_true(b >= map.arena && b + sizeof(occ_leaf_block_t) <= map.arena + map.arena_bytes);
     }
-    assert_true(occ_pool_free_leaf(&map, 1u));
-    assert_true(occ_pool_free_leaf(&map, 3u));
-    assert_true(occ_pool_free_leaf(&map, 0u));
+    assert_true(occi_pool_free_leaf(&map, 1u));
+    assert_true(occi_pool_free_leaf(&map, 3u));
+    assert_true(occi_pool_free_leaf(&map, 0u));
     assert_pool(&map.leaf, 2, 5, 3);
     const occ_pool_t before = map.leaf;
-    assert_false(occ_pool_free_leaf(&map, 0u)); /* head of the free list */
-    assert_false(occ_pool_free_leaf(&map, 1u)); /* tail */
-    assert_false(occ_pool_free_leaf(&map, 3u)); /* middle */
-    assert_false(occ_pool_free_leaf(&map, 5u));
-    assert_false(occ_pool_free_leaf(&map, OCC_NONE));
+    assert_false(occi_pool_free_leaf(&map, 0u)); /* head of the free list */
+    assert_false(occi_pool_free_leaf(&map, 1u)); /* tail */
+    assert_false(occi_pool_free_leaf(&map, 3u)); /* middle */
+    assert_false(occi_pool_free_leaf(&map, 5u));
+    assert_false(occi_pool_free_leaf(&map, OCC_NONE));
     assert_memory_equal(&before, &map.leaf, sizeof before);
-    assert_true(occ_pool_free_leaf(&map, 2u));
-    assert_true(occ_pool_free_leaf(&map, 4u));
+    assert_true(occi_pool_free_leaf(&map, 2u));
+    assert_true(occi_pool_free_leaf(&map, 4u));
     assert_pool(&map.leaf, 0, 5, 5);
     assert_int_equal(occ_map_check(&map), OCC_OK);
     /* Exhaust the leaf pool: exactly as many blocks as the byte model says. */
     const uint32_t expect = (uint32_t)((map.arena_bytes - (size_t)map.inner.hwm * OCC_INNER_BLOCK_BYTES) /
                                        OCC_LEAF_BLOCK_BYTES);
     uint32_t n = 0;
-    while (occ_pool_alloc_leaf(&map) != OCC_NONE) {
+    while (occi_pool_alloc_leaf(&map) != OCC_NONE) {
         n++;
         assert_true(n <= expect);
     }
     assert_int_equal(n, expect);
-    assert_false(occ_pool_can_supply(&map, 0u, 1u));
-    assert_int_equal(occ_pool_alloc_inner(&map), OCC_NONE);
+    assert_false(occi_pool_can_supply(&map, 0u, 1u));
+    assert_int_equal(occi_pool_alloc_inner(&map), OCC_NONE);
     for (uint32_t i = 0; i < n; i++) {
-        assert_true(occ_pool_free_leaf(&map, i));
+        assert_true(occi_pool_free_leaf(&map, i));
     }
     assert_int_equal(occ_map_check(&map), OCC_OK);
 }
@@ -180,13 +180,13 @@ static void test_leak_seen_by_check(void **state)
     (void)state;
     assert_int_equal(occ_map_observe_key(&map, mk(5, 6, 7), true), OCC_OK);
     assert_int_equal(occ_map_check(&map), OCC_OK);
-    const uint32_t l = occ_pool_alloc_leaf(&map);
+    const uint32_t l = occi_pool_alloc_leaf(&map);
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
-    assert_true(occ_pool_free_leaf(&map, l));
+    assert_true(occi_pool_free_leaf(&map, l));
     assert_int_equal(occ_map_check(&map), OCC_OK);
-    const uint32_t i = occ_pool_alloc_inner(&map);
+    const uint32_t i = occi_pool_alloc_inner(&map);
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
-    assert_true(occ_pool_free_inner(&map, i));
+    assert_true(occi_pool_free_inner(&map, i));
     assert_int_equal(occ_map_check(&map), OCC_OK);
 }
 
@@ -196,14 +196,14 @@ static void test_leak_check_fails_on_leak(void **state)
 {
     (void)state;
     assert_int_equal(occ_map_observe_key(&map, mk(5, 6, 7), true), OCC_OK);
-    const uint32_t l = occ_pool_alloc_leaf(&map);
+    const uint32_t l = occi_pool_alloc_leaf(&map);
     assert_true(l != OCC_NONE);
     assert_int_equal(leak_check(&map), -1);
-    assert_true(occ_pool_free_leaf(&map, l));
-    const uint32_t i = occ_pool_alloc_inner(&map);
+    assert_true(occi_pool_free_leaf(&map, l));
+    const uint32_t i = occi_pool_alloc_inner(&map);
     assert_true(i != OCC_NONE);
     assert_int_equal(leak_check(&map), -1);
-    assert_true(occ_pool_free_inner(&map, i));
+    assert_true(occi_pool_free_inner(&map, i));
     assert_int_equal(leak_check(&map), 0);
     assert_int_equal(map.inner.used + map.leaf.used, 0u);
 }
@@ -280,18 +280,18 @@ static void test_arena_sizing(void **state)
                 assert_int_equal(e, OCC_OK);
                 assert_true(m.arena >= arena + mis && m.arena + m.arena_bytes <= arena + mis + bytes);
                 assert_true(((uintptr_t)m.arena % OCC_ARENA_ALIGN) == 0u);
-                assert_true(occ_pool_can_supply(&m, i, j));
+                assert_true(occi_pool_can_supply(&m, i, j));
                 for (uint32_t a = 0; a < i; a++) {
-                    assert_int_equal(occ_pool_alloc_inner(&m), a);
+                    assert_int_equal(occi_pool_alloc_inner(&m), a);
                 }
                 for (uint32_t a = 0; a < j; a++) {
-                    assert_int_equal(occ_pool_alloc_leaf(&m), a);
+                    assert_int_equal(occi_pool_alloc_leaf(&m), a);
                 }
                 for (uint32_t a = 0; a < i; a++) {
-                    assert_true(occ_pool_free_inner(&m, a));
+                    assert_true(occi_pool_free_inner(&m, a));
                 }
                 for (uint32_t a = 0; a < j; a++) {
-                    assert_true(occ_pool_free_leaf(&m, a));
+                    assert_true(occi_pool_free_leaf(&m, a));
                 }
                 assert_int_equal(occ_map_check(&m), OCC_OK);
             }

@@ -28,6 +28,28 @@ int cli_parse_floats(const char *s, float *out, const int n)
     return *s == '\0';
 }
 
+bool cli_parse_float_in(const char *s, const float lo, const float hi, float *out)
+{
+    float v;
+    if (!cli_parse_floats(s, &v, 1) || v < lo || v > hi) {
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+bool cli_parse_u32(const char *s, const uint32_t lo, const uint32_t hi, uint32_t *out)
+{
+    char *end = NULL;
+    errno = 0;
+    const unsigned long v = strtoul(s, &end, 10);
+    if (end == s || *end != '\0' || errno != 0 || s[0] == '-' || v < lo || v > hi) {
+        return false;
+    }
+    *out = (uint32_t)v;
+    return true;
+}
+
 int cli_parse_size(const char *s, size_t *out)
 {
     char *end = NULL;

@@ -18,6 +18,10 @@ int cmd_can_feed(int argc, char **argv);  /* cmd_can_feed.c DroneCAN */
 
 /* Parse "a,b,c,..." into exactly n floats; false on any malformed or non-finite entry. */
 int cli_parse_floats(const char *s, float *out, int n);
+/* Parse one float in [lo, hi] (cli_parse_floats rules); false, *out unchanged, otherwise. */
+bool cli_parse_float_in(const char *s, float lo, float hi, float *out);
+/* Parse a decimal integer in [lo, hi] (no sign, no suffix); false, *out unchanged, otherwise. */
+bool cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
 /* Parse a positive size with optional K/M/G suffix (powers of 1024). */
 int cli_parse_size(const char *s, size_t *out);
 /* Print an error "occmap <cmd>: <msg>" to stderr. */

@@ -84,204 +84,294 @@ static double now_ms(void)
     return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
 }
 
-static bool parse_uint(const char *s, unsigned long max, unsigned long *out)
+/* What the command line asks for. */
+typedef struct {
+    const char *scan, *graph, *dir, *out_path; /* one input; -o */
+    float res, max_range, origin[3];
+    bool json;
+    uint32_t stride, frames, n, d, k;
+    occ_insert_method_t method;
+    evict_cli_t ev; /* --arena-bytes, --evict, --keep-radius */
+} build_opts_t;
+
+static void build_opts_init(build_opts_t *o)
 {
-    char *end = NULL;
-    const unsigned long v = strtoul(s, &end, 10);
-    if (end == s || *end != '\0' || v > max) {
-        return false;
-    }
-    *out = v;
-    return true;
+    memset(o, 0, sizeof *o);
+    o->res = 0.1f;
+    o->max_range = -1.0f;
+    o->stride = 1;
+    o->d = 2;
+    o->k = 4;
+    o->method = OCC_INSERT_SIMPLE;
+    evict_cli_init(&o->ev);
 }
 
-int cmd_build(int argc, char **argv)
+/* --n --d --k --stride --frames: the integer option `a` names, or NULL. */
+static uint32_t *count_option(build_opts_t *o, const char *a)
 {
-    const char *scan = NULL, *graph = NULL, *dir = NULL, *out_path = NULL;
-    float res = 0.1f, max_range = -1.0f, origin[3] = {0, 0, 0};
-    int json = 0;
-    unsigned long stride = 1, frames = 0, n = 0, d = 2, k = 4;
-    size_t arena_bytes = (size_t)1 << 30;
-    occ_insert_method_t method = OCC_INSERT_SIMPLE;
-    evict_cli_t ev;
-    evict_cli_init(&ev);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const bool has = i + 1 < argc;
-        const int ev_rc = evict_cli_parse(&ev, argc, argv, &i);
-        if (ev_rc < 0) {
+    static const char *const names[] = {"--n", "--d", "--k", "--stride", "--frames"};
+    uint32_t *const dst[] = {&o->n, &o->d, &o->k, &o->stride, &o->frames};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        if (strcmp(a, names[i]) == 0) {
+            return dst[i];
+        }
+    }
+    return NULL;
+}
+
+/* An option with the value v: 0, or 2 after a message (-1: not one of these). */
+static int value_option(build_opts_t *o, const char *a, const char *v)
+{
+    uint32_t *const count = count_option(o, a);
+    if (strcmp(a, "--scan") == 0) {
+        o->scan = v;
+    } else if (strcmp(a, "--graph") == 0) {
+        o->graph = v;
+    } else if (strcmp(a, "--depth-dir") == 0) {
+        o->dir = v;
+    } else if (strcmp(a, "-o") == 0) {
+        o->out_path = v;
+    } else if (strcmp(a, "--res") == 0) {
+        if (!cli_parse_floats(v, &o->res, 1) || !(o->res > 0.0f)) {
+            cli_error("build", "bad --res '%s'", v);
             return 2;
         }
-        if (ev_rc > 0) {
+    } else if (strcmp(a, "--method") == 0) {
+        if (!parse_method(v, &o->method)) {
+            cli_error("build", "bad --method '%s' (simple|discrete|fast|superrays)", v);
+            return 2;
+        }
+    } else if (strcmp(a, "--max-range") == 0) {
+        if (!cli_parse_floats(v, &o->max_range, 1)) {
+            cli_error("build", "bad --max-range '%s'", v);
+            return 2;
+        }
+    } else if (strcmp(a, "--origin") == 0) {
+        if (!cli_parse_floats(v, o->origin, 3)) {
+            cli_error("build", "bad --origin '%s' (x,y,z)", v);
+            return 2;
+        }
+    } else if (count != NULL) {
+        if (!cli_parse_u32(v, 0, 65535u, count)) {
+            cli_error("build", "bad %s '%s'", a, v);
+            return 2;
+        }
+    } else {
+        return -1;
+    }
+    return 0;
+}
+
+/* The flags that do not fit together. 0, or 2 after a message. */
+static int check_opts(const build_opts_t *o)
+{
+    if (evict_cli_finish(&o->ev) != 0) {
+        return 2;
+    }
+    if ((o->scan != NULL) + (o->graph != NULL) + (o->dir != NULL) != 1) {
+        cli_error("build", "give exactly one of --scan, --graph, --depth-dir");
+        return 2;
+    }
+    if (o->n > 255u || o->d > 20u) {
+        cli_error("build", "--n must be <= 255 and --d <= 20");
+        return 2;
+    }
+    return 0;
+}
+
+/* argv into `o`: -1 to go on, or the exit status (0 after --help, 2 after a message). */
+static int parse_args(build_opts_t *o, int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const int ev_rc = evict_cli_parse(&o->ev, argc, argv, &i);
+        if (ev_rc != 0) {
+            if (ev_rc < 0) {
+                return 2;
+            }
             continue; /* --arena-bytes, --evict, --keep-radius */
         }
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage();
             return 0;
-        } else if (strcmp(a, "--scan") == 0 && has) {
-            scan = argv[++i];
-        } else if (strcmp(a, "--graph") == 0 && has) {
-            graph = argv[++i];
-        } else if (strcmp(a, "--depth-dir") == 0 && has) {
-            dir = argv[++i];
-        } else if (strcmp(a, "--res") == 0 && has) {
-            if (!cli_parse_floats(argv[++i], &res, 1) || !(res > 0.0f)) {
-                cli_error("build", "bad --res '%s'", argv[i]);
-                return 2;
-            }
-        } else if (strcmp(a, "--method") == 0 && has) {
-            if (!parse_method(argv[++i], &method)) {
-                cli_error("build", "bad --method '%s' (simple|discrete|fast|superrays)", argv[i]);
-                return 2;
-            }
-        } else if (strcmp(a, "--max-range") == 0 && has) {
-            if (!cli_parse_floats(argv[++i], &max_range, 1)) {
-                cli_error("build", "bad --max-range '%s'", argv[i]);
-                return 2;
-            }
-        } else if (strcmp(a, "--origin") == 0 && has) {
-            if (!cli_parse_floats(argv[++i], origin, 3)) {
-                cli_error("build", "bad --origin '%s' (x,y,z)", argv[i]);
-                return 2;
-            }
-        } else if ((strcmp(a, "--n") == 0 || strcmp(a, "--d") == 0 || strcmp(a, "--k") == 0 ||
-                    strcmp(a, "--stride") == 0 || strcmp(a, "--frames") == 0) &&
-                   has) {
-            unsigned long *const dst = a[2] == 'n' ? &n
-                                       : a[2] == 'd' ? &d
-                                       : a[2] == 'k' ? &k
-                                       : a[2] == 's' ? &stride
-                                                     : &frames;
-            if (!parse_uint(argv[++i], 65535ul, dst)) {
-                cli_error("build", "bad %s '%s'", a, argv[i]);
-                return 2;
-            }
-        } else if (strcmp(a, "-o") == 0 && has) {
-            out_path = argv[++i];
-        } else if (strcmp(a, "--json") == 0) {
-            json = 1;
-        } else {
+        }
+        if (strcmp(a, "--json") == 0) {
+            o->json = true;
+            continue;
+        }
+        const int rc = i + 1 < argc ? value_option(o, a, argv[i + 1]) : -1;
+        if (rc < 0) {
             cli_error("build", "unknown option '%s' (see --help)", a);
             return 2;
         }
+        if (rc > 0) {
+            return rc;
+        }
+        i++;
     }
-    if (evict_cli_finish(&ev) != 0) {
-        return 2;
-    }
-    if (ev.fixed_arena) {
-        arena_bytes = ev.arena_bytes; /* allocated exactly once, never grown */
-    }
-    if ((scan != NULL) + (graph != NULL) + (dir != NULL) != 1) {
-        cli_error("build", "give exactly one of --scan, --graph, --depth-dir");
-        return 2;
-    }
-    if (n > 255u || d > 20u) {
-        cli_error("build", "--n must be <= 255 and --d <= 20");
-        return 2;
-    }
-    scans_t in = {NULL, 0};
-    if (load(scan, graph, dir, origin, (unsigned)stride, frames, &in) != 0) {
-        return 1;
-    }
+    const int rc = check_opts(o);
+    return rc != 0 ? rc : -1;
+}
+
+/* The map in one malloc'ed arena (--arena-bytes exactly, else 1 GiB). 0, or the exit status
+ * after a message (*arena freed). */
+static int make_map(const build_opts_t *o, occ_map_t *map, void **arena)
+{
+    const size_t arena_bytes = o->ev.fixed_arena ? o->ev.arena_bytes : (size_t)1 << 30;
     occ_map_config_t cfg = occ_map_config_default();
-    cfg.resolution_m = res;
-    void *const arena = malloc(arena_bytes);
-    occ_map_t map;
-    int rc = 0;
-    occ_err_t e = arena != NULL ? occ_map_init(&map, &cfg, arena, arena_bytes) : OCC_ERR_NOMEM;
+    cfg.resolution_m = o->res;
+    *arena = malloc(arena_bytes); /* allocated exactly once, never grown */
+    const occ_err_t e = *arena != NULL ? occ_map_init(map, &cfg, *arena, arena_bytes)
+                                       : OCC_ERR_NOMEM;
     if (e != OCC_OK) {
         cli_error("build", "cannot create the map (%s)", occ_err_str(e));
-        occ_scan_frames_free(in.frames, in.n);
-        free(arena);
+        free(*arena);
+        *arena = NULL;
         return e == OCC_ERR_NOMEM ? 1 : 2;
     }
-    occ_insert_params_t p = occ_insert_params_default();
-    p.method = method;
-    p.max_range_m = max_range;
-    p.fast_n = (uint8_t)n;
-    p.fast_d = (uint8_t)d;
-    p.super_k = (uint16_t)k;
-    size_t need = 0, total_pts = 0;
-    for (size_t i = 0; i < in.n; i++) {
-        const size_t b = occ_insert_scratch_bytes_scan(&map, &in.frames[i].origin,
-                                                       in.frames[i].points, in.frames[i].n_points,
-                                                       &p);
-        need = b > need ? b : need;
-        total_pts += in.frames[i].n_points;
-    }
-    void *const scratch = malloc(need > 0u ? need : 1u);
-    if (scratch == NULL) {
-        cli_error("build", "cannot allocate %zu bytes of scratch", need);
-        rc = 1;
-    }
+    return 0;
+}
+
+/* What the integration did, summed over the scans. */
+typedef struct {
     occ_insert_result_t sum;
-    memset(&sum, 0, sizeof sum);
-    size_t scratch_peak = 0; /* the most scratch one scan wrote (of `need` allocated) */
-    double ms = 0.0;
+    size_t total_pts;    /* points in the input */
+    size_t need;         /* the scratch bound allocated: the most any scan can need */
+    size_t scratch_peak; /* the most scratch one scan wrote */
+    double ms;           /* time inside the inserts */
+} build_result_t;
+
+static void add_result(build_result_t *b, const occ_insert_result_t *r)
+{
+    b->sum.points_integrated += r->points_integrated;
+    b->sum.points_skipped += r->points_skipped;
+    b->sum.rays_cast += r->rays_cast;
+    b->sum.rays_clipped += r->rays_clipped;
+    b->sum.voxel_visits += r->voxel_visits;
+    b->sum.voxels_updated += r->voxels_updated;
+    b->sum.coarse_updated += r->coarse_updated;
+    b->scratch_peak = r->scratch_used > b->scratch_peak ? r->scratch_used : b->scratch_peak;
+}
+
+/* Every scan into the map with the scratch bound allocated once. 0, or 1 after a message. */
+static int integrate(build_opts_t *o, occ_map_t *map, const scans_t *in,
+                     const occ_insert_params_t *p, build_result_t *b)
+{
+    for (size_t i = 0; i < in->n; i++) {
+        const occ_scan_frame_t *f = &in->frames[i];
+        const size_t need = occ_insert_scratch_bytes_scan(map, &f->origin, f->points,
+                                                          f->n_points, p);
+        b->need = need > b->need ? need : b->need;
+        b->total_pts += f->n_points;
+    }
+    void *const scratch = malloc(b->need > 0u ? b->need : 1u);
+    if (scratch == NULL) {
+        cli_error("build", "cannot allocate %zu bytes of scratch", b->need);
+        return 1;
+    }
+    int rc = 0;
     const double t_start = now_ms();
-    for (size_t i = 0; rc == 0 && i < in.n; i++) {
+    for (size_t i = 0; i < in->n; i++) {
+        const occ_scan_frame_t *f = &in->frames[i];
         occ_insert_result_t r;
         const double t0 = now_ms();
-        e = evict_cli_insert(&ev, &map, &in.frames[i].origin, in.frames[i].points,
-                             in.frames[i].n_points, &p, scratch, need, &r);
-        ms += now_ms() - t0;
+        const occ_err_t e = evict_cli_insert(&o->ev, map, &f->origin, f->points, f->n_points,
+                                             p, scratch, b->need, &r);
+        b->ms += now_ms() - t0;
         if (e != OCC_OK) {
-            cli_error("build", "scan %zu (%s): %s%s", i, in.frames[i].name, occ_err_str(e),
+            cli_error("build", "scan %zu (%s): %s%s", i, f->name, occ_err_str(e),
                       e == OCC_ERR_NOMEM ? " - try a larger --arena-bytes" : "");
             rc = 1;
             break;
         }
-        sum.points_integrated += r.points_integrated;
-        sum.points_skipped += r.points_skipped;
-        sum.rays_cast += r.rays_cast;
-        sum.rays_clipped += r.rays_clipped;
-        sum.voxel_visits += r.voxel_visits;
-        sum.voxels_updated += r.voxels_updated;
-        sum.coarse_updated += r.coarse_updated;
-        scratch_peak = r.scratch_used > scratch_peak ? r.scratch_used : scratch_peak;
-        if (in.n > 1u && now_ms() - t_start > 1000.0) {
-            fprintf(stderr, "\roccmap build: scan %zu/%zu, %.0f ms integrating", i + 1u, in.n,
-                    ms);
-            if (i + 1u == in.n) {
+        add_result(b, &r);
+        if (in->n > 1u && now_ms() - t_start > 1000.0) {
+            fprintf(stderr, "\roccmap build: scan %zu/%zu, %.0f ms integrating", i + 1u, in->n,
+                    b->ms);
+            if (i + 1u == in->n) {
                 fputc('\n', stderr);
             }
         }
     }
-    if (rc == 0) {
-        occ_map_stats_t st;
-        occ_map_stats(&map, &st);
-        static const char *const names[] = {"simple", "discrete", "fast", "superrays"};
-        if (json) {
-            printf("{");
-            cli_print_stats_json(stdout, &map, &st);
-            printf(", \"method\": \"%s\", \"scans\": %zu, \"points\": %zu, \"points_skipped\": %zu,"
-                   " \"rays\": %zu, \"voxel_visits\": %zu, \"voxels_updated\": %zu,"
-                   " \"coarse_updated\": %zu, \"scratch_bytes\": %zu, \"scratch_used\": %zu,"
-                   " \"integrate_ms\": %.3f, ",
-                   names[method], in.n, sum.points_integrated, sum.points_skipped, sum.rays_cast,
-                   sum.voxel_visits, sum.voxels_updated, sum.coarse_updated, need, scratch_peak,
-                   ms);
-            evict_cli_print_json(stdout, &ev);
-            printf("}\n");
-        } else {
-            cli_print_stats_text(stdout, &map, &st);
-            printf("method            %s, %zu scan(s), %zu points (%zu skipped) of %zu\n",
-                   names[method], in.n, sum.points_integrated, sum.points_skipped, total_pts);
-            printf("integrated        %zu rays, %zu voxel visits, %zu voxel updates, %.1f ms\n",
-                   sum.rays_cast, sum.voxel_visits, sum.voxels_updated, ms);
-            printf("scratch           %zu bytes written at most, of %zu allocated (the bound)\n",
-                   scratch_peak, need);
-        }
-        if (out_path != NULL) {
-            char msg[512] = "";
-            e = occ_file_save(out_path, &map, msg, sizeof msg);
-            if (e != OCC_OK) {
-                cli_error("build", "cannot save %s: %s (%s)", out_path, msg, occ_err_str(e));
-                rc = 1;
-            }
+    free(scratch);
+    return rc;
+}
+
+static void print_result(const build_opts_t *o, const occ_map_t *map, const scans_t *in,
+                         const build_result_t *b)
+{
+    static const char *const names[] = {"simple", "discrete", "fast", "superrays"};
+    const occ_insert_result_t *sum = &b->sum;
+    occ_map_stats_t st;
+    occ_map_stats(map, &st);
+    if (o->json) {
+        printf("{");
+        cli_print_stats_json(stdout, map, &st);
+        printf(", \"method\": \"%s\", \"scans\": %zu, \"points\": %zu, \"points_skipped\": %zu,"
+               " \"rays\": %zu, \"voxel_visits\": %zu, \"voxels_updated\": %zu,"
+               " \"coarse_updated\": %zu, \"scratch_bytes\": %zu, \"scratch_used\": %zu,"
+               " \"integrate_ms\": %.3f, ",
+               names[o->method], in->n, sum->points_integrated, sum->points_skipped,
+               sum->rays_cast, sum->voxel_visits, sum->voxels_updated, sum->coarse_updated,
+               b->need, b->scratch_peak, b->ms);
+        evict_cli_print_json(stdout, &o->ev);
+        printf("}\n");
+    } else {
+        cli_print_stats_text(stdout, map, &st);
+        printf("method            %s, %zu scan(s), %zu points (%zu skipped) of %zu\n",
+               names[o->method], in->n, sum->points_integrated, sum->points_skipped,
+               b->total_pts);
+        printf("integrated        %zu rays, %zu voxel visits, %zu voxel updates, %.1f ms\n",
+               sum->rays_cast, sum->voxel_visits, sum->voxels_updated, b->ms);
+        printf("scratch           %zu bytes written at most, of %zu allocated (the bound)\n",
+               b->scratch_peak, b->need);
+    }
+}
+
+/* The map into the scans, printed and (-o) saved. 0, or 1 after a message. */
+static int build_map(build_opts_t *o, occ_map_t *map, const scans_t *in)
+{
+    occ_insert_params_t p = occ_insert_params_default();
+    p.method = o->method;
+    p.max_range_m = o->max_range;
+    p.fast_n = (uint8_t)o->n;
+    p.fast_d = (uint8_t)o->d;
+    p.super_k = (uint16_t)o->k;
+    build_result_t b;
+    memset(&b, 0, sizeof b);
+    if (integrate(o, map, in, &p, &b) != 0) {
+        return 1;
+    }
+    print_result(o, map, in, &b);
+    if (o->out_path != NULL) {
+        char msg[512] = "";
+        const occ_err_t e = occ_file_save(o->out_path, map, msg, sizeof msg);
+        if (e != OCC_OK) {
+            cli_error("build", "cannot save %s: %s (%s)", o->out_path, msg, occ_err_str(e));
+            return 1;
         }
     }
-    free(scratch);
+    return 0;
+}
+
+int cmd_build(int argc, char **argv)
+{
+    build_opts_t o;
+    build_opts_init(&o);
+    const int parsed = parse_args(&o, argc, argv);
+    if (parsed >= 0) {
+        return parsed;
+    }
+    scans_t in = {NULL, 0};
+    if (load(o.scan, o.graph, o.dir, o.origin, (unsigned)o.stride, o.frames, &in) != 0) {
+        return 1;
+    }
+    occ_map_t map;
+    void *arena = NULL;
+    int rc = make_map(&o, &map, &arena);
+    if (rc == 0) {
+        rc = build_map(&o, &map, &in);
+    }
     free(arena);
     occ_scan_frames_free(in.frames, in.n);
     return rc;

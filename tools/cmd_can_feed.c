@@ -1,37 +1,16 @@
-/* cmd_can_feed.c - occmap can-feed: a DroneCAN node that publishes a map's obstacles. */
-#include <arpa/inet.h>
-#include <errno.h>
+/* cmd_can_feed.c - occmap can-feed: a DroneCAN node that publishes a map's obstacles.
+ * The options it shares with feed (--map, --map-frame, --min-m, --max-m, --rate-hz,
+ * --duration-s) and the MAVLink link, map and stop signal: feed_args.c. */
 #include <math.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/socket.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "cli.h"
+#include "feed_args.h"
 #include "occmap/occ_can.h"
-#include "occmap/host/occ_file.h"
-#include "occmap/occ_mavlink.h"
 
 #define CMD "can-feed"
-
-static volatile sig_atomic_t stop_requested;
-
-static void on_signal(int sig)
-{
-    (void)sig;
-    stop_requested = 1;
-}
-
-static uint64_t now_us(void)
-{
-    struct timespec ts;
-    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
-}
 
 static void usage(FILE *f)
 {
@@ -51,6 +30,107 @@ static void usage(FILE *f)
             "one JSON line.\n");
 }
 
+/* The options only `occmap can-feed` takes. */
+typedef struct {
+    const char *socketcan_if;  /* --socketcan IF, or */
+    bool have_mcast;           /* --mcast BUS */
+    uint32_t mcast_bus;
+    uint32_t node_id, sensor_id, sectors, priority;
+    bool have_pose;            /* --pose N,E,D,YAW_DEG, or */
+    float pose_v[4];
+    const char *mav_udp;       /* --mavlink-udp HOST:PORT */
+    size_t arena_extra;
+} can_opts_t;
+
+static void can_opts_init(can_opts_t *o)
+{
+    memset(o, 0, sizeof *o);
+    o->sectors = 72;
+    o->priority = 24;
+}
+
+/* feed_opt_fn for the options above (none is a flag). */
+static int can_option(void *ctx, const char *a, const char *v)
+{
+    can_opts_t *const o = ctx;
+    bool ok = true;
+    if (strcmp(a, "--socketcan") == 0) {
+        o->socketcan_if = v;
+    } else if (strcmp(a, "--mcast") == 0) {
+        ok = o->have_mcast = cli_parse_u32(v, 0, 255, &o->mcast_bus);
+    } else if (strcmp(a, "--node-id") == 0) {
+        ok = cli_parse_u32(v, 1, 127, &o->node_id);
+    } else if (strcmp(a, "--sensor-id") == 0) {
+        ok = cli_parse_u32(v, 0, 255, &o->sensor_id);
+    } else if (strcmp(a, "--priority") == 0) {
+        ok = cli_parse_u32(v, 0, 31, &o->priority);
+    } else if (strcmp(a, "--sectors") == 0) {
+        ok = cli_parse_u32(v, 4, OCC_SECTORS_MAX, &o->sectors);
+    } else if (strcmp(a, "--pose") == 0) {
+        ok = o->have_pose = cli_parse_floats(v, o->pose_v, 4) != 0;
+    } else if (strcmp(a, "--mavlink-udp") == 0) {
+        o->mav_udp = v;
+    } else if (strcmp(a, "--arena-extra") == 0) {
+        ok = cli_parse_size(v, &o->arena_extra) != 0;
+    } else {
+        return FEED_OPT_UNKNOWN;
+    }
+    return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
+}
+
+/* The sectors of the Proximity messages; 0, or 2 after a message. */
+static int sectors_config(const can_opts_t *o, const feed_args_t *fa, occ_sectors_config_t *sc)
+{
+    *sc = occ_sectors_config_default();
+    sc->n_sectors = (uint8_t)o->sectors;
+    sc->increment_deg = 360.0f / (float)o->sectors;
+    sc->angle_offset_deg = 0.0f;
+    feed_args_apply_range(fa, sc);
+    sc->map_ned = fa->map_ned;
+    if (occ_sectors_config_check(sc) != OCC_OK) {
+        cli_error(CMD, "bad sector settings (sectors %lu, %.2f..%.2f m)", (unsigned long)o->sectors,
+                  (double)fa->min_m, (double)fa->max_m);
+        return 2;
+    }
+    return 0;
+}
+
+/* --pose (NED metres, yaw degrees from north) in the map's frame. */
+static occ_pose_t fixed_pose(const can_opts_t *o, const bool map_ned)
+{
+    const float deg = 3.14159265358979f / 180.0f;
+    const float *const v = o->pose_v;
+    occ_pose_t pose;
+    memset(&pose, 0, sizeof pose);
+    if (!o->have_pose) {
+        return pose;
+    }
+    if (!map_ned) {
+        return occ_pose_from_ned(v[0], v[1], v[2], v[3] * deg);
+    }
+    pose.x = v[0];
+    pose.y = v[1];
+    pose.z = v[2];
+    pose.yaw_rad = v[3] * deg;
+    return pose;
+}
+
+/* --mavlink-udp: listen for the autopilot's poses (it sends nothing, so it never asks for
+ * streams). 0, or the exit status after a message. */
+static int mavlink_open(const occ_sectors_config_t *sc, const bool map_ned, const char *spec,
+                        occ_mav_feed_t *mav, occ_link_t *link)
+{
+    occ_mav_feed_config_t mcfg = occ_mav_feed_config_default();
+    mcfg.map_frame = map_ned ? OCC_MAP_FRAME_NED : OCC_MAP_FRAME_ENU;
+    mcfg.sectors = *sc;
+    mcfg.pose_interval_us = 0; /* this link only listens: the streams must be set up */
+    if (occ_mav_feed_init(mav, &mcfg) != OCC_OK) {
+        cli_error(CMD, "bad MAVLink pose settings");
+        return 2;
+    }
+    return feed_link_open(CMD, "--mavlink-udp", OCC_LINK_UDP_LISTEN, spec, link);
+}
+
 typedef struct {
     bool use_mcast;
     occ_socketcan_t sc;
@@ -63,293 +143,220 @@ static occ_err_t bus_recv(bus_t *b, occ_can_frame_t *f, int timeout_ms, bool *go
                         : occ_socketcan_recv(&b->sc, f, timeout_ms, got);
 }
 
-static int open_udp_listen(const char *hostport)
+/* --socketcan IF (every extended frame in) or --mcast BUS. 0, or 1 after a message. */
+static int bus_open(bus_t *bus, const can_opts_t *o, occ_can_iface_t *iface)
 {
-    char host[64];
-    const char *colon = strrchr(hostport, ':');
-    if (colon == NULL || (size_t)(colon - hostport) >= sizeof host) {
-        return -1;
-    }
-    memcpy(host, hostport, (size_t)(colon - hostport));
-    host[colon - hostport] = '\0';
-    const long port = strtol(colon + 1, NULL, 10);
-    if (port <= 0 || port > 65535) {
-        return -1;
-    }
-    struct sockaddr_in a;
-    memset(&a, 0, sizeof a);
-    a.sin_family = AF_INET;
-    a.sin_port = htons((uint16_t)port);
-    if (inet_pton(AF_INET, host[0] != '\0' ? host : "0.0.0.0", &a.sin_addr) != 1) {
-        return -1;
-    }
-    const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (fd < 0) {
-        return -1;
-    }
-    if (bind(fd, (struct sockaddr *)&a, sizeof a) < 0) {
-        (void)close(fd);
-        return -1;
-    }
-    return fd;
-}
-
-static bool parse_uint(const char *s, unsigned long lo, unsigned long hi, unsigned long *out)
-{
-    char *end = NULL;
-    errno = 0;
-    const unsigned long v = strtoul(s, &end, 10);
-    if (end == s || *end != '\0' || errno != 0 || s[0] == '-' || v < lo || v > hi) {
-        return false;
-    }
-    *out = v;
-    return true;
-}
-
-int cmd_can_feed(int argc, char **argv)
-{
-    const char *map_path = NULL, *socketcan_if = NULL, *mav_udp = NULL;
-    long mcast_bus = -1;
-    unsigned long node_id = 0, sensor_id = 0, sectors = 72, priority = 24;
-    float pose_v[4] = {0, 0, 0, 0};
-    bool have_pose = false, map_ned = false;
-    float rate_hz = 10.0f, duration_s = -1.0f, min_m = 0.2f, max_m = 20.0f;
-    size_t arena_extra = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
-        unsigned long u = 0;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return 0;
-        }
-        if (v == NULL) {
-            cli_error(CMD, "%s needs a value (or unknown option)", a);
-            return 2;
-        }
-        i++;
-        bool ok = true;
-        if (strcmp(a, "--map") == 0) {
-            map_path = v;
-        } else if (strcmp(a, "--socketcan") == 0) {
-            socketcan_if = v;
-        } else if (strcmp(a, "--mcast") == 0) {
-            ok = parse_uint(v, 0, 255, &u);
-            mcast_bus = (long)u;
-        } else if (strcmp(a, "--node-id") == 0) {
-            ok = parse_uint(v, 1, 127, &node_id);
-        } else if (strcmp(a, "--sensor-id") == 0) {
-            ok = parse_uint(v, 0, 255, &sensor_id);
-        } else if (strcmp(a, "--priority") == 0) {
-            ok = parse_uint(v, 0, 31, &priority);
-        } else if (strcmp(a, "--sectors") == 0) {
-            ok = parse_uint(v, 4, OCC_SECTORS_MAX, &sectors);
-        } else if (strcmp(a, "--pose") == 0) {
-            ok = cli_parse_floats(v, pose_v, 4) != 0;
-            have_pose = ok;
-        } else if (strcmp(a, "--mavlink-udp") == 0) {
-            mav_udp = v;
-        } else if (strcmp(a, "--rate-hz") == 0) {
-            ok = cli_parse_floats(v, &rate_hz, 1) != 0 && rate_hz >= 0.1f && rate_hz <= 100.0f;
-        } else if (strcmp(a, "--duration-s") == 0) {
-            ok = cli_parse_floats(v, &duration_s, 1) != 0 && duration_s >= 0.0f;
-        } else if (strcmp(a, "--min-m") == 0) {
-            ok = cli_parse_floats(v, &min_m, 1) != 0 && min_m >= 0.01f;
-        } else if (strcmp(a, "--max-m") == 0) {
-            ok = cli_parse_floats(v, &max_m, 1) != 0 && max_m <= 655.0f;
-        } else if (strcmp(a, "--map-frame") == 0) {
-            ok = strcmp(v, "enu") == 0 || strcmp(v, "ned") == 0;
-            map_ned = strcmp(v, "ned") == 0;
-        } else if (strcmp(a, "--arena-extra") == 0) {
-            ok = cli_parse_size(v, &arena_extra) != 0;
-        } else {
-            cli_error(CMD, "unknown option %s", a);
-            usage(stderr);
-            return 2;
-        }
-        if (!ok) {
-            cli_error(CMD, "bad value for %s: '%s'", a, v);
-            return 2;
-        }
-    }
-    if (map_path == NULL || node_id == 0u || ((socketcan_if != NULL) == (mcast_bus >= 0)) ||
-        (have_pose == (mav_udp != NULL)) || min_m >= max_m) {
-        cli_error(CMD, "need --map, --node-id, one of --socketcan/--mcast and one of "
-                       "--pose/--mavlink-udp (min < max)");
-        usage(stderr);
-        return 2;
-    }
-
-    /* The map. */
-    occ_map_t map;
-    void *arena = NULL;
     char msg[256] = "";
-    occ_err_t e = occ_file_load_alloc(map_path, NULL, &map, arena_extra, &arena, NULL, msg,
-                                      sizeof msg);
-    if (e != OCC_OK) {
-        cli_error(CMD, "cannot load %s: %s (%s)", map_path, msg, occ_err_str(e));
-        return 1;
-    }
-
-    occ_sectors_config_t scfg = occ_sectors_config_default();
-    scfg.n_sectors = (uint8_t)sectors;
-    scfg.increment_deg = 360.0f / (float)sectors;
-    scfg.angle_offset_deg = 0.0f;
-    scfg.min_distance_cm = (uint16_t)lroundf(min_m * 100.0f);
-    scfg.max_distance_cm = (uint16_t)lroundf(max_m * 100.0f);
-    scfg.map_ned = map_ned;
-    if (occ_sectors_config_check(&scfg) != OCC_OK) {
-        cli_error(CMD, "bad sector settings (sectors %lu, %.2f..%.2f m)", sectors, (double)min_m,
-                  (double)max_m);
-        free(arena);
-        return 2;
-    }
-
-    /* The pose: fixed, or live from MAVLink. */
-    occ_pose_t pose;
-    memset(&pose, 0, sizeof pose);
-    const float deg = 3.14159265358979f / 180.0f;
-    if (have_pose) {
-        if (map_ned) {
-            pose.x = pose_v[0];
-            pose.y = pose_v[1];
-            pose.z = pose_v[2];
-            pose.yaw_rad = pose_v[3] * deg;
-        } else {
-            pose = occ_pose_from_ned(pose_v[0], pose_v[1], pose_v[2], pose_v[3] * deg);
-        }
-    }
-    static occ_mav_feed_t mav; /* ~5 KB of sector scratch: keep it off the stack */
-    int mav_fd = -1;
-    if (mav_udp != NULL) {
-        occ_mav_feed_config_t mcfg = occ_mav_feed_config_default();
-        mcfg.map_frame = map_ned ? OCC_MAP_FRAME_NED : OCC_MAP_FRAME_ENU;
-        mcfg.sectors = scfg;
-        mcfg.pose_interval_us = 0; /* this link only listens: the streams must be set up */
-        if (occ_mav_feed_init(&mav, &mcfg) != OCC_OK || (mav_fd = open_udp_listen(mav_udp)) < 0) {
-            cli_error(CMD, "cannot listen for MAVLink on %s: %s", mav_udp, strerror(errno));
-            free(arena);
-            return 1;
-        }
-    }
-
-    /* The bus. */
-    static bus_t bus;
-    memset(&bus, 0, sizeof bus);
-    occ_can_iface_t iface;
-    if (socketcan_if != NULL) {
-        e = occ_socketcan_open(&bus.sc, socketcan_if, false, msg, sizeof msg);
-        iface = occ_socketcan_iface(&bus.sc);
+    occ_err_t e;
+    memset(bus, 0, sizeof *bus);
+    if (o->socketcan_if != NULL) {
+        e = occ_socketcan_open(&bus->sc, o->socketcan_if, false, msg, sizeof msg);
+        *iface = occ_socketcan_iface(&bus->sc);
     } else {
-        bus.use_mcast = true;
-        e = occ_can_mcast_open(&bus.mc, (unsigned)mcast_bus, true, msg, sizeof msg);
-        iface = occ_can_mcast_iface(&bus.mc);
+        bus->use_mcast = true;
+        e = occ_can_mcast_open(&bus->mc, (unsigned)o->mcast_bus, true, msg, sizeof msg);
+        *iface = occ_can_mcast_iface(&bus->mc);
     }
     if (e != OCC_OK) {
         cli_error(CMD, "cannot open the CAN bus: %s", msg);
-        free(arena);
-        if (mav_fd >= 0) {
-            (void)close(mav_fd);
-        }
         return 1;
     }
     const occ_can_filter_t all_ext = {0, 0, true};
-    if (!bus.use_mcast) {
-        (void)occ_socketcan_set_filters(&bus.sc, &all_ext, 1);
+    if (!bus->use_mcast) {
+        (void)occ_socketcan_set_filters(&bus->sc, &all_ext, 1);
     }
+    return 0;
+}
 
-    /* The node. */
-    static occ_dronecan_node_t node;
-    occ_dronecan_config_t ncfg = occ_dronecan_config_default();
-    ncfg.node_id = (uint8_t)node_id;
-    ncfg.sensor_id = (uint8_t)sensor_id;
-    ncfg.priority = (uint8_t)priority;
-    ncfg.proximity_period_us = (uint32_t)lroundf(1e6f / rate_hz);
-    uint32_t h = 2166136261u; /* unique id: FNV-1a of host name and node id, stable per host */
+static void bus_close(bus_t *bus)
+{
+    if (bus->use_mcast) {
+        occ_can_mcast_close(&bus->mc);
+    } else {
+        occ_socketcan_close(&bus->sc);
+    }
+}
+
+/* A unique id stable per host and node: FNV-1a of the host name and the node id. */
+static void host_unique_id(uint8_t id[16], const uint32_t node_id)
+{
+    uint32_t h = 2166136261u;
     char hostname[64] = "";
     (void)gethostname(hostname, sizeof hostname - 1u);
     const size_t hl = strlen(hostname);
     for (size_t k = 0; k < 16u; k++) {
         const unsigned c = k < hl ? (unsigned)(unsigned char)hostname[k] : (unsigned)(k + node_id);
         h = (h ^ c) * 16777619u;
-        ncfg.unique_id[k] = (uint8_t)(h >> 24);
+        id[k] = (uint8_t)(h >> 24);
     }
-    e = occ_dronecan_init(&node, &ncfg, &iface);
+}
+
+/* The DroneCAN node on `iface`; 0, or 1 after a message. */
+static int node_open(occ_dronecan_node_t *node, const can_opts_t *o, const feed_args_t *fa,
+                     const occ_can_iface_t *iface)
+{
+    occ_dronecan_config_t ncfg = occ_dronecan_config_default();
+    ncfg.node_id = (uint8_t)o->node_id;
+    ncfg.sensor_id = (uint8_t)o->sensor_id;
+    ncfg.priority = (uint8_t)o->priority;
+    ncfg.proximity_period_us = (uint32_t)lroundf(1e6f / fa->rate_hz);
+    host_unique_id(ncfg.unique_id, o->node_id);
+    const occ_err_t e = occ_dronecan_init(node, &ncfg, iface);
     if (e != OCC_OK) {
         cli_error(CMD, "node init: %s", occ_err_str(e));
-        free(arena);
         return 1;
     }
+    return 0;
+}
 
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    (void)sigaction(SIGINT, &sa, NULL);
-    (void)sigaction(SIGTERM, &sa, NULL);
+/* What one run holds: the map, where the pose comes from, the bus and the node. */
+typedef struct {
+    const occ_map_t *map;
+    occ_sectors_config_t sectors;
+    occ_pose_t pose;           /* fixed, or the last live one */
+    occ_link_t *mav_link;      /* NULL with --pose */
+    occ_mav_feed_t *mav;       /* the live pose's parser (with mav_link) */
+    bus_t *bus;
+    occ_dronecan_node_t *node;
+    uint32_t sector_errors, send_errors;
+} can_run_t;
 
-    const uint64_t t_start = now_us();
-    const uint64_t t_end = duration_s >= 0.0f ? t_start + (uint64_t)(duration_s * 1e6f) : UINT64_MAX;
-    uint32_t sector_errors = 0, send_errors = 0;
-    while (!stop_requested) {
-        const uint64_t t = now_us();
+/* The pose's time stamp at t: t for a fixed or fresh pose, 0 when no live pose is fresh (the
+ * node then reports NO_DATA). */
+static uint64_t update_pose(can_run_t *r, const uint64_t t)
+{
+    if (r->mav_link == NULL) {
+        return t;
+    }
+    (void)feed_link_drain(r->mav_link, r->mav, t); /* a read error leaves the pose to go stale */
+    return occ_mav_feed_pose(r->mav, t, &r->pose) ? t : 0u;
+}
+
+/* Serve the bus until the next publication is due (at most 10 ms per wait). */
+static void serve_bus(can_run_t *r, const uint64_t t_end)
+{
+    occ_dronecan_node_t *const node = r->node;
+    occ_can_frame_t f;
+    bool got = true;
+    while (got && !feed_stop_requested()) {
+        const uint64_t t2 = occ_port_clock_us();
+        const uint64_t due = node->next_proximity_us < node->next_status_us
+                                 ? node->next_proximity_us : node->next_status_us;
+        if (t2 >= due || t2 >= t_end) {
+            break;
+        }
+        int wait_ms = (int)((due - t2) / 1000u);
+        wait_ms = wait_ms > 10 ? 10 : wait_ms;
+        if (bus_recv(r->bus, &f, wait_ms, &got) != OCC_OK) {
+            break;
+        }
+        if (got) {
+            (void)occ_dronecan_ingest(node, &f, occ_port_clock_us());
+        }
+        got = got || wait_ms > 0; /* keep waiting until due */
+    }
+}
+
+/* Publish and serve until t_end or a stop signal. */
+static void run(can_run_t *r, const uint64_t t_end)
+{
+    while (!feed_stop_requested()) {
+        const uint64_t t = occ_port_clock_us();
         if (t >= t_end) {
             break;
         }
-        uint64_t pose_stamp = t;
-        if (mav_fd >= 0) {
-            uint8_t buf[2048];
-            ssize_t r;
-            while ((r = recv(mav_fd, buf, sizeof buf, 0)) > 0) {
-                occ_mav_feed_rx(&mav, buf, (size_t)r, t);
-            }
-            if (!occ_mav_feed_pose(&mav, t, &pose)) {
-                pose_stamp = 0; /* no fresh pose: the node reports NO_DATA */
-            }
-        }
-        e = occ_dronecan_poll_map(&node, t, &map, t, &pose, pose_stamp, &scfg);
+        const uint64_t pose_stamp = update_pose(r, t);
+        const occ_err_t e = occ_dronecan_poll_map(r->node, t, r->map, t, &r->pose, pose_stamp,
+                                                  &r->sectors);
         if (e == OCC_ERR_RANGE || e == OCC_ERR_ARG) {
-            sector_errors++; /* vehicle off the map: the node said NO_DATA */
+            r->sector_errors++; /* vehicle off the map: the node said NO_DATA */
         } else if (e == OCC_ERR_IO) {
-            send_errors++;
+            r->send_errors++;
         }
-        /* Serve the bus until the next publication is due (at most 10 ms per wait). */
-        occ_can_frame_t f;
-        bool got = true;
-        while (got && !stop_requested) {
-            const uint64_t t2 = now_us();
-            const uint64_t due = node.next_proximity_us < node.next_status_us
-                                     ? node.next_proximity_us : node.next_status_us;
-            if (t2 >= due || t2 >= t_end) {
-                break;
-            }
-            int wait_ms = (int)((due - t2) / 1000u);
-            wait_ms = wait_ms > 10 ? 10 : wait_ms;
-            if (bus_recv(&bus, &f, wait_ms, &got) != OCC_OK) {
-                break;
-            }
-            if (got) {
-                (void)occ_dronecan_ingest(&node, &f, now_us());
-            }
-            got = got || wait_ms > 0; /* keep waiting until due */
-        }
+        serve_bus(r, t_end);
     }
-    const occ_dronecan_stats_t *st = &node.stats;
+}
+
+static void print_stats(const can_run_t *r, const uint64_t t_start)
+{
+    const occ_dronecan_stats_t *st = &r->node->stats;
     printf("{\"proximity_sent\": %u, \"tx_frames\": %u, \"tx_transfers\": %u, \"tx_full\": %u, "
            "\"tx_errors\": %u, \"rx_frames\": %u, \"node_info_answered\": %u, "
            "\"bus_off\": %u, \"sector_errors\": %u, \"send_errors\": %u, \"last_obstacles\": %u, "
            "\"seconds\": %.2f}\n",
            st->proximity_sent, st->tx_frames, st->tx_transfers, st->tx_full, st->tx_errors,
-           st->rx_frames, st->node_info_answered, st->bus_off, sector_errors, send_errors,
-           (unsigned)node.last_obstacles, (double)(now_us() - t_start) / 1e6);
+           st->rx_frames, st->node_info_answered, st->bus_off, r->sector_errors, r->send_errors,
+           (unsigned)r->node->last_obstacles, (double)(occ_port_clock_us() - t_start) / 1e6);
     fflush(stdout);
-    if (bus.use_mcast) {
-        occ_can_mcast_close(&bus.mc);
-    } else {
-        occ_socketcan_close(&bus.sc);
+}
+
+/* Everything after the map is loaded: the sectors, the pose source, the bus, the node, the
+ * run. Returns the exit status; closes what it opened. */
+static int serve(const can_opts_t *o, const feed_args_t *fa, const occ_map_t *map)
+{
+    static occ_mav_feed_t mav; /* ~5 KB of sector scratch: keep it off the stack */
+    static bus_t bus;
+    static occ_dronecan_node_t node;
+    occ_link_t mav_link;
+    can_run_t r;
+    memset(&r, 0, sizeof r);
+    r.map = map;
+    r.bus = &bus;
+    r.node = &node;
+    int status = sectors_config(o, fa, &r.sectors);
+    if (status != 0) {
+        return status;
     }
-    if (mav_fd >= 0) {
-        (void)close(mav_fd);
+    r.pose = fixed_pose(o, fa->map_ned);
+    if (o->mav_udp != NULL) {
+        status = mavlink_open(&r.sectors, fa->map_ned, o->mav_udp, &mav, &mav_link);
+        if (status != 0) {
+            return status;
+        }
+        r.mav_link = &mav_link;
+        r.mav = &mav;
     }
+    occ_can_iface_t iface;
+    status = bus_open(&bus, o, &iface);
+    if (status == 0) {
+        status = node_open(&node, o, fa, &iface);
+        if (status == 0) {
+            feed_stop_install();
+            const uint64_t t_start = occ_port_clock_us();
+            run(&r, feed_args_end_us(fa, t_start));
+            print_stats(&r, t_start);
+        }
+        bus_close(&bus);
+    }
+    if (r.mav_link != NULL) {
+        occ_link_close(r.mav_link);
+    }
+    return status;
+}
+
+int cmd_can_feed(int argc, char **argv)
+{
+    can_opts_t o;
+    can_opts_init(&o);
+    feed_args_t fa;
+    const feed_cmd_t cmd = {CMD, usage, NULL, can_option, &o};
+    const int parsed = feed_args_parse(&fa, &cmd, argc, argv);
+    if (parsed != FEED_ARGS_RUN) {
+        return parsed;
+    }
+    if (fa.map_path == NULL || o.node_id == 0u || ((o.socketcan_if != NULL) == o.have_mcast) ||
+        (o.have_pose == (o.mav_udp != NULL)) || fa.min_m >= fa.max_m) {
+        cli_error(CMD, "need --map, --node-id, one of --socketcan/--mcast and one of "
+                       "--pose/--mavlink-udp (min < max)");
+        usage(stderr);
+        return 2;
+    }
+    occ_map_t map;
+    void *arena = NULL;
+    if (feed_load_map(CMD, &fa, o.arena_extra, &map, &arena) != 0) {
+        return 1;
+    }
+    const int status = serve(&o, &fa, &map);
     free(arena);
-    return 0;
+    return status;
 }

@@ -1,22 +1,13 @@
-/* cmd_feed.c - occmap feed: OBSTACLE_DISTANCE over MAVLink from a map and the autopilot's pose. */
-#include <signal.h>
+/* cmd_feed.c - occmap feed: OBSTACLE_DISTANCE over MAVLink from a map and the autopilot's pose.
+ * The options it shares with can-feed (--map, --map-frame, --min-m, --max-m, --rate-hz,
+ * --duration-s) and the link, map and stop signal: feed_args.c. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
-#include "occmap/host/occ_file.h"
-#include "occmap/occ_mavlink.h"
-#include "occmap/occ_port.h"
+#include "feed_args.h"
 
 #define CMD "feed"
-
-static volatile sig_atomic_t stop_requested;
-
-static void on_signal(int sig)
-{
-    (void)sig;
-    stop_requested = 1;
-}
 
 static void usage(FILE *f)
 {
@@ -61,51 +52,166 @@ static void usage(FILE *f)
             "flies over is no obstacle; --no-ignore-ground reports it.\n");
 }
 
-static bool parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out)
+/* The options only `occmap feed` takes, read into the feed's configuration. */
+typedef struct {
+    occ_mav_feed_config_t cfg; /* ids, autopilot, map frame, sectors: filled by configure() */
+    uint32_t timeout_ms, sysid, compid, ap_sysid, ap_compid, pose_interval_ms;
+    const char *udp, *udp_listen, *serial; /* exactly one: the link */
+    bool verbose;
+} feed_opts_t;
+
+static const char *const feed_flags[] = {"--verbose", "--unknown-as-distance",
+                                         "--no-ignore-ground", NULL};
+
+static void feed_opts_init(feed_opts_t *o)
 {
-    char *end = NULL;
-    const unsigned long v = strtoul(s, &end, 10);
-    if (s[0] == '\0' || s[0] == '-' || end == NULL || *end != '\0' || v < lo || v > hi) {
-        return false;
-    }
-    *out = (uint32_t)v;
-    return true;
+    memset(o, 0, sizeof *o);
+    o->cfg = occ_mav_feed_config_default();
+    o->timeout_ms = 300;
+    o->sysid = o->cfg.sysid;
+    o->compid = o->cfg.compid;
+    o->ap_sysid = o->cfg.autopilot_sysid;
+    o->ap_compid = o->cfg.autopilot_compid;
+    o->pose_interval_ms = o->cfg.pose_interval_us / 1000u;
 }
 
-static bool parse_float(const char *s, float lo, float hi, float *out)
+/* Which voxels count and what an element says: the band, the ground, angles, unknown space. */
+static int sector_option(occ_sectors_config_t *sc, const char *a, const char *v)
 {
-    float v;
-    if (!cli_parse_floats(s, &v, 1) || v < lo || v > hi) {
-        return false;
+    bool ok;
+    if (strcmp(a, "--band-m") == 0) {
+        float band_m = 0.0f;
+        ok = cli_parse_float_in(v, 0.01f, 100.0f, &band_m);
+        sc->band_below_m = sc->band_above_m = band_m;
+    } else if (strcmp(a, "--band-below-m") == 0) {
+        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->band_below_m);
+    } else if (strcmp(a, "--band-above-m") == 0) {
+        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->band_above_m);
+    } else if (strcmp(a, "--ground-clearance-m") == 0) {
+        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->ground_clearance_m);
+    } else if (strcmp(a, "--angle-offset-deg") == 0) {
+        ok = cli_parse_float_in(v, -360.0f, 360.0f, &sc->angle_offset_deg);
+    } else if (strcmp(a, "--unknown") == 0) {
+        ok = strcmp(v, "no-data") == 0 || strcmp(v, "distance") == 0;
+        sc->unknown_as_distance = ok ? strcmp(v, "distance") == 0 : sc->unknown_as_distance;
+    } else {
+        return FEED_OPT_UNKNOWN;
     }
-    *out = v;
-    return true;
+    return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
 }
 
-/* "HOST:PORT" -> host (copied) and port; for --udp-listen "PORT" alone is accepted too. */
-static bool split_host_port(const char *s, char *host, size_t host_len, uint32_t *port,
-                            bool host_optional)
+/* Who is who on the MAVLink side: our ids, the autopilot's, its streams and its kind. */
+static int mavlink_option(feed_opts_t *o, const char *a, const char *v)
 {
-    const char *colon = strrchr(s, ':');
-    if (colon == NULL) {
-        if (!host_optional) {
-            return false;
+    bool ok = true;
+    if (strcmp(a, "--sysid") == 0) {
+        ok = cli_parse_u32(v, 1, 255, &o->sysid);
+    } else if (strcmp(a, "--compid") == 0) {
+        ok = cli_parse_u32(v, 1, 255, &o->compid);
+    } else if (strcmp(a, "--timeout-ms") == 0) {
+        ok = cli_parse_u32(v, 1, 60000, &o->timeout_ms);
+    } else if (strcmp(a, "--autopilot-sysid") == 0) {
+        ok = cli_parse_u32(v, 1, 255, &o->ap_sysid);
+    } else if (strcmp(a, "--autopilot-compid") == 0) {
+        ok = cli_parse_u32(v, 1, 255, &o->ap_compid);
+    } else if (strcmp(a, "--pose-interval-ms") == 0) {
+        ok = cli_parse_u32(v, 0, 60000, &o->pose_interval_ms);
+    } else if (strcmp(a, "--autopilot") == 0) {
+        ok = strcmp(v, "ardupilot") == 0 || strcmp(v, "px4") == 0;
+        if (ok) {
+            o->cfg.autopilot = strcmp(v, "px4") == 0 ? OCC_AUTOPILOT_PX4 : OCC_AUTOPILOT_ARDUPILOT;
         }
-        host[0] = '\0';
-        return parse_u32(s, 1, 65535, port);
+    } else if (strcmp(a, "--udp") == 0) {
+        o->udp = v;
+    } else if (strcmp(a, "--udp-listen") == 0) {
+        o->udp_listen = v;
+    } else if (strcmp(a, "--serial") == 0) {
+        o->serial = v;
+    } else {
+        return FEED_OPT_UNKNOWN;
     }
-    const size_t n = (size_t)(colon - s);
-    if (n >= host_len || (n == 0 && !host_optional)) {
-        return false;
+    return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
+}
+
+/* feed_opt_fn: the flags (v == NULL), then the sector and MAVLink options. */
+static int feed_option(void *ctx, const char *a, const char *v)
+{
+    feed_opts_t *const o = ctx;
+    if (v == NULL) {
+        if (strcmp(a, "--verbose") == 0) {
+            o->verbose = true;
+        } else if (strcmp(a, "--unknown-as-distance") == 0) { /* the old spelling */
+            o->cfg.sectors.unknown_as_distance = true;
+        } else {
+            o->cfg.sectors.ignore_ground = false; /* --no-ignore-ground */
+        }
+        return FEED_OPT_OK;
     }
-    memcpy(host, s, n);
-    host[n] = '\0';
-    return parse_u32(colon + 1, 1, 65535, port);
+    const int r = sector_option(&o->cfg.sectors, a, v);
+    return r != FEED_OPT_UNKNOWN ? r : mavlink_option(o, a, v);
+}
+
+/* The options into the feed's configuration and the feed; 0, or 2 after a message. */
+static int configure(occ_mav_feed_t *feed, feed_opts_t *o, const feed_args_t *fa)
+{
+    occ_mav_feed_config_t *const cfg = &o->cfg;
+    cfg->sysid = (uint8_t)o->sysid;
+    cfg->compid = (uint8_t)o->compid;
+    cfg->period_us = (uint32_t)(1e6 / (double)fa->rate_hz);
+    cfg->pose_timeout_us = o->timeout_ms * 1000u;
+    cfg->autopilot_sysid = (uint8_t)o->ap_sysid;
+    cfg->autopilot_compid = (uint8_t)o->ap_compid;
+    cfg->pose_interval_us = o->pose_interval_ms * 1000u;
+    cfg->map_frame = fa->map_ned ? OCC_MAP_FRAME_NED : OCC_MAP_FRAME_ENU;
+    feed_args_apply_range(fa, &cfg->sectors);
+    if (occ_mav_feed_init(feed, cfg) != OCC_OK) {
+        cli_error(CMD, "bad feed configuration (min %.2f m must be < max %.2f m; the band "
+                  "below + above must be > 0)", (double)fa->min_m, (double)fa->max_m);
+        return 2;
+    }
+    return 0;
+}
+
+static int open_link(const feed_opts_t *o, occ_link_t *link)
+{
+    if (o->udp != NULL) {
+        return feed_link_open(CMD, "--udp", OCC_LINK_UDP_CLIENT, o->udp, link);
+    }
+    if (o->udp_listen != NULL) {
+        return feed_link_open(CMD, "--udp-listen", OCC_LINK_UDP_LISTEN, o->udp_listen, link);
+    }
+    return feed_link_open(CMD, "--serial", OCC_LINK_SERIAL, o->serial, link);
 }
 
 typedef struct {
     uint64_t n, sum_us, max_us;
 } timing_t;
+
+/* Write every frame the feed has due at `now`, timing each OBSTACLE_DISTANCE it computes.
+ * 0, or 1 after a message. */
+static int send_due(occ_mav_feed_t *feed, const occ_map_t *map, occ_link_t *link,
+                    const uint64_t now, timing_t *tm)
+{
+    for (;;) {
+        uint8_t out[OCC_MAV_FRAME_MAX];
+        const uint32_t before = feed->counters.obstacle_tx;
+        const uint64_t a = occ_port_clock_us();
+        const size_t len = occ_mav_feed_poll(feed, map, now, out, sizeof out);
+        if (len == 0u) {
+            return 0;
+        }
+        if (feed->counters.obstacle_tx != before) {
+            const uint64_t dt = occ_port_clock_us() - a;
+            tm->n++;
+            tm->sum_us += dt;
+            tm->max_us = dt > tm->max_us ? dt : tm->max_us;
+        }
+        if (occ_link_write(link, out, len) != OCC_OK) {
+            cli_error(CMD, "write failed");
+            return 1;
+        }
+    }
+}
 
 /* The autopilot the feed listens to, once; every refused SET_MESSAGE_INTERVAL. */
 static void log_autopilot(const occ_mav_feed_t *feed, bool *named, uint32_t *refusals)
@@ -123,249 +229,66 @@ static void log_autopilot(const occ_mav_feed_t *feed, bool *named, uint32_t *ref
     }
 }
 
-int cmd_feed(int argc, char **argv)
+/* --verbose, once a second: the pose and the counters. */
+static void log_progress(const occ_mav_feed_t *feed, const uint64_t now, const uint64_t t0)
 {
-    const char *map_path = NULL, *udp = NULL, *udp_listen = NULL, *serial = NULL;
-    occ_mav_feed_config_t cfg = occ_mav_feed_config_default();
-    uint32_t rate_hz = 10, timeout_ms = 300, sysid = cfg.sysid, compid = cfg.compid;
-    uint32_t ap_sysid = cfg.autopilot_sysid, ap_compid = cfg.autopilot_compid;
-    uint32_t pose_interval_ms = cfg.pose_interval_us / 1000u;
-    float duration_s = 0.0f, min_m = 0.2f, max_m = 20.0f, band_m = 0.0f;
-    occ_sectors_config_t *const sc = &cfg.sectors;
-    bool verbose = false;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        bool ok = true;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return 0;
-        } else if (strcmp(a, "--verbose") == 0) {
-            verbose = true;
-            continue;
-        } else if (strcmp(a, "--unknown-as-distance") == 0) { /* the old spelling */
-            sc->unknown_as_distance = true;
-            continue;
-        } else if (strcmp(a, "--no-ignore-ground") == 0) {
-            sc->ignore_ground = false;
-            continue;
-        }
-        if (v == NULL) {
-            cli_error(CMD, "%s needs a value", a);
-            usage(stderr);
-            return 2;
-        }
-        i++;
-        if (strcmp(a, "--map") == 0) {
-            map_path = v;
-        } else if (strcmp(a, "--udp") == 0) {
-            udp = v;
-        } else if (strcmp(a, "--udp-listen") == 0) {
-            udp_listen = v;
-        } else if (strcmp(a, "--serial") == 0) {
-            serial = v;
-        } else if (strcmp(a, "--rate-hz") == 0) {
-            ok = parse_u32(v, 1, 100, &rate_hz);
-        } else if (strcmp(a, "--sysid") == 0) {
-            ok = parse_u32(v, 1, 255, &sysid);
-        } else if (strcmp(a, "--compid") == 0) {
-            ok = parse_u32(v, 1, 255, &compid);
-        } else if (strcmp(a, "--timeout-ms") == 0) {
-            ok = parse_u32(v, 1, 60000, &timeout_ms);
-        } else if (strcmp(a, "--duration-s") == 0) {
-            ok = parse_float(v, 0.0f, 1e7f, &duration_s);
-        } else if (strcmp(a, "--min-m") == 0) {
-            ok = parse_float(v, 0.01f, 600.0f, &min_m);
-        } else if (strcmp(a, "--max-m") == 0) {
-            ok = parse_float(v, 0.02f, 655.0f, &max_m);
-        } else if (strcmp(a, "--band-m") == 0) {
-            ok = parse_float(v, 0.01f, 100.0f, &band_m);
-            sc->band_below_m = sc->band_above_m = band_m;
-        } else if (strcmp(a, "--band-below-m") == 0) {
-            ok = parse_float(v, 0.0f, 100.0f, &sc->band_below_m);
-        } else if (strcmp(a, "--band-above-m") == 0) {
-            ok = parse_float(v, 0.0f, 100.0f, &sc->band_above_m);
-        } else if (strcmp(a, "--ground-clearance-m") == 0) {
-            ok = parse_float(v, 0.0f, 100.0f, &sc->ground_clearance_m);
-        } else if (strcmp(a, "--angle-offset-deg") == 0) {
-            ok = parse_float(v, -360.0f, 360.0f, &sc->angle_offset_deg);
-        } else if (strcmp(a, "--unknown") == 0) {
-            if (strcmp(v, "no-data") == 0) {
-                sc->unknown_as_distance = false;
-            } else if (strcmp(v, "distance") == 0) {
-                sc->unknown_as_distance = true;
-            } else {
-                ok = false;
-            }
-        } else if (strcmp(a, "--autopilot-sysid") == 0) {
-            ok = parse_u32(v, 1, 255, &ap_sysid);
-        } else if (strcmp(a, "--autopilot-compid") == 0) {
-            ok = parse_u32(v, 1, 255, &ap_compid);
-        } else if (strcmp(a, "--pose-interval-ms") == 0) {
-            ok = parse_u32(v, 0, 60000, &pose_interval_ms);
-        } else if (strcmp(a, "--autopilot") == 0) {
-            if (strcmp(v, "ardupilot") == 0) {
-                cfg.autopilot = OCC_AUTOPILOT_ARDUPILOT;
-            } else if (strcmp(v, "px4") == 0) {
-                cfg.autopilot = OCC_AUTOPILOT_PX4;
-            } else {
-                ok = false;
-            }
-        } else if (strcmp(a, "--map-frame") == 0) {
-            if (strcmp(v, "enu") == 0) {
-                cfg.map_frame = OCC_MAP_FRAME_ENU;
-            } else if (strcmp(v, "ned") == 0) {
-                cfg.map_frame = OCC_MAP_FRAME_NED;
-            } else {
-                ok = false;
-            }
-        } else {
-            cli_error(CMD, "unknown option %s", a);
-            usage(stderr);
-            return 2;
-        }
-        if (!ok) {
-            cli_error(CMD, "bad value for %s: '%s'", a, v);
-            return 2;
-        }
-    }
-    const int n_links = (udp != NULL) + (udp_listen != NULL) + (serial != NULL);
-    if (map_path == NULL || n_links != 1) {
-        cli_error(CMD, "needs --map and exactly one of --udp, --udp-listen, --serial");
-        usage(stderr);
-        return 2;
-    }
-    cfg.sysid = (uint8_t)sysid;
-    cfg.compid = (uint8_t)compid;
-    cfg.period_us = 1000000u / rate_hz;
-    cfg.pose_timeout_us = timeout_ms * 1000u;
-    cfg.autopilot_sysid = (uint8_t)ap_sysid;
-    cfg.autopilot_compid = (uint8_t)ap_compid;
-    cfg.pose_interval_us = pose_interval_ms * 1000u;
-    sc->min_distance_cm = (uint16_t)(min_m * 100.0f + 0.5f);
-    sc->max_distance_cm = (uint16_t)(max_m * 100.0f + 0.5f);
-    static occ_mav_feed_t feed;
-    if (occ_mav_feed_init(&feed, &cfg) != OCC_OK) {
-        cli_error(CMD, "bad feed configuration (min %.2f m must be < max %.2f m; the band "
-                  "below + above must be > 0)", (double)min_m, (double)max_m);
-        return 2;
-    }
+    occ_pose_t p;
+    const bool fresh = occ_mav_feed_pose(feed, now, &p);
+    fprintf(stderr, "feed: t=%.1fs pose %s (%.2f %.2f %.2f yaw %.1f deg) tx %u obstacle %u hb"
+            ", rx ok %u bad %u\n", (double)(now - t0) * 1e-6, fresh ? "fresh" : "stale",
+            (double)p.x, (double)p.y, (double)p.z, (double)p.yaw_rad * 57.29578,
+            feed->counters.obstacle_tx, feed->counters.heartbeat_tx,
+            feed->parser.counters.frames_ok,
+            feed->parser.counters.bad_crc + feed->parser.counters.bad_len);
+}
 
-    char msg[256] = "";
-    occ_map_t map;
-    void *arena = NULL;
-    occ_err_t e = occ_file_load_alloc(map_path, NULL, &map, 0, &arena, NULL, msg, sizeof msg);
-    if (e != OCC_OK) {
-        cli_error(CMD, "%s: %s (%s)", map_path, occ_err_str(e), msg);
-        return 1;
+/* Sleep until the feed's next message is due or input arrives (at most 50 ms). */
+static void wait_next(const occ_mav_feed_t *feed, occ_link_t *link)
+{
+    const uint64_t due = occ_mav_feed_next_due(feed);
+    const uint64_t now = occ_port_clock_us();
+    uint64_t wait = due > now ? due - now : 0u;
+    wait = wait > 50000u ? 50000u : wait;
+    if (wait > 0u) {
+        (void)occ_link_wait(link, wait);
     }
+}
 
-    occ_link_t link;
-    char host[256];
-    uint32_t port = 0;
-    if (udp != NULL) {
-        if (!split_host_port(udp, host, sizeof host, &port, false)) {
-            cli_error(CMD, "--udp wants HOST:PORT, got '%s'", udp);
-            free(arena);
-            return 2;
-        }
-        e = occ_link_udp_connect(&link, host, (uint16_t)port, msg, sizeof msg);
-    } else if (udp_listen != NULL) {
-        if (!split_host_port(udp_listen, host, sizeof host, &port, true)) {
-            cli_error(CMD, "--udp-listen wants [HOST:]PORT, got '%s'", udp_listen);
-            free(arena);
-            return 2;
-        }
-        e = occ_link_udp_listen(&link, host[0] != '\0' ? host : NULL, (uint16_t)port, msg,
-                                sizeof msg);
-    } else {
-        if (!split_host_port(serial, host, sizeof host, &port, false)) {
-            cli_error(CMD, "--serial wants DEV:BAUD, got '%s'", serial);
-            free(arena);
-            return 2;
-        }
-        e = occ_link_serial_open(&link, host, port, msg, sizeof msg);
-    }
-    if (e != OCC_OK) {
-        cli_error(CMD, "%s", msg);
-        free(arena);
-        return e == OCC_ERR_ARG ? 2 : 1;
-    }
-
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+/* Read, send, log and wait until --duration-s or a stop signal. 0, or 1 after an i/o error. */
+static int run(occ_mav_feed_t *feed, const occ_map_t *map, occ_link_t *link,
+               const feed_args_t *fa, const bool verbose, timing_t *tm)
+{
     const uint64_t t0 = occ_port_clock_us();
-    const uint64_t t_end = duration_s > 0.0f ? t0 + (uint64_t)(duration_s * 1e6f) : UINT64_MAX;
-    timing_t tm = {0, 0, 0};
+    const uint64_t t_end = feed_args_end_us(fa, t0);
     uint64_t next_report = t0 + 1000000u;
     uint32_t refusals_logged = 0;
     bool autopilot_logged = false;
-    int status = 0;
-    while (!stop_requested) {
-        uint64_t now = occ_port_clock_us();
+    while (!feed_stop_requested()) {
+        const uint64_t now = occ_port_clock_us();
         if (now >= t_end) {
             break;
         }
-        uint8_t buf[2048];
-        size_t n = 0;
-        do {
-            if (occ_link_read(&link, buf, sizeof buf, &n) != OCC_OK) {
-                cli_error(CMD, "read failed");
-                status = 1;
-                break;
-            }
-            if (n > 0u) {
-                occ_mav_feed_rx(&feed, buf, n, now);
-            }
-        } while (n > 0u);
-        if (status != 0) {
-            break;
+        if (feed_link_drain(link, feed, now) != OCC_OK) {
+            cli_error(CMD, "read failed");
+            return 1;
         }
-        for (;;) {
-            uint8_t out[OCC_MAV_FRAME_MAX];
-            const uint32_t before = feed.counters.obstacle_tx;
-            const uint64_t a = occ_port_clock_us();
-            const size_t len = occ_mav_feed_poll(&feed, &map, now, out, sizeof out);
-            if (len == 0u) {
-                break;
-            }
-            if (feed.counters.obstacle_tx != before) {
-                const uint64_t dt = occ_port_clock_us() - a;
-                tm.n++;
-                tm.sum_us += dt;
-                tm.max_us = dt > tm.max_us ? dt : tm.max_us;
-            }
-            if (occ_link_write(&link, out, len) != OCC_OK) {
-                cli_error(CMD, "write failed");
-                status = 1;
-                break;
-            }
+        if (send_due(feed, map, link, now, tm) != 0) {
+            return 1;
         }
-        if (status != 0) {
-            break;
-        }
-        log_autopilot(&feed, &autopilot_logged, &refusals_logged);
+        log_autopilot(feed, &autopilot_logged, &refusals_logged);
         if (verbose && now >= next_report) {
             next_report += 1000000u;
-            occ_pose_t p;
-            const bool fresh = occ_mav_feed_pose(&feed, now, &p);
-            fprintf(stderr, "feed: t=%.1fs pose %s (%.2f %.2f %.2f yaw %.1f deg) tx %u obstacle %u hb"
-                    ", rx ok %u bad %u\n", (double)(now - t0) * 1e-6, fresh ? "fresh" : "stale",
-                    (double)p.x, (double)p.y, (double)p.z, (double)p.yaw_rad * 57.29578,
-                    feed.counters.obstacle_tx, feed.counters.heartbeat_tx,
-                    feed.parser.counters.frames_ok,
-                    feed.parser.counters.bad_crc + feed.parser.counters.bad_len);
+            log_progress(feed, now, t0);
         }
-        const uint64_t due = occ_mav_feed_next_due(&feed);
-        now = occ_port_clock_us();
-        uint64_t wait = due > now ? due - now : 0u;
-        wait = wait > 50000u ? 50000u : wait;
-        if (wait > 0u) {
-            (void)occ_link_wait(&link, wait);
-        }
+        wait_next(feed, link);
     }
-    const occ_mav_feed_counters_t *c = &feed.counters;
-    const occ_mav_counters_t *pc = &feed.parser.counters;
+    return 0;
+}
+
+static void print_stats(const occ_mav_feed_t *feed, const occ_link_t *link, const timing_t *tm)
+{
+    const occ_mav_feed_counters_t *c = &feed->counters;
+    const occ_mav_counters_t *pc = &feed->parser.counters;
     printf("{\"obstacle_tx\": %u, \"heartbeat_tx\": %u, \"positions_rx\": %u, \"attitudes_rx\": %u, "
            "\"ignored_rx\": %u, \"foreign_rx\": %u, \"requests_tx\": %u, \"request_acks\": %u, "
            "\"request_refusals\": %u, \"stale_skips\": %u, \"sector_errors\": %u, \"frames_ok\": %u, "
@@ -374,10 +297,46 @@ int cmd_feed(int argc, char **argv)
            "\"update_us_max\": %llu}\n",
            c->obstacle_tx, c->heartbeat_tx, c->positions_rx, c->attitudes_rx, c->ignored_rx,
            c->foreign_rx, c->requests_tx, c->request_acks, c->request_refusals, c->stale_skips,
-           c->sector_errors, pc->frames_ok, pc->bad_crc, pc->bad_len, pc->unknown_id, pc->bad_flags, pc->junk_bytes, link.tx_dropped,
-           tm.n > 0u ? (double)tm.sum_us / (double)tm.n : 0.0, (unsigned long long)tm.max_us);
+           c->sector_errors, pc->frames_ok, pc->bad_crc, pc->bad_len, pc->unknown_id,
+           pc->bad_flags, pc->junk_bytes, link->tx_dropped,
+           tm->n > 0u ? (double)tm->sum_us / (double)tm->n : 0.0, (unsigned long long)tm->max_us);
     fflush(stdout);
-    occ_link_close(&link);
+}
+
+int cmd_feed(int argc, char **argv)
+{
+    feed_opts_t o;
+    feed_opts_init(&o);
+    feed_args_t fa;
+    const feed_cmd_t cmd = {CMD, usage, feed_flags, feed_option, &o};
+    const int parsed = feed_args_parse(&fa, &cmd, argc, argv);
+    if (parsed != FEED_ARGS_RUN) {
+        return parsed;
+    }
+    const int n_links = (o.udp != NULL) + (o.udp_listen != NULL) + (o.serial != NULL);
+    if (fa.map_path == NULL || n_links != 1) {
+        cli_error(CMD, "needs --map and exactly one of --udp, --udp-listen, --serial");
+        usage(stderr);
+        return 2;
+    }
+    static occ_mav_feed_t feed; /* sector scratch: keep it off the stack */
+    if (configure(&feed, &o, &fa) != 0) {
+        return 2;
+    }
+    occ_map_t map;
+    void *arena = NULL;
+    if (feed_load_map(CMD, &fa, 0, &map, &arena) != 0) {
+        return 1;
+    }
+    occ_link_t link;
+    int status = open_link(&o, &link);
+    if (status == 0) {
+        feed_stop_install();
+        timing_t tm = {0, 0, 0};
+        status = run(&feed, &map, &link, &fa, o.verbose, &tm);
+        print_stats(&feed, &link, &tm);
+        occ_link_close(&link);
+    }
     free(arena);
     return status;
 }

@@ -38,6 +38,42 @@ static void usage(void)
            "  Prints the format, the header, reader warnings and the map statistics.\n");
 }
 
+/* The file's header facts and warnings, then the map statistics. */
+static void print_info(const char *path, const occ_io_info_t *info, const occ_map_t *map,
+                       const int json)
+{
+    occ_map_stats_t st;
+    occ_map_stats(map, &st);
+    if (json) {
+        printf("{\"file\": \"%s\", \"format\": \"%s\", \"tree_id\": \"%s\", \"file_bytes\": %zu, "
+               "\"file_nodes\": %llu, \"warnings\": [",
+               path, format_name(info->format), info->tree_id, info->bytes_used,
+               (unsigned long long)info->nodes);
+        int first = 1;
+        for (size_t i = 0; i < sizeof warn_names / sizeof warn_names[0]; i++) {
+            if ((info->warnings & warn_names[i].bit) != 0u) {
+                printf("%s\"%s\"", first ? "" : ", ", warn_names[i].name);
+                first = 0;
+            }
+        }
+        printf("], ");
+        cli_print_stats_json(stdout, map, &st);
+        printf("}\n");
+    } else {
+        printf("file              %s\n", path);
+        printf("format            %s%s%s\n", format_name(info->format),
+               info->tree_id[0] != '\0' ? ", id " : "", info->tree_id);
+        printf("file nodes        %llu (%zu bytes read)\n", (unsigned long long)info->nodes,
+               info->bytes_used);
+        for (size_t i = 0; i < sizeof warn_names / sizeof warn_names[0]; i++) {
+            if ((info->warnings & warn_names[i].bit) != 0u) {
+                printf("warning           %s\n", warn_names[i].name);
+            }
+        }
+        cli_print_stats_text(stdout, map, &st);
+    }
+}
+
 int cmd_info(int argc, char **argv)
 {
     const char *path = NULL;
@@ -68,36 +104,7 @@ int cmd_info(int argc, char **argv)
         cli_error("info", "%s", msg);
         return 1;
     }
-    occ_map_stats_t st;
-    occ_map_stats(&map, &st);
-    if (json) {
-        printf("{\"file\": \"%s\", \"format\": \"%s\", \"tree_id\": \"%s\", \"file_bytes\": %zu, "
-               "\"file_nodes\": %llu, \"warnings\": [",
-               path, format_name(info.format), info.tree_id, info.bytes_used,
-               (unsigned long long)info.nodes);
-        int first = 1;
-        for (size_t i = 0; i < sizeof warn_names / sizeof warn_names[0]; i++) {
-            if ((info.warnings & warn_names[i].bit) != 0u) {
-                printf("%s\"%s\"", first ? "" : ", ", warn_names[i].name);
-                first = 0;
-            }
-        }
-        printf("], ");
-        cli_print_stats_json(stdout, &map, &st);
-        printf("}\n");
-    } else {
-        printf("file              %s\n", path);
-        printf("format            %s%s%s\n", format_name(info.format),
-               info.tree_id[0] != '\0' ? ", id " : "", info.tree_id);
-        printf("file nodes        %llu (%zu bytes read)\n", (unsigned long long)info.nodes,
-               info.bytes_used);
-        for (size_t i = 0; i < sizeof warn_names / sizeof warn_names[0]; i++) {
-            if ((info.warnings & warn_names[i].bit) != 0u) {
-                printf("warning           %s\n", warn_names[i].name);
-            }
-        }
-        cli_print_stats_text(stdout, &map, &st);
-    }
+    print_info(path, &info, &map, json);
     free(arena);
     return 0;
 }

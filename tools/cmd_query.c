@@ -125,94 +125,109 @@ static int run_distance(const occ_map_t *map, const query_t *q, FILE *out)
 }
 
 /* Run one query and print its answer; returns 0 or 1 (error, printed). */
+/* The query's volume (a ray: its segment up to the range, after casting it into *ray). */
+static occ_err_t make_volume(const occ_map_t *map, const query_t *q, occ_volume_t *vol,
+                             occ_ray_result_t *ray)
+{
+    switch (q->kind) {
+    case Q_SPHERE:
+        return occ_volume_sphere(vol, vec(q->v), q->v[3]);
+    case Q_AABB:
+        return occ_volume_aabb(vol, vec(q->v), vec(q->v + 3));
+    case Q_CAPSULE:
+        return occ_volume_capsule(vol, vec(q->v), vec(q->v + 3), q->v[6]);
+    case Q_RAY: {
+        const occ_vec3_t o = vec(q->v), d = vec(q->v + 3);
+        const float len = sqrtf(d.x * d.x + d.y * d.y + d.z * d.z);
+        if (!(len > 0.0f) || !(q->v[6] > 0.0f)) {
+            return OCC_ERR_ARG;
+        }
+        occ_err_t e = occ_cast_ray(map, o, d, q->policy == OCC_UNKNOWN_SAFE, q->v[6], ray);
+        if (e == OCC_OK) {
+            const float s = q->v[6] / len;
+            const occ_vec3_t b = {o.x + d.x * s, o.y + d.y * s, o.z + d.z * s};
+            e = occ_volume_segment(vol, o, b);
+        }
+        return e;
+    }
+    case Q_DISTANCE: /* run_distance */
+    case Q_NONE:
+    default:
+        return OCC_ERR_ARG;
+    }
+}
+
+/* What a volume or ray query found. */
+typedef struct {
+    bool is_ray, collides;
+    occ_ray_result_t ray;  /* is_ray */
+    occ_collision_t col;   /* !is_ray */
+    occ_query_counts_t cnt;
+} answer_t;
+
+static void print_answer(const query_t *q, const answer_t *r, FILE *out)
+{
+    static const char *const stops[] = {"hit", "max_range", "unknown", "map_edge"};
+    const occ_ray_result_t *ray = &r->ray;
+    if (q->json) {
+        fprintf(out, "{\"collides\": %s, \"occupied_voxels\": %llu, \"unknown_voxels\": %llu",
+                r->collides ? "true" : "false", (unsigned long long)r->cnt.occupied,
+                (unsigned long long)r->cnt.unknown);
+        if (r->is_ray) {
+            fprintf(out, ", \"hit\": %s, \"hit_point\": ", ray->hit ? "true" : "false");
+            if (ray->hit) {
+                fprintf(out, "[%.4f, %.4f, %.4f]", (double)ray->end.x, (double)ray->end.y,
+                        (double)ray->end.z);
+            } else {
+                fprintf(out, "null");
+            }
+            fprintf(out, ", \"stop\": \"%s\"", stops[ray->stop]);
+        } else if (!r->col.safe) {
+            fprintf(out, ", \"outside_map\": %s", r->col.outside ? "true" : "false");
+        }
+        fprintf(out, "}\n");
+    } else {
+        fprintf(out, "%s: %llu occupied, %llu unknown voxels inside",
+                r->collides ? "COLLIDES" : "safe", (unsigned long long)r->cnt.occupied,
+                (unsigned long long)r->cnt.unknown);
+        if (r->is_ray) {
+            if (ray->hit) {
+                fprintf(out, "; ray hit at %.4f %.4f %.4f", (double)ray->end.x,
+                        (double)ray->end.y, (double)ray->end.z);
+            } else {
+                fprintf(out, "; ray: no hit (%s)", stops[ray->stop]);
+            }
+        } else if (!r->col.safe && r->col.outside) {
+            fprintf(out, "; leaves the map");
+        }
+        fprintf(out, "\n");
+    }
+}
+
 static int run(const occ_map_t *map, const query_t *q, FILE *out)
 {
     if (q->kind == Q_DISTANCE) {
         return run_distance(map, q, out);
     }
+    answer_t r;
+    memset(&r, 0, sizeof r);
+    r.is_ray = q->kind == Q_RAY;
     occ_volume_t vol;
-    occ_err_t e = OCC_OK;
-    occ_ray_result_t ray;
-    bool is_ray = q->kind == Q_RAY;
-    switch (q->kind) {
-    case Q_SPHERE:
-        e = occ_volume_sphere(&vol, vec(q->v), q->v[3]);
-        break;
-    case Q_AABB:
-        e = occ_volume_aabb(&vol, vec(q->v), vec(q->v + 3));
-        break;
-    case Q_CAPSULE:
-        e = occ_volume_capsule(&vol, vec(q->v), vec(q->v + 3), q->v[6]);
-        break;
-    case Q_RAY: {
-        const occ_vec3_t o = vec(q->v), d = vec(q->v + 3);
-        const float len = sqrtf(d.x * d.x + d.y * d.y + d.z * d.z);
-        if (!(len > 0.0f) || !(q->v[6] > 0.0f)) {
-            e = OCC_ERR_ARG;
-            break;
-        }
-        e = occ_cast_ray(map, o, d, q->policy == OCC_UNKNOWN_SAFE, q->v[6], &ray);
-        if (e == OCC_OK) {
-            const float s = q->v[6] / len;
-            const occ_vec3_t b = {o.x + d.x * s, o.y + d.y * s, o.z + d.z * s};
-            e = occ_volume_segment(&vol, o, b);
-        }
-        break;
-    }
-    case Q_DISTANCE: /* run_distance */
-    case Q_NONE:
-    default:
-        e = OCC_ERR_ARG;
-        break;
-    }
-    occ_collision_t col;
-    occ_query_counts_t cnt;
-    if (e == OCC_OK && !is_ray) e = occ_collide_volume(map, &vol, q->policy, &col);
-    if (e == OCC_OK) e = occ_query_count(map, &vol, &cnt);
+    occ_err_t e = make_volume(map, q, &vol, &r.ray);
+    if (e == OCC_OK && !r.is_ray) e = occ_collide_volume(map, &vol, q->policy, &r.col);
+    if (e == OCC_OK) e = occ_query_count(map, &vol, &r.cnt);
     if (e != OCC_OK) {
         if (q->json) fprintf(out, "{\"error\": \"%s\"}\n", occ_err_str(e));
         else fprintf(stderr, "occmap query: %s\n", occ_err_str(e));
         return 1;
     }
-    bool collides;
-    if (is_ray) {
-        collides = ray.hit || (q->policy == OCC_UNKNOWN_UNSAFE && ray.stop == OCC_RAY_UNKNOWN);
+    if (r.is_ray) {
+        r.collides = r.ray.hit ||
+                     (q->policy == OCC_UNKNOWN_UNSAFE && r.ray.stop == OCC_RAY_UNKNOWN);
     } else {
-        collides = !col.safe;
+        r.collides = !r.col.safe;
     }
-    static const char *const stops[] = {"hit", "max_range", "unknown", "map_edge"};
-    if (q->json) {
-        fprintf(out, "{\"collides\": %s, \"occupied_voxels\": %llu, \"unknown_voxels\": %llu",
-                collides ? "true" : "false", (unsigned long long)cnt.occupied,
-                (unsigned long long)cnt.unknown);
-        if (is_ray) {
-            fprintf(out, ", \"hit\": %s, \"hit_point\": ", ray.hit ? "true" : "false");
-            if (ray.hit) {
-                fprintf(out, "[%.4f, %.4f, %.4f]", (double)ray.end.x, (double)ray.end.y,
-                        (double)ray.end.z);
-            } else {
-                fprintf(out, "null");
-            }
-            fprintf(out, ", \"stop\": \"%s\"", stops[ray.stop]);
-        } else if (!col.safe) {
-            fprintf(out, ", \"outside_map\": %s", col.outside ? "true" : "false");
-        }
-        fprintf(out, "}\n");
-    } else {
-        fprintf(out, "%s: %llu occupied, %llu unknown voxels inside", collides ? "COLLIDES" : "safe",
-                (unsigned long long)cnt.occupied, (unsigned long long)cnt.unknown);
-        if (is_ray) {
-            if (ray.hit) {
-                fprintf(out, "; ray hit at %.4f %.4f %.4f", (double)ray.end.x, (double)ray.end.y,
-                        (double)ray.end.z);
-            } else {
-                fprintf(out, "; ray: no hit (%s)", stops[ray.stop]);
-            }
-        } else if (!col.safe && col.outside) {
-            fprintf(out, "; leaves the map");
-        }
-        fprintf(out, "\n");
-    }
+    print_answer(q, &r, out);
     return 0;
 }
 

@@ -126,7 +126,7 @@ typedef struct occ_evict_out {
 void occ_evict_out_init(occ_evict_out_t *out);
 
 /* Evict (see above) until the pools could hand out `target_free_blocks` inner blocks AND
- * `target_free_blocks` leaf blocks at once (occ_pool_can_supply), or the budget is spent, or
+ * `target_free_blocks` leaf blocks at once (occi_pool_can_supply), or the budget is spent, or
  * nothing evictable is left. `center` is the vehicle position (map frame, metres).
  * Returns OCC_OK (see out->target_reached / exhausted / resumable for which happened),
  * OCC_ERR_ARG (NULL, non-finite centre, negative or non-finite radius/half extents, bad mode,

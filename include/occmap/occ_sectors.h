@@ -125,8 +125,8 @@ occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg);
  * it lies outside the search cylinder, holds only free space, or is farther than what every
  * sector it spans already found (d_occ_m / d_unk_m are exact where they decide the result).
  * Cost grows with the nodes between the vehicle and the nearest non-free space per sector, not
- * with R^2: on OctoMap's geb079.bt (0.08 m) about 860 node reads and 1.26 M instructions per
- * call with the defaults (make bench); each read is an O(depth) descent from the root.
+ * with R^2 (what it costs on a real map: README, Limits); each read is an O(depth) descent from
+ * the root.
  * Stack: < 512 bytes (the work space is in `out`). Never writes the map; reads no memory other
  * than map, pose, cfg and out.
  * The ground rule adds at most band_below_m / resolution + 1 voxel reads.

@@ -16,15 +16,10 @@ occ_map_config_t occ_map_config_default(void)
     return c;
 }
 
-static bool finite_f(const float x)
-{
-    return x - x < 1.0f;  /* false for NaN and +-Inf */
-}
-
 /* Log-odds a fixed-point value can hold exactly enough (|x| < 31). */
 static bool in_value_range(const float x)
 {
-    return finite_f(x) && x > -31.0f && x < 31.0f;
+    return occ_finite(x) && x > -31.0f && x < 31.0f;
 }
 
 occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, void *const arena,
@@ -33,7 +28,7 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
     if (map == NULL || cfg == NULL || (arena == NULL && arena_bytes != 0u)) {
         return OCC_ERR_ARG;
     }
-    if (!finite_f(cfg->resolution_m) || !(cfg->resolution_m > 0.0f) ||
+    if (!occ_finite(cfg->resolution_m) || !(cfg->resolution_m > 0.0f) ||
         cfg->depth_levels < 1u || cfg->depth_levels > OCC_MAX_DEPTH ||
         !in_value_range(cfg->hit) || !(cfg->hit > 0.0f) || !in_value_range(cfg->miss) ||
         !(cfg->miss < 0.0f) || !in_value_range(cfg->clamp_min) ||
@@ -49,7 +44,7 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
     map->q_clamp_max = occ_value_from_logodds(cfg->clamp_max);
     map->q_free_max = occ_value_from_logodds(cfg->free_max);
     map->q_occ_min = occ_value_from_logodds(cfg->occupied_min);
-    occ_geom_init(map);
+    occi_geom_init(map);
     /* Align the start and the size to 8 so both block kinds stay aligned from either end. */
     uintptr_t start = (uintptr_t)arena;
     size_t bytes = arena_bytes;
@@ -82,14 +77,9 @@ void occ_map_clear(occ_map_t *const map)
     map->write_gen++; /* every handle on the old content is stale */
 }
 
-static bool finite_v(const occ_vec3_t p)
-{
-    return finite_f(p.x) && finite_f(p.y) && finite_f(p.z);
-}
-
 occ_err_t occ_map_key(const occ_map_t *const map, const occ_vec3_t p, occ_key_t *const key)
 {
-    if (map == NULL || key == NULL || !finite_v(p)) {
+    if (map == NULL || key == NULL || !occ_finite3(p)) {
         return OCC_ERR_ARG;
     }
     occ_key_t k;
@@ -127,13 +117,13 @@ float occ_map_node_size(const occ_map_t *const map, const unsigned level)
 occ_err_t occ_map_key_range(const occ_map_t *const map, const float lo_m, const float hi_m,
                             uint32_t *const lo, uint32_t *const hi)
 {
-    if (map == NULL || lo == NULL || hi == NULL || !finite_f(lo_m) || !finite_f(hi_m) ||
+    if (map == NULL || lo == NULL || hi == NULL || !occ_finite(lo_m) || !occ_finite(hi_m) ||
         lo_m > hi_m) {
         return OCC_ERR_ARG;
     }
     uint32_t l;
     uint32_t h;
-    if (!occ_geom_key_range(map, lo_m, hi_m, (occ_real_t)0, &l, &h)) {
+    if (!occi_geom_key_range(map, lo_m, hi_m, (occ_real_t)0, &l, &h)) {
         return OCC_ERR_RANGE;
     }
     *lo = l;
@@ -149,10 +139,7 @@ occ_vec3_t occ_map_key_center(const occ_map_t *const map, const occ_key_t key, c
     const uint32_t kmax = (uint32_t)1 << map->cfg.depth_levels;
     occ_vec3_t c;
     if (base.k[0] < kmax && base.k[1] < kmax && base.k[2] < kmax) {
-        c.x = occ_geom_center1(map, base.k[0], lv);
-        c.y = occ_geom_center1(map, base.k[1], lv);
-        c.z = occ_geom_center1(map, base.k[2], lv);
-        return c;
+        return occ_geom_center(map, base, lv);
     }
     /* A caller key off the map (up to 2^32 - 1) gets the centre it would have, outside the map,
      * in 64-bit key arithmetic so that nothing overflows. */

@@ -38,7 +38,7 @@ static void note_alloc(occ_pool_t *const p)
     }
 }
 
-bool occ_pool_can_supply(const occ_map_t *const m, const uint32_t n_inner, const uint32_t n_leaf)
+bool occi_pool_can_supply(const occ_map_t *const m, const uint32_t n_inner, const uint32_t n_leaf)
 {
     const uint64_t new_inner = n_inner > m->inner.free_count ? n_inner - m->inner.free_count : 0u;
     const uint64_t new_leaf = n_leaf > m->leaf.free_count ? n_leaf - m->leaf.free_count : 0u;
@@ -46,7 +46,7 @@ bool occ_pool_can_supply(const occ_map_t *const m, const uint32_t n_inner, const
     return need <= (uint64_t)gap_bytes(m);
 }
 
-uint32_t occ_pool_alloc_inner(occ_map_t *const m)
+uint32_t occi_pool_alloc_inner(occ_map_t *const m)
 {
     uint32_t idx = m->inner.free_head;
     OCC_ASSERT(pools_fit(m));
@@ -66,7 +66,7 @@ uint32_t occ_pool_alloc_inner(occ_map_t *const m)
     return idx;
 }
 
-uint32_t occ_pool_alloc_leaf(occ_map_t *const m)
+uint32_t occi_pool_alloc_leaf(occ_map_t *const m)
 {
     uint32_t idx = m->leaf.free_head;
     OCC_ASSERT(pools_fit(m));
@@ -84,7 +84,7 @@ uint32_t occ_pool_alloc_leaf(occ_map_t *const m)
     return idx;
 }
 
-bool occ_pool_free_inner(occ_map_t *const m, const uint32_t idx)
+bool occi_pool_free_inner(occ_map_t *const m, const uint32_t idx)
 {
     if (idx >= m->inner.hwm || m->inner.used == 0u) {
         return false;
@@ -101,7 +101,7 @@ bool occ_pool_free_inner(occ_map_t *const m, const uint32_t idx)
     return true;
 }
 
-bool occ_pool_free_leaf(occ_map_t *const m, const uint32_t idx)
+bool occi_pool_free_leaf(occ_map_t *const m, const uint32_t idx)
 {
     if (idx >= m->leaf.hwm || m->leaf.used == 0u) {
         return false;

@@ -9,7 +9,7 @@ static double volume_resolution(const occ_map_t *const map)
 #if OCC_RAY_DOUBLE
     return map->geo_res;
 #else
-    return occ_geom_decimal(map->cfg.resolution_m);
+    return occi_geom_decimal(map->cfg.resolution_m);
 #endif
 }
 

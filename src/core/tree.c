@@ -26,13 +26,13 @@ static occ_value_t max_of8(const occ_value_t *const v)
     return mx;
 }
 
-void occ_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
+void occi_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
     OCC_ASSERT(level >= 1u && *node.child == OCC_NONE);
     OCC_ASSERT(level <= m->cfg.depth_levels);
     const occ_value_t v = *node.value;
     if (level == 1u) {
-        const uint32_t idx = occ_pool_alloc_leaf(m);
+        const uint32_t idx = occi_pool_alloc_leaf(m);
         OCC_ASSERT(idx != OCC_NONE);
         occ_leaf_block_t *const b = occ_leaf_at(m, idx);
         for (unsigned i = 0; i < 8u; i++) {
@@ -40,7 +40,7 @@ void occ_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned 
         }
         *node.child = idx;
     } else {
-        const uint32_t idx = occ_pool_alloc_inner(m);
+        const uint32_t idx = occi_pool_alloc_inner(m);
         OCC_ASSERT(idx != OCC_NONE);
         occ_inner_block_t *const b = occ_inner_at(m, idx);
         const uint8_t f = occ_value_flags(m, v);
@@ -53,7 +53,7 @@ void occ_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned 
     }
 }
 
-bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
+bool occi_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
     const uint32_t child = *node.child;
     if (child == OCC_NONE) {
@@ -72,7 +72,7 @@ bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned
             prunable = prunable && occ_value_eq(b->value[i], b->value[0]);
         }
         if (prunable) {
-            const bool freed = occ_pool_free_leaf(m, child);
+            const bool freed = occi_pool_free_leaf(m, child);
             OCC_ASSERT(freed);
         }
     } else {
@@ -84,7 +84,7 @@ bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned
             prunable = prunable && b->child[i] == OCC_NONE && occ_value_eq(b->value[i], b->value[0]);
         }
         if (prunable) {
-            const bool freed = occ_pool_free_inner(m, child);
+            const bool freed = occi_pool_free_inner(m, child);
             OCC_ASSERT(freed);
         }
     }
@@ -97,14 +97,14 @@ bool occ_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned
     return changed;
 }
 
-void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
+void occi_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
     if (*node.child == OCC_NONE) {
         return;
     }
     OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
     if (level == 1u) {
-        const bool freed = occ_pool_free_leaf(m, *node.child);
+        const bool freed = occi_pool_free_leaf(m, *node.child);
         OCC_ASSERT(freed);
         *node.child = OCC_NONE;
         return;
@@ -128,7 +128,7 @@ void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const
                 continue;
             }
             if (lvl[sp] == 1u) {
-                const bool freed = occ_pool_free_leaf(m, c);
+                const bool freed = occi_pool_free_leaf(m, c);
                 OCC_ASSERT(freed);
             } else {
                 OCC_ASSERT(sp < OCC_MAX_DEPTH && lvl[sp] > 1u);
@@ -139,7 +139,7 @@ void occ_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const
             }
             continue;
         }
-        const bool freed = occ_pool_free_inner(m, blk[sp]);
+        const bool freed = occi_pool_free_inner(m, blk[sp]);
         OCC_ASSERT(freed);
         if (sp == 0u) {
             break;
@@ -261,7 +261,7 @@ static void refresh_up_to(occ_map_t *const m, path_t *const p, const unsigned to
     for (unsigned l = p->low; l <= top; l++) {
         if (p->dirty[l]) {
             p->dirty[l] = false;
-            if (occ_tree_refresh(m, p->node[l], l)) {
+            if (occi_tree_refresh(m, p->node[l], l)) {
                 p->dirty[l + 1u] = true;
             }
         }
@@ -365,7 +365,7 @@ static void count_blocks(const occ_map_t *const m, const occ_code_t *const codes
 static bool can_supply64(const occ_map_t *const m, const uint64_t n_inner, const uint64_t n_leaf)
 {
     return n_inner <= OCC_NONE && n_leaf <= OCC_NONE &&
-           occ_pool_can_supply(m, (uint32_t)n_inner, (uint32_t)n_leaf);
+           occi_pool_can_supply(m, (uint32_t)n_inner, (uint32_t)n_leaf);
 }
 
 /* `bound_fits`: the caller showed that an upper bound of the blocks needed fits, so the exact
@@ -420,7 +420,7 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
             continue;
         }
         for (unsigned l = stop; l >= 1u; l--) {
-            occ_tree_expand(m, p.node[l], l);
+            occi_tree_expand(m, p.node[l], l);
             if (l > 1u) {
                 p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(c, l));
             }
@@ -472,14 +472,9 @@ occ_err_t occ_map_observe_need(const occ_map_t *const map, const occ_code_t *con
     return OCC_OK;
 }
 
-static bool finite_f(const float x)
-{
-    return x - x < 1.0f;
-}
-
 occ_err_t occ_map_update_key(occ_map_t *const map, const occ_key_t key, const float delta_logodds)
 {
-    if (map == NULL || !finite_f(delta_logodds)) {
+    if (map == NULL || !occ_finite(delta_logodds)) {
         return OCC_ERR_ARG;
     }
     if (!key_in_range(map, key)) {
@@ -543,12 +538,12 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
         /* Expand the uniform node at l down to the target level: blocks for levels l..level+1. */
         const unsigned n_blocks = l - level;
         const uint32_t n_leaf = level == 0u ? 1u : 0u;
-        if (!occ_pool_can_supply(m, n_blocks - n_leaf, n_leaf)) {
+        if (!occi_pool_can_supply(m, n_blocks - n_leaf, n_leaf)) {
             m->oom_count++;
             return OCC_ERR_NOMEM;
         }
         while (l > level) {
-            occ_tree_expand(m, p.node[l], l);
+            occi_tree_expand(m, p.node[l], l);
             if (l - 1u >= 1u) {
                 p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(code, l));
             }
@@ -564,13 +559,13 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
         leaf->value[occ_code_slot(code, 1u)] = v;
         first_dirty = 1u;
     } else {
-        occ_tree_release_children(m, p.node[level], level);
+        occi_tree_release_children(m, p.node[level], level);
         *p.node[level].value = v;
         *p.node[level].flags = occ_value_flags(m, v);
         first_dirty = level + 1u;
     }
     for (unsigned k = first_dirty; k <= depth; k++) {
-        if (!occ_tree_refresh(m, p.node[k], k)) {
+        if (!occi_tree_refresh(m, p.node[k], k)) {
             break;
         }
     }
@@ -580,7 +575,7 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
 occ_err_t occ_map_set_key(occ_map_t *const map, const occ_key_t key, const unsigned level,
                           const float logodds)
 {
-    if (map == NULL || !finite_f(logodds)) {
+    if (map == NULL || !occ_finite(logodds)) {
         return OCC_ERR_ARG;
     }
     return set_raw(map, key, level, occ_value_from_logodds(logodds));

@@ -148,7 +148,7 @@ static void node_distance(const ctx_t *const x, const occ_code_t code, const uns
 
 static bool target_ok(const ctx_t *const x)
 {
-    return occ_pool_can_supply(x->m, x->need_inner, x->need_leaf);
+    return occi_pool_can_supply(x->m, x->need_inner, x->need_leaf);
 }
 
 static bool forgetting(const ctx_t *const x)
@@ -186,7 +186,7 @@ static void collapse(ctx_t *const x, const occ_nodep_t n, const unsigned level)
             v = OCC_VALUE_UNOBSERVED;
         }
     }
-    occ_tree_release_children(m, n, level);
+    occi_tree_release_children(m, n, level);
     *n.value = v;
     *n.flags = occ_value_flags(m, v);
     x->evictions++;
@@ -271,7 +271,7 @@ static void pop(ctx_t *const x)
     const occ_nodep_t n = frame_node(m, cur, top);
     bool changed = false;
     if (cur->dirty[top] != 0u) {
-        changed = occ_tree_refresh(m, n, lvl);
+        changed = occi_tree_refresh(m, n, lvl);
     }
     if (*n.child != OCC_NONE && collapsible_level(x, lvl)) {
         float dmin, dmax;
@@ -299,7 +299,7 @@ static void settle(ctx_t *const x)
         const unsigned top = cur->sp - 1u;
         if (cur->dirty[top] != 0u) {
             const occ_nodep_t n = frame_node(m, cur, top);
-            if (occ_tree_refresh(m, n, m->cfg.depth_levels - top) && top > 0u) {
+            if (occi_tree_refresh(m, n, m->cfg.depth_levels - top) && top > 0u) {
                 cur->dirty[top - 1u] = 1u;
             }
         }

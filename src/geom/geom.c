@@ -2,7 +2,7 @@
 #include "geom_internal.h"
 
 /* Double arithmetic in every build: the float build calls it only for statistics (stats.c). */
-double occ_geom_decimal(const float r)
+double occi_geom_decimal(const float r)
 {
     /* A user who writes OcTree(0.1) or cfg.resolution_m = 0.1f means 0.1: the shortest decimal
      * (1 to 9 significant digits) that rounds to the float. n / 10^p is the double nearest to
@@ -22,11 +22,11 @@ double occ_geom_decimal(const float r)
     return rd;
 }
 
-void occ_geom_init(occ_map_t *const m)
+void occi_geom_init(occ_map_t *const m)
 {
     const float r = m->cfg.resolution_m;
 #if OCC_RAY_DOUBLE
-    m->geo_res = occ_geom_decimal(r);
+    m->geo_res = occi_geom_decimal(r);
     m->geo_inv = 1.0 / m->geo_res;
     m->geo_res_f = (float)m->geo_res;
     m->geo_inv_f = (float)m->geo_inv;
@@ -38,8 +38,8 @@ void occ_geom_init(occ_map_t *const m)
 #endif
 }
 
-bool occ_geom_key_range(const occ_map_t *const m, const float lo_m, const float hi_m,
-                        const occ_real_t slack, uint32_t *const lo, uint32_t *const hi)
+bool occi_geom_key_range(const occ_map_t *const m, const float lo_m, const float hi_m,
+                         const occ_real_t slack, uint32_t *const lo, uint32_t *const hi)
 {
     const occ_real_t inv = occ_geom_inv(m);
     const int32_t half = occ_geom_half(m);

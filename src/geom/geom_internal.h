@@ -12,6 +12,7 @@
 #define OCC_GEOM_INTERNAL_H_INCLUDED
 
 #include <float.h>
+#include <string.h>
 #include "occmap/occmap.h"
 
 #if OCC_RAY_DOUBLE
@@ -21,6 +22,21 @@ typedef double occ_real_t;
 typedef float occ_real_t;
 #define OCC_REAL_MAX FLT_MAX
 #endif
+
+/* THE "is finite" test of the map modules for every float a caller gives (coordinates, ranges, angles,
+ * log-odds, file fields): false for NaN and +-Inf. On the bit pattern (exponent all ones), so it
+ * holds under -ffinite-math-only and costs no float compare on a soft-float Cortex-M0+. */
+static inline bool occ_finite(float x)
+{
+    uint32_t u;
+    memcpy(&u, &x, sizeof u);
+    return (u & 0x7F800000u) != 0x7F800000u;
+}
+
+static inline bool occ_finite3(occ_vec3_t v)
+{
+    return occ_finite(v.x) && occ_finite(v.y) && occ_finite(v.z);
+}
 
 /* The map's decimal resolution and its inverse (OctoMap's resolution / resolution_factor). */
 static inline occ_real_t occ_geom_res(const occ_map_t *m)
@@ -93,16 +109,27 @@ static inline float occ_geom_center1(const occ_map_t *m, uint32_t base, unsigned
     return (float)occ_geom_center_of(occ_geom_res(m), occ_geom_half(m), base, level);
 }
 
+/* Centre (metres) of the node at `level` whose first voxel key is `base` (in the map; off-map
+ * keys: occ_map_key_center). */
+static inline occ_vec3_t occ_geom_center(const occ_map_t *m, occ_key_t base, unsigned level)
+{
+    occ_vec3_t c;
+    c.x = occ_geom_center1(m, base.k[0], level);
+    c.y = occ_geom_center1(m, base.k[1], level);
+    c.z = occ_geom_center1(m, base.k[2], level);
+    return c;
+}
+
 /* Keys [lo, hi] of the voxels holding a coordinate of [lo_m, hi_m] widened by `slack` voxels
  * on each side, clamped to the map: the same conversion as occ_geom_key_of (slack 0: exactly
  * the keys of lo_m and hi_m). False when the interval misses the map or is empty / NaN. */
-bool occ_geom_key_range(const occ_map_t *m, float lo_m, float hi_m, occ_real_t slack,
-                        uint32_t *lo, uint32_t *hi);
+bool occi_geom_key_range(const occ_map_t *m, float lo_m, float hi_m, occ_real_t slack,
+                         uint32_t *lo, uint32_t *hi);
 
 /* Shortest decimal (as a double, OCC_RAY_DOUBLE) that rounds to the float r > 0. */
-double occ_geom_decimal(float r);
+double occi_geom_decimal(float r);
 /* Set the map's geometry fields from cfg.resolution_m (occ_map_init). */
-void occ_geom_init(occ_map_t *m);
+void occi_geom_init(occ_map_t *m);
 
 /* ---- 3D-DDA (Amanatides & Woo, as OctoMap) ---------------------------------------------------
  * The set-up both walks share: from the origin o (in voxel key[]) along the float unit vector

@@ -5,8 +5,8 @@
  */
 #include "coarse_internal.h"
 
-void occ_coarse_need(const occ_code_t *const codes, const size_t n, const unsigned level,
-                     const unsigned depth, uint64_t *const inner, uint64_t *const leaf)
+void occi_coarse_need(const occ_code_t *const codes, const size_t n, const unsigned level,
+                      const unsigned depth, uint64_t *const inner, uint64_t *const leaf)
 {
     /* Neighbours in sorted order whose highest differing bit is in level j's bits: their paths
      * part at level j, so nodes at level l = 1 + pairs parting at j >= l. */
@@ -75,12 +75,12 @@ static void apply_subtree(occ_map_t *const m, const uint32_t block, const unsign
             for (unsigned i = 0; i < 8u; i++) {
                 b->value[i] = occ_value_apply_delta(m, b->value[i], delta);
             }
-            (void)occ_tree_refresh(m, nd, 1u);
+            (void)occi_tree_refresh(m, nd, 1u);
             sp--;
             continue;
         }
         if (stack[t].next == 8u) {
-            (void)occ_tree_refresh(m, nd, stack[t].level);
+            (void)occi_tree_refresh(m, nd, stack[t].level);
             sp--;
             continue;
         }
@@ -105,12 +105,12 @@ static void refresh_path(occ_map_t *const m, const uint32_t *const blk, const oc
 {
     for (unsigned l = from; l <= to; l++) {
         const occ_nodep_t nd = node_at(m, blk[l], l < depth ? occ_code_slot(c, l + 1u) : 0u);
-        (void)occ_tree_refresh(m, nd, l);
+        (void)occi_tree_refresh(m, nd, l);
     }
 }
 
-size_t occ_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, const size_t n,
-                        const unsigned level, const occ_value_t delta)
+size_t occi_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, const size_t n,
+                         const unsigned level, const occ_value_t delta)
 {
     const unsigned depth = m->cfg.depth_levels;
     if (n > 0u) {
@@ -133,7 +133,7 @@ size_t occ_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, const
         for (unsigned l = start; l > level; l--) {
             const occ_nodep_t nd = node_at(m, blk[l], l < depth ? occ_code_slot(c, l + 1u) : 0u);
             if (*nd.child == OCC_NONE) {
-                occ_tree_expand(m, nd, l);
+                occi_tree_expand(m, nd, l);
             }
             blk[l - 1u] = *nd.child;
         }

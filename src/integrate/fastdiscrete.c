@@ -16,10 +16,10 @@ static void mark_coarse(occ_ictx_t *const x, const uint32_t k[3])
     }
 }
 
-void occ_fast_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+void occi_fast_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 {
     const float step = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << x->cd));
-    const float len = (float)occ_raygeo_dist(x->o, e);
+    const float len = (float)occi_raygeo_dist(x->o, e);
     float u[3] = {0.0f, 0.0f, 0.0f};
     if (len > 0.0f) {
         for (unsigned i = 0; i < 3u; i++) {
@@ -64,18 +64,18 @@ void occ_fast_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
         }
     }
     uint32_t ks[3];
-    if (!occ_raygeo_key(&x->g, s, ks)) {
+    if (!occi_raygeo_key(&x->g, s, ks)) {
         return;
     }
     if (x->bs != NULL) {
-        x->r->voxel_visits += occ_dda_mark(&x->g, s, e, ks, ke, x->bs);
+        x->r->voxel_visits += occi_dda_mark(&x->g, s, e, ks, ke, x->bs);
         return;
     }
-    if (!occ_ictx_reserve(x, occ_dda_bound(ks, ke))) {
+    if (!occi_ictx_reserve(x, occi_dda_bound(ks, ke))) {
         x->cbs->overflow = true; /* reported as out of scratch by the caller */
         return;
     }
-    const size_t m = occ_dda_codes(&x->g, s, e, ks, ke, x->a + x->n, x->cap - x->n);
+    const size_t m = occi_dda_codes(&x->g, s, e, ks, ke, x->a + x->n, x->cap - x->n);
     x->r->voxel_visits += m;
     x->n += m;
 }

@@ -44,7 +44,7 @@ size_t occ_insert_scratch_bytes(const occ_map_t *const map, const size_t n_point
     }
     const float res = map->cfg.resolution_m;
     const float edge = (float)((uint32_t)1 << map->cfg.depth_levels);
-    float cells = isfinite(max_ray_m) && max_ray_m > 0.0f ? ceilf(max_ray_m / res) : edge;
+    float cells = occ_finite(max_ray_m) && max_ray_m > 0.0f ? ceilf(max_ray_m / res) : edge;
     if (!(cells < edge)) {
         cells = edge;
     }
@@ -62,10 +62,10 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_
         return 0;
     }
     occ_raygeo_t g;
-    occ_raygeo_init(&g, map);
+    occi_raygeo_init(&g, map);
     const float o[3] = {origin->x, origin->y, origin->z};
     uint32_t ko[3];
-    if (!occ_raygeo_key(&g, o, ko)) {
+    if (!occi_raygeo_key(&g, o, ko)) {
         return OCC_INSERT_SCRATCH_FIXED_BYTES;
     }
     const bool fast = params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u &&
@@ -75,14 +75,14 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_
     for (size_t i = 0; i < n_points; i++) {
         float p[3] = {points[i].x, points[i].y, points[i].z};
         if (params->max_range_m > 0.0f &&
-            occ_raygeo_dist(o, p) > (occ_rr_t)params->max_range_m) {
+            occi_raygeo_dist(o, p) > (occ_rr_t)params->max_range_m) {
             float c[3];
-            occ_raygeo_clip(o, p, params->max_range_m, c);
+            occi_raygeo_clip(o, p, params->max_range_m, c);
             memcpy(p, c, sizeof p);
         }
         uint32_t k[3];
-        if (occ_raygeo_key(&g, p, k)) {
-            const size_t b = occ_dda_bound(ko, k);
+        if (occi_raygeo_key(&g, p, k)) {
+            const size_t b = occi_dda_bound(ko, k);
             codes = occ_sat_add(codes, b + 1u);
             samples = occ_sat_add(samples, (b >> params->fast_d) + 2u);
             for (unsigned a = 0; a < 3u; a++) {
@@ -108,14 +108,14 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *const map, const occ_vec3_
 }
 
 /* ---- the insert context -------------------------------------------------------------------- */
-bool occ_ictx_reserve(occ_ictx_t *const x, const size_t need)
+bool occi_ictx_reserve(occ_ictx_t *const x, const size_t need)
 {
     if (x->cap - x->n >= need) {
         return true;
     }
     occ_ictx_note(x, x->n, x->n);
-    occ_code_t *const s = occ_keyset_sort(x->a, x->b, x->n, x->hist);
-    const size_t m = occ_keyset_unique(s, x->n);
+    occ_code_t *const s = occi_keyset_sort(x->a, x->b, x->n, x->hist);
+    const size_t m = occi_keyset_unique(s, x->n);
     if (s != x->a) {
         memcpy(x->a, s, m * sizeof *s);
     }
@@ -128,19 +128,20 @@ static inline size_t filt_slot(const occ_code_t c)
     return (size_t)((c * 0x9E3779B97F4A7C15ull) >> (64u - OCC_INSERT_FILTER_BITS));
 }
 
-void occ_ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+/* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
+static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 {
     if (x->cbs != NULL) {
-        occ_fast_ray(x, e, ke);
+        occi_fast_ray(x, e, ke);
         return;
     }
     if (x->bs != NULL) {
-        x->r->voxel_visits += occ_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
+        x->r->voxel_visits += occi_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
         x->r->rays_cast++;
         return;
     }
     occ_code_t *const base = x->a + x->n;
-    const size_t m = occ_dda_codes(&x->g, x->o, e, x->ko, ke, base, x->cap - x->n);
+    const size_t m = occi_dda_codes(&x->g, x->o, e, x->ko, ke, base, x->cap - x->n);
     x->r->voxel_visits += m;
     x->r->rays_cast++;
     occ_code_t *const filt = x->filt;
@@ -156,32 +157,32 @@ void occ_ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
     x->n += w;
 }
 
-int occ_ictx_point(occ_ictx_t *const x, const float p[3])
+int occi_ictx_point(occ_ictx_t *const x, const float p[3])
 {
-    if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) {
+    if (!occ_finite(p[0]) || !occ_finite(p[1]) || !occ_finite(p[2])) {
         return 1;
     }
     uint32_t ke[3];
-    if (x->max_range > 0.0f && occ_raygeo_dist(x->o, p) > x->max_range_r) {
+    if (x->max_range > 0.0f && occi_raygeo_dist(x->o, p) > x->max_range_r) {
         float e[3];
-        occ_raygeo_clip(x->o, p, x->max_range, e);
-        if (!occ_raygeo_key(&x->g, e, ke)) {
+        occi_raygeo_clip(x->o, p, x->max_range, e);
+        if (!occi_raygeo_key(&x->g, e, ke)) {
             return 1;
         }
-        if (x->bs == NULL && !occ_ictx_reserve(x, occ_dda_bound(x->ko, ke))) {
+        if (x->bs == NULL && !occi_ictx_reserve(x, occi_dda_bound(x->ko, ke))) {
             return -1;
         }
-        occ_ictx_ray(x, e, ke);
+        ictx_ray(x, e, ke);
         x->r->rays_clipped++;
         return 0;
     }
-    if (!occ_raygeo_key(&x->g, p, ke)) {
+    if (!occi_raygeo_key(&x->g, p, ke)) {
         return 1;
     }
-    if (!occ_ictx_reserve(x, (x->bs == NULL ? occ_dda_bound(x->ko, ke) : 0u) + 1u)) {
+    if (!occi_ictx_reserve(x, (x->bs == NULL ? occi_dda_bound(x->ko, ke) : 0u) + 1u)) {
         return -1;
     }
-    occ_ictx_ray(x, p, ke);
+    ictx_ray(x, p, ke);
     const occ_key_t k = {{ke[0], ke[1], ke[2]}};
     const occ_code_t c = occ_morton_encode(k);
     if (x->bs == NULL) {
@@ -203,7 +204,7 @@ static size_t discretize(occ_ictx_t *const x, const occ_vec3_t *const points, co
     for (size_t i = 0; i < n; i++) {
         const float p[3] = {points[i].x, points[i].y, points[i].z};
         uint32_t k[3];
-        if (occ_raygeo_key(&x->g, p, k)) { /* also rejects NaN / Inf */
+        if (occi_raygeo_key(&x->g, p, k)) { /* also rejects NaN / Inf */
             if (k[0] < x->box_lo[0] || k[1] < x->box_lo[1] || k[2] < x->box_lo[2] ||
                 k[0] > x->box_hi[0] || k[1] > x->box_hi[1] || k[2] > x->box_hi[2]) {
                 /* beyond max range: its centre's ray is clipped, the box holds the clip */
@@ -221,7 +222,7 @@ static size_t discretize(occ_ictx_t *const x, const occ_vec3_t *const points, co
     /* a and b are still empty: use them as the sort's buffers. Keys outside the box carry
      * bit 63 (ignored by the sort); they are rare and may repeat, which only repeats a ray. */
     occ_ictx_note(x, m, 0);
-    occ_code_t *const s = occ_keyset_sort(ends, x->a, m, x->hist);
+    occ_code_t *const s = occi_keyset_sort(ends, x->a, m, x->hist);
     size_t u = 0;
     for (size_t i = 0; i < m; i++) {
         if (u == 0u || s[i] != ends[u - 1u] || (s[i] >> 63) != 0u) {
@@ -244,9 +245,9 @@ static int run_discrete(occ_ictx_t *const x, const occ_code_t *const ends, const
             k.k[1] = x->box_lo[1] + (uint32_t)((ends[i] / bx) % by);
             k.k[2] = x->box_lo[2] + (uint32_t)(ends[i] / bx / by);
         }
-        const float c[3] = {occ_raygeo_center(&x->g, k.k[0]), occ_raygeo_center(&x->g, k.k[1]),
-                            occ_raygeo_center(&x->g, k.k[2])};
-        const int rc = occ_ictx_point(x, c);
+        const float c[3] = {occi_raygeo_center(&x->g, k.k[0]), occi_raygeo_center(&x->g, k.k[1]),
+                            occi_raygeo_center(&x->g, k.k[2])};
+        const int rc = occi_ictx_point(x, c);
         if (rc < 0) {
             return rc;
         }
@@ -265,7 +266,7 @@ static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const para
     case OCC_INSERT_SIMPLE:
         for (size_t i = 0; i < n_points && rc >= 0; i++) {
             const float q[3] = {points[i].x, points[i].y, points[i].z};
-            rc = occ_ictx_point(x, q);
+            rc = occi_ictx_point(x, q);
             if (rc == 0) {
                 r->points_integrated++;
             } else if (rc > 0) {
@@ -282,7 +283,7 @@ static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const para
         return run_discrete(x, ends, u);
     }
     case OCC_INSERT_SUPER_RAYS:
-        return occ_superray_run(x, points, n_points, params->super_k) ? 0 : -1;
+        return occi_superray_run(x, points, n_points, params->super_k) ? 0 : -1;
     default:
         return -1;
     }
@@ -295,17 +296,17 @@ static size_t box_bricks(occ_ictx_t *const x, const occ_vec3_t *const points,
 {
     uint32_t lo[3] = {x->ko[0], x->ko[1], x->ko[2]}, hi[3] = {x->ko[0], x->ko[1], x->ko[2]};
     for (size_t i = 0; i < n; i++) {
-        float q[3] = {points[i].x, points[i].y, points[i].z};
-        if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
+        if (!occ_finite3(points[i])) {
             continue;
         }
-        if (x->max_range > 0.0f && occ_raygeo_dist(x->o, q) > x->max_range_r) {
+        float q[3] = {points[i].x, points[i].y, points[i].z};
+        if (x->max_range > 0.0f && occi_raygeo_dist(x->o, q) > x->max_range_r) {
             float c[3];
-            occ_raygeo_clip(x->o, q, x->max_range, c);
+            occi_raygeo_clip(x->o, q, x->max_range, c);
             memcpy(q, c, sizeof q);
         }
         uint32_t k[3];
-        if (!occ_raygeo_key(&x->g, q, k)) {
+        if (!occi_raygeo_key(&x->g, q, k)) {
             continue;
         }
         for (unsigned a = 0; a < 3u; a++) {
@@ -341,13 +342,13 @@ static bool coarse_fits(occ_map_t *const map, const occ_vec3_t *const origin,
     if (n_inner > OCC_NONE || n_leaf > OCC_NONE) {
         return false;
     }
-    if (occ_pool_can_supply(map, (uint32_t)n_inner, (uint32_t)n_leaf)) {
+    if (occi_pool_can_supply(map, (uint32_t)n_inner, (uint32_t)n_leaf)) {
         return true;
     }
     return params->auto_evict != NULL &&
            occ_map_evict_for(map, origin, params->auto_evict, (uint32_t)n_inner,
                              (uint32_t)n_leaf, params->auto_evict_state) == OCC_OK &&
-           occ_pool_can_supply(map, (uint32_t)n_inner, (uint32_t)n_leaf);
+           occi_pool_can_supply(map, (uint32_t)n_inner, (uint32_t)n_leaf);
 }
 
 /* FAST_DISCRETE: the coarse nodes' codes (in `spare`), a capacity check covering them and the
@@ -363,7 +364,7 @@ static occ_err_t apply_coarse(occ_ictx_t *const x, occ_bitset_t *const cbs,
     if (spare_cap < cbs->n_touched) {
         return OCC_ERR_SCRATCH;
     }
-    const size_t nc = occ_bitset_extract(cbs, NULL, 0, spare, spare_cap, spare, x->hist);
+    const size_t nc = occi_bitset_extract(cbs, NULL, 0, spare, spare_cap, spare, x->hist);
     if (nc == SIZE_MAX) {
         return OCC_ERR_SCRATCH;
     }
@@ -372,14 +373,14 @@ static occ_err_t apply_coarse(occ_ictx_t *const x, occ_bitset_t *const cbs,
         spare[i] <<= 3u * d; /* the node's first voxel */
     }
     uint64_t ci, cl, fi, fl;
-    occ_coarse_need(spare, nc, d, map->cfg.depth_levels, &ci, &cl);
-    occ_coarse_need(fine, nf, 0, map->cfg.depth_levels, &fi, &fl);
+    occi_coarse_need(spare, nc, d, map->cfg.depth_levels, &ci, &cl);
+    occi_coarse_need(fine, nf, 0, map->cfg.depth_levels, &fi, &fl);
     if (!coarse_fits(map, origin, params, ci + fi, cl + fl)) {
         map->oom_count++;
         return OCC_ERR_NOMEM;
     }
     const float delta = map->cfg.miss / (float)(2u * d + 1u);
-    (void)occ_coarse_apply(map, spare, nc, d, occ_value_from_logodds(delta));
+    (void)occi_coarse_apply(map, spare, nc, d, occ_value_from_logodds(delta));
     x->r->coarse_updated = nc;
     return OCC_OK;
 }
@@ -453,12 +454,12 @@ static occ_err_t collapse_and_apply(occ_ictx_t *const x, const occ_insert_params
             return OCC_ERR_SCRATCH;
         }
         occ_ictx_note(x, 0, x->n > bs->n_touched ? x->n : bs->n_touched);
-        occ_code_t *const hs = occ_keyset_sort(x->a, x->b, x->n, x->hist);
-        const size_t nh = occ_keyset_unique(hs, x->n);
+        occ_code_t *const hs = occi_keyset_sort(x->a, x->b, x->n, x->hist);
+        const size_t nh = occi_keyset_unique(hs, x->n);
         if (hs != x->a) {
             memcpy(x->a, hs, nh * sizeof *hs);
         }
-        m = occ_bitset_extract(bs, x->a, nh, x->b, x->b_cap, x->b, x->hist);
+        m = occi_bitset_extract(bs, x->a, nh, x->b, x->b_cap, x->b, x->hist);
         if (m == SIZE_MAX) {
             occ_ictx_note(x, 0, x->b_cap);
             return OCC_ERR_SCRATCH;
@@ -469,8 +470,8 @@ static occ_err_t collapse_and_apply(occ_ictx_t *const x, const occ_insert_params
         spare_cap = x->b_cap - m;
     } else {
         occ_ictx_note(x, x->n, x->n);
-        codes = occ_keyset_sort(x->a, x->b, x->n, x->hist);
-        m = occ_keyset_unique(codes, x->n);
+        codes = occi_keyset_sort(x->a, x->b, x->n, x->hist);
+        m = occi_keyset_unique(codes, x->n);
         spare = codes == x->a ? x->b : x->a;
         spare_cap = x->cap;
     }
@@ -536,6 +537,7 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
                                const size_t scratch_bytes, occ_insert_result_t *const out)
 {
     occ_insert_result_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_insert_result_t *const r = out != NULL ? out : &local;
     memset(r, 0, sizeof *r);
     if (map == NULL || origin == NULL || params == NULL || (points == NULL && n_points > 0u) ||
@@ -547,18 +549,18 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         params->fast_d >= map->cfg.depth_levels || isnan(params->max_range_m)) {
         return OCC_ERR_ARG;
     }
-    if (!isfinite(origin->x) || !isfinite(origin->y) || !isfinite(origin->z)) {
+    if (!occ_finite3(*origin)) {
         return OCC_ERR_ARG;
     }
     occ_ictx_t x;
     memset(&x, 0, sizeof x);
     x.map = map;
     x.r = r;
-    occ_raygeo_init(&x.g, map);
+    occi_raygeo_init(&x.g, map);
     x.o[0] = origin->x;
     x.o[1] = origin->y;
     x.o[2] = origin->z;
-    if (!occ_raygeo_key(&x.g, x.o, x.ko)) {
+    if (!occi_raygeo_key(&x.g, x.o, x.ko)) {
         return OCC_ERR_RANGE;
     }
     x.max_range = params->max_range_m > 0.0f ? params->max_range_m : -1.0f;

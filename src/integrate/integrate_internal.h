@@ -20,35 +20,24 @@ typedef struct {
     uint8_t depth;     /* D */
 } occ_raygeo_t;
 
-void occ_raygeo_init(occ_raygeo_t *g, const occ_map_t *map);
-/* Key of one coordinate; false when NaN/Inf or outside [0, 2^D). */
-bool occ_raygeo_key1(const occ_raygeo_t *g, float c, uint32_t *k);
+void occi_raygeo_init(occ_raygeo_t *g, const occ_map_t *map);
 /* Key of a point (all three axes valid). */
-bool occ_raygeo_key(const occ_raygeo_t *g, const float p[3], uint32_t k[3]);
+bool occi_raygeo_key(const occ_raygeo_t *g, const float p[3], uint32_t k[3]);
 /* Centre coordinate of key k, as OctoMap's float(keyToCoord(k)). */
-float occ_raygeo_center(const occ_raygeo_t *g, uint32_t k);
+float occi_raygeo_center(const occ_raygeo_t *g, uint32_t k);
 /* OctoMap's |p - o| (float squares, double sqrt when OCC_RAY_DOUBLE). */
-occ_rr_t occ_raygeo_dist(const float o[3], const float p[3]);
+occ_rr_t occi_raygeo_dist(const float o[3], const float p[3]);
 /* OctoMap's origin + normalized(p - o) * (float)range. */
-void occ_raygeo_clip(const float o[3], const float p[3], float range, float out[3]);
+void occi_raygeo_clip(const float o[3], const float p[3], float range, float out[3]);
 
-/* What the DDA decides with: OctoMap's float direction and length, tMax / tDelta per axis. */
-typedef struct {
-    occ_rr_t tmax[3], tdelta[3];
-    int32_t step[3];
-    float length;
-} occ_dda_param_t;
-void occ_dda_setup(const occ_raygeo_t *g, const float o[3], const float e[3], const uint32_t ko[3],
-                   occ_dda_param_t *out);
-
-/* Upper bound of the codes occ_dda_codes() writes for keys ko -> ke. */
-size_t occ_dda_bound(const uint32_t ko[3], const uint32_t ke[3]);
+/* Upper bound of the codes occi_dda_codes() writes for keys ko -> ke. */
+size_t occi_dda_bound(const uint32_t ko[3], const uint32_t ke[3]);
 
 /* computeRayKeys(o, e) as Morton codes: the origin's code first, the end's excluded, nothing
  * when ko == ke. Writes at most `cap` codes; returns the count (which may exceed cap). ko/ke
  * must be the keys of o/e. */
-size_t occ_dda_codes(const occ_raygeo_t *g, const float o[3], const float e[3],
-                     const uint32_t ko[3], const uint32_t ke[3], occ_code_t *out, size_t cap);
+size_t occi_dda_codes(const occ_raygeo_t *g, const float o[3], const float e[3],
+                      const uint32_t ko[3], const uint32_t ke[3], occ_code_t *out, size_t cap);
 
 /* Dilated (Morton) +-1 along axis `dim`. */
 static inline occ_code_t occ_code_step(occ_code_t c, unsigned dim, int step)
@@ -66,14 +55,14 @@ static inline occ_code_t occ_code_step(occ_code_t c, unsigned dim, int step)
 
 /* Stable LSD radix sort of a[0..n) by bits 0..62 (bit 63, the hit flag, is carried along),
  * using tmp[n] and hist[OCC_KS_HIST_WORDS]; n < 2^32. Returns a or tmp: where the result is. */
-occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, size_t n, uint32_t *hist);
+occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, size_t n, uint32_t *hist);
 /* The same sort of keys k[0..n) (bits 0..62) carrying v[]; tk/tv are the temporaries. Returns
  * the key array holding the result; its values are in v if it is k, else in tv. */
-uint64_t *occ_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t *tv, size_t n,
-                                uint32_t *hist);
+uint64_t *occi_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t *tv, size_t n,
+                                 uint32_t *hist);
 /* Collapse runs of equal codes (bits 0..62) of a sorted array to one entry whose hit bit is the
  * OR of the run's. Returns the new length. */
-size_t occ_keyset_unique(occ_code_t *a, size_t n);
+size_t occi_keyset_unique(occ_code_t *a, size_t n);
 
 /* ---- dense per-scan voxel set over the scan's bounding box (keyset.c, raycast.c) -------------
  * One 64-bit word per 4x4x4-voxel brick aligned to absolute keys, so a brick's voxels are the
@@ -116,7 +105,7 @@ static inline unsigned occ_brick_bit(uint32_t kx, uint32_t ky, uint32_t kz)
 }
 
 /* Morton interleave of the low 5 bits of a key for one axis (shift by the axis). */
-extern const uint16_t occ_spread5[32];
+extern const uint16_t occi_spread5[32];
 
 /* Add voxel (kx, ky, kz); false when it is outside the box. */
 static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, uint32_t kz)
@@ -126,8 +115,8 @@ static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, ui
     if (cx >= (bs->nb[0] >> 3) || cy >= (bs->nb[1] >> 3) || cz >= (bs->nb[2] >> 3)) {
         return false;
     }
-    const uint32_t local = (uint32_t)occ_spread5[kx & 31u] | ((uint32_t)occ_spread5[ky & 31u] << 1) |
-                           ((uint32_t)occ_spread5[kz & 31u] << 2);
+    const uint32_t local = (uint32_t)occi_spread5[kx & 31u] | ((uint32_t)occi_spread5[ky & 31u] << 1) |
+                           ((uint32_t)occi_spread5[kz & 31u] << 2);
     const size_t idx = (((size_t)cx + bs->stride_y * cy + bs->stride_z * cz) << 9) | (local >> 6);
     const uint64_t bit = (uint64_t)1 << (local & 63u);
     const uint64_t w = bs->words[idx];
@@ -143,14 +132,14 @@ static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, ui
 
 /* computeRayKeys(o, e) into the set; returns the visits. Sets bs->overflow and stops when a
  * voxel is outside the box. */
-size_t occ_dda_mark(const occ_raygeo_t *g, const float o[3], const float e[3],
-                    const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *bs);
+size_t occi_dda_mark(const occ_raygeo_t *g, const float o[3], const float e[3],
+                     const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *bs);
 
 /* Sorted, collapsed codes of the set merged with `hits` (sorted, unique, hit bit set): a voxel
  * in both is a hit. Writes to out (cap codes); returns the count, or SIZE_MAX when cap is too
  * small. tmp must hold n_touched codes. The touched list is reordered. */
-size_t occ_bitset_extract(occ_bitset_t *bs, const occ_code_t *hits, size_t n_hits,
-                          occ_code_t *out, size_t cap, occ_code_t *tmp, uint32_t *hist);
+size_t occi_bitset_extract(occ_bitset_t *bs, const occ_code_t *hits, size_t n_hits,
+                           occ_code_t *out, size_t cap, occ_code_t *tmp, uint32_t *hist);
 
 /* ---- one insert call (integrate.c); superray.c and fastdiscrete.c add rays through it ----- */
 typedef struct {
@@ -181,9 +170,7 @@ static inline void occ_ictx_note(occ_ictx_t *x, size_t na, size_t nb)
 }
 
 /* Make room for `need` more codes in a (sorting and collapsing what is there if needed). */
-bool occ_ictx_reserve(occ_ictx_t *x, size_t need);
-/* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
-void occ_ictx_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
+bool occi_ictx_reserve(occ_ictx_t *x, size_t need);
 /* Emit one voxel code (free, or hit with OCC_CODE_HIT_BIT); room must have been reserved. */
 static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
 {
@@ -191,16 +178,16 @@ static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
 }
 
 /* FAST_DISCRETE's ray (fastdiscrete.c): coarse marching, then fine DDA near the end. */
-void occ_fast_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
+void occi_fast_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
 
 /* One point as OctoMap's computeUpdate() treats it: max range, keys, ray, hit.
  * Returns 0 (integrated), 1 (bad point, skipped) or -1 (no scratch). */
-int occ_ictx_point(occ_ictx_t *x, const float p[3]);
+int occi_ictx_point(occ_ictx_t *x, const float p[3]);
 
 /* SUPER_RAYS (superray.c): integrate the valid points whose end voxel codes are ends[0..n)
- * (sorted, bit 63 clear) - equal result to occ_ictx_point() on each. `work` has work_cap codes.
+ * (sorted, bit 63 clear) - equal result to occi_ictx_point() on each. `work` has work_cap codes.
  * Returns false when scratch ran out. */
-bool occ_superray_run(occ_ictx_t *x, const occ_vec3_t *points, size_t n_points,
-                      uint16_t k_min);
+bool occi_superray_run(occ_ictx_t *x, const occ_vec3_t *points, size_t n_points,
+                       uint16_t k_min);
 
 #endif

@@ -45,7 +45,7 @@ static uint32_t *pass_offsets(uint32_t *const hist, const unsigned p, const occ_
     return h;
 }
 
-occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint32_t *const hist)
+occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint32_t *const hist)
 {
     if (n < 2u) {
         return a;
@@ -69,7 +69,7 @@ occ_code_t *occ_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint
     return a;
 }
 
-size_t occ_keyset_unique(occ_code_t *const a, const size_t n)
+size_t occi_keyset_unique(occ_code_t *const a, const size_t n)
 {
     if (n == 0u) {
         return 0;
@@ -86,7 +86,7 @@ size_t occ_keyset_unique(occ_code_t *const a, const size_t n)
     return w + 1u;
 }
 
-const uint16_t occ_spread5[32] = {
+const uint16_t occi_spread5[32] = {
     0x0000, 0x0001, 0x0008, 0x0009, 0x0040, 0x0041, 0x0048, 0x0049, 0x0200, 0x0201, 0x0208,
     0x0209, 0x0240, 0x0241, 0x0248, 0x0249, 0x1000, 0x1001, 0x1008, 0x1009, 0x1040, 0x1041,
     0x1048, 0x1049, 0x1200, 0x1201, 0x1208, 0x1209, 0x1240, 0x1241, 0x1248, 0x1249};
@@ -96,9 +96,9 @@ static uint32_t compact3b(const uint32_t v)
     return (v & 1u) | ((v >> 2) & 2u) | ((v >> 4) & 4u);
 }
 
-size_t occ_bitset_extract(occ_bitset_t *const bs, const occ_code_t *const hits,
-                          const size_t n_hits, occ_code_t *const out, const size_t cap,
-                          occ_code_t *const tmp, uint32_t *const hist)
+size_t occi_bitset_extract(occ_bitset_t *const bs, const occ_code_t *const hits,
+                           const size_t n_hits, occ_code_t *const out, const size_t cap,
+                           occ_code_t *const tmp, uint32_t *const hist)
 {
     /* Brick codes in place of the word indices, sorted. */
     uint64_t *const t = bs->touched;
@@ -114,7 +114,7 @@ size_t occ_bitset_extract(occ_bitset_t *const bs, const occ_code_t *const hits,
         bk.k[2] = bs->b0[2] + (uint32_t)(chunk / (ncx * ncy)) * 8u + compact3b(in >> 2);
         t[i] = occ_morton_encode(bk);
     }
-    occ_code_t *const s = occ_keyset_sort(t, tmp, nt, hist);
+    occ_code_t *const s = occi_keyset_sort(t, tmp, nt, hist);
     if (s != t) {
         memcpy(t, s, nt * sizeof *t);
     }
@@ -154,8 +154,8 @@ size_t occ_bitset_extract(occ_bitset_t *const bs, const occ_code_t *const hits,
     return n;
 }
 
-uint64_t *occ_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t *tv,
-                                const size_t n, uint32_t *const hist)
+uint64_t *occi_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t *tv,
+                                 const size_t n, uint32_t *const hist)
 {
     if (n < 2u) {
         return k;

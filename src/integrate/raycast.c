@@ -9,7 +9,7 @@
 
 #include "integrate_internal.h"
 
-void occ_raygeo_init(occ_raygeo_t *const g, const occ_map_t *const map)
+void occi_raygeo_init(occ_raygeo_t *const g, const occ_map_t *const map)
 {
     g->depth = map->cfg.depth_levels;
     g->tmv = (int32_t)1 << (g->depth - 1u);
@@ -18,23 +18,24 @@ void occ_raygeo_init(occ_raygeo_t *const g, const occ_map_t *const map)
     g->rf = occ_geom_inv(map);
 }
 
-bool occ_raygeo_key1(const occ_raygeo_t *const g, const float c, uint32_t *const k)
+/* Key of one coordinate; false when NaN/Inf or outside [0, 2^D). */
+static bool raygeo_key1(const occ_raygeo_t *const g, const float c, uint32_t *const k)
 {
     return occ_geom_key_of(g->rf, g->tmv, c, k);
 }
 
-bool occ_raygeo_key(const occ_raygeo_t *const g, const float p[3], uint32_t k[3])
+bool occi_raygeo_key(const occ_raygeo_t *const g, const float p[3], uint32_t k[3])
 {
-    return occ_raygeo_key1(g, p[0], &k[0]) && occ_raygeo_key1(g, p[1], &k[1]) &&
-           occ_raygeo_key1(g, p[2], &k[2]);
+    return raygeo_key1(g, p[0], &k[0]) && raygeo_key1(g, p[1], &k[1]) &&
+           raygeo_key1(g, p[2], &k[2]);
 }
 
-float occ_raygeo_center(const occ_raygeo_t *const g, const uint32_t k)
+float occi_raygeo_center(const occ_raygeo_t *const g, const uint32_t k)
 {
     return (float)occ_geom_center_of(g->res, g->tmv, k, 0u);
 }
 
-occ_rr_t occ_raygeo_dist(const float o[3], const float p[3])
+occ_rr_t occi_raygeo_dist(const float o[3], const float p[3])
 {
     const float dx = p[0] - o[0], dy = p[1] - o[1], dz = p[2] - o[2];
     const float nsq = dx * dx + dy * dy + dz * dz;
@@ -45,10 +46,10 @@ occ_rr_t occ_raygeo_dist(const float o[3], const float p[3])
 #endif
 }
 
-void occ_raygeo_clip(const float o[3], const float p[3], const float range, float out[3])
+void occi_raygeo_clip(const float o[3], const float p[3], const float range, float out[3])
 {
     float d[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
-    const occ_rr_t len = occ_raygeo_dist(o, p);
+    const occ_rr_t len = occi_raygeo_dist(o, p);
     if (len > (occ_rr_t)0) {
         const float lf = (float)len;
         d[0] /= lf;
@@ -60,7 +61,7 @@ void occ_raygeo_clip(const float o[3], const float p[3], const float range, floa
     }
 }
 
-size_t occ_dda_bound(const uint32_t ko[3], const uint32_t ke[3])
+size_t occi_dda_bound(const uint32_t ko[3], const uint32_t ke[3])
 {
     size_t n = 4u;
     for (unsigned i = 0; i < 3u; i++) {
@@ -85,7 +86,7 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
                             const float e[3], const uint32_t ko[3], const uint32_t ke[3])
 {
     float d[3] = {e[0] - o[0], e[1] - o[1], e[2] - o[2]};
-    s->length = (float)occ_raygeo_dist(o, e);
+    s->length = (float)occi_raygeo_dist(o, e);
     d[0] /= s->length;
     d[1] /= s->length;
     d[2] /= s->length;
@@ -101,20 +102,7 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
     const occ_key_t k0 = {{ko[0], ko[1], ko[2]}};
     s->c = occ_morton_encode(k0);
     s->kmax = 2 * g->tmv;
-    s->limit = occ_dda_bound(ko, ke);
-}
-
-void occ_dda_setup(const occ_raygeo_t *const g, const float o[3], const float e[3],
-                   const uint32_t ko[3], occ_dda_param_t *const out)
-{
-    dda_t s;
-    dda_init(&s, g, o, e, ko, ko);
-    for (unsigned i = 0; i < 3u; i++) {
-        out->tmax[i] = s.tmax[i];
-        out->tdelta[i] = s.tdelta[i];
-        out->step[i] = s.step[i];
-    }
-    out->length = s.length;
+    s->limit = occi_dda_bound(ko, ke);
 }
 
 /* The hot loop, with the state in scalars so that it stays in registers. EMIT(kx, ky, kz) is
@@ -157,9 +145,9 @@ void occ_dda_setup(const occ_raygeo_t *const g, const float o[3], const float e[
         }                                                                                         \
     } while (0)
 
-size_t occ_dda_codes(const occ_raygeo_t *const g, const float o[3], const float e[3],
-                     const uint32_t ko[3], const uint32_t ke[3], occ_code_t *const out,
-                     const size_t cap)
+size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float e[3],
+                      const uint32_t ko[3], const uint32_t ke[3], occ_code_t *const out,
+                      const size_t cap)
 {
     if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
         return 0;
@@ -208,8 +196,8 @@ size_t occ_dda_codes(const occ_raygeo_t *const g, const float o[3], const float 
         }                                                                                         \
     } while (0)
 
-size_t occ_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
-                    const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *const bs)
+size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
+                     const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *const bs)
 {
     if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
         return 0;
@@ -227,8 +215,8 @@ size_t occ_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e
         cc[a] = (ko[a] >> 5) - (bs->b0[a] >> 3);
     }
     size_t chunk = cc[0] + stride[1] * cc[1] + stride[2] * cc[2];
-    uint32_t local = (uint32_t)occ_spread5[ko[0] & 31u] | ((uint32_t)occ_spread5[ko[1] & 31u] << 1) |
-                     ((uint32_t)occ_spread5[ko[2] & 31u] << 2);
+    uint32_t local = (uint32_t)occi_spread5[ko[0] & 31u] | ((uint32_t)occi_spread5[ko[1] & 31u] << 1) |
+                     ((uint32_t)occi_spread5[ko[2] & 31u] << 2);
     uint64_t *const words = bs->words;
     size_t n = 1;
     occ_rr_t t0 = s.tmax[0], t1 = s.tmax[1], t2 = s.tmax[2];
@@ -286,10 +274,6 @@ size_t occ_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */
-static bool finite3(const occ_vec3_t p)
-{
-    return isfinite(p.x) && isfinite(p.y) && isfinite(p.z);
-}
 
 size_t occ_ray_max_keys(const occ_map_t *const map, const occ_vec3_t origin, const occ_vec3_t end)
 {
@@ -297,14 +281,14 @@ size_t occ_ray_max_keys(const occ_map_t *const map, const occ_vec3_t origin, con
         return 0;
     }
     occ_raygeo_t g;
-    occ_raygeo_init(&g, map);
+    occi_raygeo_init(&g, map);
     const float o[3] = {origin.x, origin.y, origin.z};
     const float e[3] = {end.x, end.y, end.z};
     uint32_t ko[3], ke[3];
-    if (!occ_raygeo_key(&g, o, ko) || !occ_raygeo_key(&g, e, ke)) {
+    if (!occi_raygeo_key(&g, o, ko) || !occi_raygeo_key(&g, e, ke)) {
         return 0;
     }
-    return occ_dda_bound(ko, ke);
+    return occi_dda_bound(ko, ke);
 }
 
 occ_err_t occ_ray_keys(const occ_map_t *const map, const occ_vec3_t origin, const occ_vec3_t end,
@@ -314,15 +298,15 @@ occ_err_t occ_ray_keys(const occ_map_t *const map, const occ_vec3_t origin, cons
         return OCC_ERR_ARG;
     }
     *n_keys = 0;
-    if (!finite3(origin) || !finite3(end)) {
+    if (!occ_finite3(origin) || !occ_finite3(end)) {
         return OCC_ERR_ARG;
     }
     occ_raygeo_t g;
-    occ_raygeo_init(&g, map);
+    occi_raygeo_init(&g, map);
     const float o[3] = {origin.x, origin.y, origin.z};
     const float e[3] = {end.x, end.y, end.z};
     uint32_t ko[3], ke[3];
-    if (!occ_raygeo_key(&g, o, ko) || !occ_raygeo_key(&g, e, ke)) {
+    if (!occi_raygeo_key(&g, o, ko) || !occi_raygeo_key(&g, e, ke)) {
         return OCC_ERR_RANGE;
     }
     size_t n = 0;

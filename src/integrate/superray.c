@@ -40,7 +40,7 @@ static const unsigned PA[3] = {0u, 0u, 1u}, PB[3] = {1u, 2u, 2u};
 static void cast_one(occ_ictx_t *const x, const occ_vec3_t p, const uint32_t ke[3])
 {
     const float e[3] = {p.x, p.y, p.z};
-    x->r->voxel_visits += occ_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
+    x->r->voxel_visits += occi_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
     x->r->rays_cast++;
 }
 
@@ -137,7 +137,7 @@ static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
         const occ_vec3_t p = points[idx[j]];
         const float e[3] = {p.x, p.y, p.z};
         /* The DDA's direction: float difference, float length, float division. */
-        const float len = (float)occ_raygeo_dist(x->o, e);
+        const float len = (float)occi_raygeo_dist(x->o, e);
         float d[3];
         bool safe = true;
         for (unsigned a = 0; a < 3u; a++) {
@@ -253,7 +253,7 @@ static bool run_voxel(occ_ictx_t *const x, const occ_vec3_t *const points,
                             x->box_lo[1] + (uint32_t)((cell / bx) % by),
                             x->box_lo[2] + (uint32_t)(cell / bx / by)};
     const occ_key_t kk = {{ke[0], ke[1], ke[2]}};
-    if (!occ_ictx_reserve(x, 1u)) {
+    if (!occi_ictx_reserve(x, 1u)) {
         return false;
     }
     occ_ictx_emit(x, occ_morton_encode(kk) | OCC_CODE_HIT_BIT);
@@ -281,7 +281,7 @@ static bool run_single(occ_ictx_t *const x, const occ_vec3_t *const points, cons
 {
     for (size_t i = 0; i < n; i++) {
         const float q[3] = {points[i].x, points[i].y, points[i].z};
-        const int rc = occ_ictx_point(x, q);
+        const int rc = occi_ictx_point(x, q);
         if (rc < 0) {
             return false;
         }
@@ -294,8 +294,8 @@ static bool run_single(occ_ictx_t *const x, const occ_vec3_t *const points, cons
     return true;
 }
 
-bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
-                      const uint16_t k_min)
+bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                       const uint16_t k_min)
 {
     /* Workspace in the dense path's free scratch: end cells and point indices (sorted as
      * pairs), per-bundle rays, edges, signature keys and the signature stamps. */
@@ -322,15 +322,15 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
     const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
-        const float q[3] = {points[i].x, points[i].y, points[i].z};
-        if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
+        if (!occ_finite3(points[i])) {
             x->r->points_skipped++;
             continue;
         }
+        const float q[3] = {points[i].x, points[i].y, points[i].z};
         uint32_t k[3];
-        if ((x->max_range > 0.0f && occ_raygeo_dist(x->o, q) > x->max_range_r) ||
-            !occ_raygeo_key(&x->g, q, k)) {
-            const int rc = occ_ictx_point(x, q); /* clipped ray, or a bad point */
+        if ((x->max_range > 0.0f && occi_raygeo_dist(x->o, q) > x->max_range_r) ||
+            !occi_raygeo_key(&x->g, q, k)) {
+            const int rc = occi_ictx_point(x, q); /* clipped ray, or a bad point */
             if (rc < 0) {
                 return false;
             }
@@ -372,7 +372,7 @@ bool occ_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const
         }
         return true;
     }
-    const uint64_t *const sk = occ_keyset_sort_pairs(keys, vals, tkeys, tvals, m, x->hist);
+    const uint64_t *const sk = occi_keyset_sort_pairs(keys, vals, tkeys, tvals, m, x->hist);
     const uint32_t *const sv = sk == keys ? vals : tvals;
     for (size_t s0 = 0; s0 < m;) {
         size_t e = s0 + 1u;

@@ -52,7 +52,7 @@ static occ_err_t parse_header(occ_cursor_t *const c, parsed_t *const p,
     info->format = p->format;
     occ_err_t e;
     if (p->format == OCC_FORMAT_SNAPSHOT) {
-        e = occ_snap_header_parse(c, &p->snap);
+        e = occi_snap_header_parse(c, &p->snap);
         if (e != OCC_OK) {
             return e;
         }
@@ -60,7 +60,7 @@ static occ_err_t parse_header(occ_cursor_t *const c, parsed_t *const p,
         info->version = OCC_SNAPSHOT_VERSION;
         info->data_offset = OCC_SNAPSHOT_HEADER_BYTES;
     } else if (p->format == OCC_FORMAT_BT || p->format == OCC_FORMAT_OT) {
-        e = occ_om_header_parse(c, &p->om);
+        e = occi_om_header_parse(c, &p->om);
         c->warnings |= p->om.warnings;
         memcpy(info->tree_id, p->om.id, sizeof info->tree_id);
         info->header_nodes = p->om.size;
@@ -105,14 +105,14 @@ static occ_err_t parse_body(occ_cursor_t *const c, const parsed_t *const p, occ_
     occ_err_t e;
     switch (p->format) {
     case OCC_FORMAT_BT:
-        e = occ_bt_parse(c, b, p->om.size, occ_value_from_logodds(model->clamp_min),
-                         occ_value_from_logodds(model->clamp_max));
+        e = occi_bt_parse(c, b, p->om.size, occ_value_from_logodds(model->clamp_min),
+                          occ_value_from_logodds(model->clamp_max));
         break;
     case OCC_FORMAT_OT:
-        e = occ_ot_parse(c, b, p->om.size, p->extra);
+        e = occi_ot_parse(c, b, p->om.size, p->extra);
         break;
     case OCC_FORMAT_SNAPSHOT:
-        e = occ_snap_parse(c, b, &p->snap);
+        e = occi_snap_parse(c, b, &p->snap);
         break;
     case OCC_FORMAT_UNKNOWN:
     default:
@@ -146,7 +146,7 @@ static occ_err_t pass(const void *const buf, const size_t len, const occ_map_con
     occ_build_t b;
     occ_err_t e = parse_header(&c, p, base, info);
     if (e == OCC_OK) {
-        occ_build_begin(&b, map, p->cfg.depth_levels);
+        occi_build_begin(&b, map, p->cfg.depth_levels);
         /* .bt leaves take the clamp bounds of the destination's sensor model. */
         e = parse_body(&c, p, &b, map != NULL ? &map->cfg : base);
         info->nodes = b.nodes;
@@ -188,7 +188,7 @@ occ_err_t occ_io_probe(const void *const buf, const size_t len, const occ_map_co
 static occ_err_t build(occ_map_t *const tmp, const void *const buf, const size_t len,
                        occ_io_info_t *const info)
 {
-    if (!occ_pool_can_supply(tmp, info->peak_inner_blocks, info->peak_leaf_blocks)) {
+    if (!occi_pool_can_supply(tmp, info->peak_inner_blocks, info->peak_leaf_blocks)) {
         info->error = "the map does not fit the arena";
         return OCC_ERR_NOMEM;
     }
@@ -208,6 +208,7 @@ occ_err_t occ_io_load(occ_map_t *const map, const occ_map_config_t *const base_c
                       occ_io_info_t *const info)
 {
     occ_io_info_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_io_info_t *const inf = info != NULL ? info : &local;
     if (map == NULL || arena == NULL) {
         info_reset(inf);
@@ -235,6 +236,7 @@ occ_err_t occ_io_read(occ_map_t *const map, const void *const buf, const size_t 
                       occ_io_info_t *const info)
 {
     occ_io_info_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_io_info_t *const inf = info != NULL ? info : &local;
     if (map == NULL) {
         info_reset(inf);
@@ -266,12 +268,12 @@ uint64_t occ_io_octomap_nodes(const occ_map_t *const map, const occ_format_t for
         return 0u;
     }
     occ_sink_t counter;
-    occ_sink_init(&counter, NULL, NULL);
+    occi_sink_init(&counter, NULL, NULL);
     uint64_t nodes = 0u;
     if (format == OCC_FORMAT_BT) {
-        occ_bt_emit(map, &counter, &nodes);
+        occi_bt_emit(map, &counter, &nodes);
     } else if (format == OCC_FORMAT_OT) {
-        occ_ot_emit(map, &counter, &nodes);
+        occi_ot_emit(map, &counter, &nodes);
     }
     return nodes;
 }
@@ -286,24 +288,24 @@ occ_err_t occ_io_write(const occ_map_t *const map, const occ_format_t format,
         return OCC_ERR_ARG;
     }
     occ_sink_t s;
-    occ_sink_init(&s, fn, ctx);
+    occi_sink_init(&s, fn, ctx);
     occ_err_t e;
     if (format == OCC_FORMAT_SNAPSHOT) {
-        e = occ_snap_write(map, &s);
+        e = occi_snap_write(map, &s);
     } else if (format == OCC_FORMAT_BT || format == OCC_FORMAT_OT) {
         if (map->cfg.depth_levels != OM_DEPTH) {
             return OCC_ERR_UNSUPPORTED;
         }
         const uint64_t nodes = occ_io_octomap_nodes(map, format);
-        e = occ_om_header_write(&s, format, nodes, map->cfg.resolution_m);
+        e = occi_om_header_write(&s, format, nodes, map->cfg.resolution_m);
         if (e == OCC_OK) {
             uint64_t again = 0u;
             if (format == OCC_FORMAT_BT) {
-                occ_bt_emit(map, &s, &again);
+                occi_bt_emit(map, &s, &again);
             } else {
-                occ_ot_emit(map, &s, &again);
+                occi_ot_emit(map, &s, &again);
             }
-            e = occ_sink_flush(&s);
+            e = occi_sink_flush(&s);
         }
     } else {
         return OCC_ERR_ARG;

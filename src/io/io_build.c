@@ -1,7 +1,7 @@
 /*
  * io_build.c - builds a tree from a preorder description, or (map == NULL) counts what that
  * build allocates and frees, so readers can check fit before touching the destination.
- * The dry run prunes exactly when occ_tree_refresh() would: eight childless equal entries.
+ * The dry run prunes exactly when occi_tree_refresh() would: eight childless equal entries.
  */
 #include "io_internal.h"
 
@@ -20,7 +20,7 @@ static void note_alloc(occ_build_t *const b, const unsigned child_level)
     }
 }
 
-void occ_build_begin(occ_build_t *const b, occ_map_t *const map, const unsigned depth_levels)
+void occi_build_begin(occ_build_t *const b, occ_map_t *const map, const unsigned depth_levels)
 {
     b->map = map;
     b->top = (uint8_t)depth_levels;
@@ -34,7 +34,7 @@ void occ_build_begin(occ_build_t *const b, occ_map_t *const map, const unsigned 
     b->nodes = 0u;
 }
 
-void occ_build_root_uniform(occ_build_t *const b, const occ_value_t v)
+void occi_build_root_uniform(occ_build_t *const b, const occ_value_t v)
 {
     b->nodes++;
     b->root_uniform = true;
@@ -50,7 +50,7 @@ void occ_build_root_uniform(occ_build_t *const b, const occ_value_t v)
 static uint32_t new_block(occ_map_t *const m, const unsigned level)
 {
     if (level == 1u) {
-        const uint32_t idx = occ_pool_alloc_leaf(m);
+        const uint32_t idx = occi_pool_alloc_leaf(m);
         if (idx != OCC_NONE) {
             occ_leaf_block_t *const lb = occ_leaf_at(m, idx);
             for (unsigned i = 0; i < 8u; i++) {
@@ -59,7 +59,7 @@ static uint32_t new_block(occ_map_t *const m, const unsigned level)
         }
         return idx;
     }
-    const uint32_t idx = occ_pool_alloc_inner(m);
+    const uint32_t idx = occi_pool_alloc_inner(m);
     if (idx != OCC_NONE) {
         occ_inner_block_t *const ib = occ_inner_at(m, idx);
         const uint8_t f = occ_value_flags(m, OCC_VALUE_UNOBSERVED);
@@ -85,7 +85,7 @@ static void push(occ_build_t *const b, const unsigned level, const unsigned slot
     f->vmax = OCC_VALUE_UNOBSERVED;
 }
 
-void occ_build_open_root(occ_build_t *const b)
+void occi_build_open_root(occ_build_t *const b)
 {
     b->nodes++;
     note_alloc(b, b->top - 1u);
@@ -98,7 +98,7 @@ void occ_build_open_root(occ_build_t *const b)
     push(b, b->top, 0u, blk);
 }
 
-void occ_build_open(occ_build_t *const b, const unsigned slot)
+void occi_build_open(occ_build_t *const b, const unsigned slot)
 {
     OCC_ASSERT(b->sp >= 1u && slot < 8u);
     occ_build_frame_t *const p = &b->st[b->sp - 1u];
@@ -127,7 +127,7 @@ static void dry_child(occ_build_frame_t *const p, const occ_value_t v, const boo
     p->any_block = p->any_block || has_block;
 }
 
-void occ_build_leaf(occ_build_t *const b, const unsigned slot, const occ_value_t v)
+void occi_build_leaf(occ_build_t *const b, const unsigned slot, const occ_value_t v)
 {
     OCC_ASSERT(b->sp >= 1u && slot < 8u);
     occ_build_frame_t *const p = &b->st[b->sp - 1u];
@@ -145,7 +145,7 @@ void occ_build_leaf(occ_build_t *const b, const unsigned slot, const occ_value_t
     }
 }
 
-void occ_build_close(occ_build_t *const b)
+void occi_build_close(occ_build_t *const b)
 {
     OCC_ASSERT(b->sp >= 1u);
     occ_build_frame_t *const f = &b->st[b->sp - 1u];
@@ -170,7 +170,7 @@ void occ_build_close(occ_build_t *const b)
         } else {
             node = occ_inner_node(b->map, b->st[b->sp - 2u].block, f->slot);
         }
-        (void)occ_tree_refresh(b->map, node, f->level);
+        (void)occi_tree_refresh(b->map, node, f->level);
     }
     b->sp--;
 }

@@ -166,7 +166,7 @@ static bool parse_uint(occ_cursor_t *const c, uint64_t *const out)
     return true;
 }
 
-occ_err_t occ_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
+occ_err_t occi_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
 {
     memset(h, 0, sizeof *h);
     const size_t nb = sizeof magic_bt - 1u, no = sizeof magic_ot - 1u;
@@ -240,7 +240,7 @@ occ_err_t occ_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
     if (h->id[0] == '\0') {
         return occ_cursor_fail(c, c->pos, "header without id");
     }
-    if (!have_res || !occ_f32_finite(h->res) || !(h->res > 0.0f)) {
+    if (!have_res || !occ_finite(h->res) || !(h->res > 0.0f)) {
         return occ_cursor_fail(c, c->pos, "header without a positive res");
     }
     if (h->res < 1e-6f || h->res >= 1e6f) {
@@ -267,10 +267,10 @@ static uint64_t scaled_round(const uint32_t m, const unsigned p, const unsigned 
     return (r > half || (r == half && (q & 1u) != 0u)) ? q + 1u : q;
 }
 
-occ_err_t occ_om_header_write(occ_sink_t *const s, const occ_format_t format, const uint64_t size,
-                              const float res)
+occ_err_t occi_om_header_write(occ_sink_t *const s, const occ_format_t format, const uint64_t size,
+                               const float res)
 {
-    if (!occ_f32_finite(res) || !(res >= 1e-6f) || !(res < 1e6f)) {
+    if (!occ_finite(res) || !(res >= 1e-6f) || !(res < 1e6f)) {
         return OCC_ERR_UNSUPPORTED;
     }
     uint32_t bits;
@@ -341,13 +341,13 @@ occ_err_t occ_om_header_write(occ_sink_t *const s, const occ_format_t format, co
             }
         }
     }
-    occ_sink_str(s, format == OCC_FORMAT_BT ? magic_bt : magic_ot);
-    occ_sink_str(s, "\n");
-    occ_sink_str(s, comment);
-    occ_sink_str(s, "id OcTree\nsize ");
-    occ_sink_dec(s, size);
-    occ_sink_str(s, "\nres ");
-    occ_sink_put(s, out, o);
-    occ_sink_str(s, "\ndata\n");
+    occi_sink_str(s, format == OCC_FORMAT_BT ? magic_bt : magic_ot);
+    occi_sink_str(s, "\n");
+    occi_sink_str(s, comment);
+    occi_sink_str(s, "id OcTree\nsize ");
+    occi_sink_dec(s, size);
+    occi_sink_str(s, "\nres ");
+    occi_sink_put(s, out, o);
+    occi_sink_str(s, "\ndata\n");
     return s->err;
 }

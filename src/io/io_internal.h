@@ -34,12 +34,12 @@ typedef struct {
     occ_build_frame_t st[OCC_MAX_DEPTH + 1];
 } occ_build_t;
 
-void occ_build_begin(occ_build_t *b, occ_map_t *map, unsigned depth_levels);
-void occ_build_root_uniform(occ_build_t *b, occ_value_t v);
-void occ_build_open_root(occ_build_t *b);
-void occ_build_open(occ_build_t *b, unsigned slot);
-void occ_build_leaf(occ_build_t *b, unsigned slot, occ_value_t v);
-void occ_build_close(occ_build_t *b);
+void occi_build_begin(occ_build_t *b, occ_map_t *map, unsigned depth_levels);
+void occi_build_root_uniform(occ_build_t *b, occ_value_t v);
+void occi_build_open_root(occ_build_t *b);
+void occi_build_open(occ_build_t *b, unsigned slot);
+void occi_build_leaf(occ_build_t *b, unsigned slot, occ_value_t v);
+void occi_build_close(occ_build_t *b);
 static inline unsigned occ_build_level(const occ_build_t *b)
 {
     return b->st[b->sp - 1u].level;
@@ -75,21 +75,20 @@ typedef struct {
     uint8_t buf[OCC_SINK_BUF];
 } occ_sink_t;
 
-void occ_sink_init(occ_sink_t *s, occ_io_write_fn fn, void *ctx);
-void occ_sink_put(occ_sink_t *s, const void *data, size_t len);
-void occ_sink_u8(occ_sink_t *s, uint8_t v);
-void occ_sink_u16(occ_sink_t *s, uint16_t v);
-void occ_sink_u32(occ_sink_t *s, uint32_t v);
-void occ_sink_f32(occ_sink_t *s, float v);
-void occ_sink_str(occ_sink_t *s, const char *str);
-void occ_sink_dec(occ_sink_t *s, uint64_t v);
-occ_err_t occ_sink_flush(occ_sink_t *s);
+void occi_sink_init(occ_sink_t *s, occ_io_write_fn fn, void *ctx);
+void occi_sink_put(occ_sink_t *s, const void *data, size_t len);
+void occi_sink_u8(occ_sink_t *s, uint8_t v);
+void occi_sink_u16(occ_sink_t *s, uint16_t v);
+void occi_sink_u32(occ_sink_t *s, uint32_t v);
+void occi_sink_f32(occ_sink_t *s, float v);
+void occi_sink_str(occ_sink_t *s, const char *str);
+void occi_sink_dec(occ_sink_t *s, uint64_t v);
+occ_err_t occi_sink_flush(occ_sink_t *s);
 
-uint16_t occ_rd_u16(const uint8_t *p);
-uint32_t occ_rd_u32(const uint8_t *p);
-uint64_t occ_rd_u64(const uint8_t *p);
-float occ_rd_f32(const uint8_t *p);
-bool occ_f32_finite(float x);
+uint16_t occi_rd_u16(const uint8_t *p);
+uint32_t occi_rd_u32(const uint8_t *p);
+uint64_t occi_rd_u64(const uint8_t *p);
+float occi_rd_f32(const uint8_t *p);
 
 /* ---- OctoMap text header (io_header.c) ---------------------------------------------------- */
 typedef struct {
@@ -102,17 +101,17 @@ typedef struct {
 } occ_om_header_t;
 
 /* Parse as OctoMap's readHeader does. OCC_ERR_FORMAT with the cursor's error set. */
-occ_err_t occ_om_header_parse(occ_cursor_t *c, occ_om_header_t *h);
+occ_err_t occi_om_header_parse(occ_cursor_t *c, occ_om_header_t *h);
 /* Append the header OctoMap writes (res printed as iostream's default "%g"). */
-occ_err_t occ_om_header_write(occ_sink_t *s, occ_format_t format, uint64_t size, float res);
+occ_err_t occi_om_header_write(occ_sink_t *s, occ_format_t format, uint64_t size, float res);
 
 /* ---- format bodies ---------------------------------------------------------------------- */
 /* Parse the tree data of a .bt / .ot from c->pos, driving b. */
-occ_err_t occ_bt_parse(occ_cursor_t *c, occ_build_t *b, uint64_t header_size, occ_value_t q_free,
-                       occ_value_t q_occ);
-occ_err_t occ_ot_parse(occ_cursor_t *c, occ_build_t *b, uint64_t header_size, size_t extra);
-void occ_bt_emit(const occ_map_t *m, occ_sink_t *s, uint64_t *nodes);
-void occ_ot_emit(const occ_map_t *m, occ_sink_t *s, uint64_t *nodes);
+occ_err_t occi_bt_parse(occ_cursor_t *c, occ_build_t *b, uint64_t header_size, occ_value_t q_free,
+                        occ_value_t q_occ);
+occ_err_t occi_ot_parse(occ_cursor_t *c, occ_build_t *b, uint64_t header_size, size_t extra);
+void occi_bt_emit(const occ_map_t *m, occ_sink_t *s, uint64_t *nodes);
+void occi_ot_emit(const occ_map_t *m, occ_sink_t *s, uint64_t *nodes);
 
 /* Snapshot (io_snapshot.c). */
 typedef struct {
@@ -121,8 +120,8 @@ typedef struct {
     uint32_t inner_blocks, leaf_blocks;
     uint64_t payload_bytes;
 } occ_snap_header_t;
-occ_err_t occ_snap_header_parse(occ_cursor_t *c, occ_snap_header_t *h);
-occ_err_t occ_snap_parse(occ_cursor_t *c, occ_build_t *b, const occ_snap_header_t *h);
-occ_err_t occ_snap_write(const occ_map_t *m, occ_sink_t *s);
+occ_err_t occi_snap_header_parse(occ_cursor_t *c, occ_snap_header_t *h);
+occ_err_t occi_snap_parse(occ_cursor_t *c, occ_build_t *b, const occ_snap_header_t *h);
+occ_err_t occi_snap_write(const occ_map_t *m, occ_sink_t *s);
 
 #endif /* OCC_IO_INTERNAL_H_INCLUDED */

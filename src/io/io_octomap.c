@@ -33,15 +33,15 @@ static void bt_leaves(occ_build_t *const b, const uint16_t codes, const occ_valu
     for (unsigned i = 0; i < 8u; i++) {
         const unsigned k = bt_code(codes, i);
         if (k == BT_FREE) {
-            occ_build_leaf(b, i, q_free);
+            occi_build_leaf(b, i, q_free);
         } else if (k == BT_OCC) {
-            occ_build_leaf(b, i, q_occ);
+            occi_build_leaf(b, i, q_occ);
         }
     }
 }
 
-occ_err_t occ_bt_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64_t header_size,
-                       const occ_value_t q_free, const occ_value_t q_occ)
+occ_err_t occi_bt_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64_t header_size,
+                        const occ_value_t q_free, const occ_value_t q_occ)
 {
     if (header_size == 0u) {
         return OCC_OK;  /* OctoMap reads no data for an empty tree */
@@ -53,7 +53,7 @@ occ_err_t occ_bt_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
     if (c->len - c->pos < 2u) {
         return occ_cursor_fail(c, c->pos, "truncated .bt data");
     }
-    uint16_t codes = occ_rd_u16(c->buf + c->pos);
+    uint16_t codes = occi_rd_u16(c->buf + c->pos);
     if (codes == 0u) {
         return occ_cursor_fail(c, c->pos, "root node without children");
     }
@@ -61,7 +61,7 @@ occ_err_t occ_bt_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
         return occ_cursor_fail(c, c->pos, "more nodes than the header's size");
     }
     c->pos += 2u;
-    occ_build_open_root(b);
+    occi_build_open_root(b);
     st[0].codes = codes;
     st[0].next = 0u;
     bt_leaves(b, codes, q_free, q_occ);
@@ -72,7 +72,7 @@ occ_err_t occ_bt_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
             i++;
         }
         if (i == 8u) {
-            occ_build_close(b);
+            occi_build_close(b);
             continue;
         }
         st[top].next = (uint8_t)(i + 1u);
@@ -82,7 +82,7 @@ occ_err_t occ_bt_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
         if (c->len - c->pos < 2u) {
             return occ_cursor_fail(c, c->pos, "truncated .bt data");
         }
-        codes = occ_rd_u16(c->buf + c->pos);
+        codes = occi_rd_u16(c->buf + c->pos);
         if (codes == 0u) {
             return occ_cursor_fail(c, c->pos, "inner node without children");
         }
@@ -90,7 +90,7 @@ occ_err_t occ_bt_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
             return occ_cursor_fail(c, c->pos, "more nodes than the header's size");
         }
         c->pos += 2u;
-        occ_build_open(b, i);
+        occi_build_open(b, i);
         st[top + 1u].codes = codes;
         st[top + 1u].next = 0u;
         bt_leaves(b, codes, q_free, q_occ);
@@ -122,8 +122,8 @@ static occ_err_t ot_record(occ_cursor_t *const c, const size_t extra, occ_value_
     if (c->len - c->pos < 5u + extra) {
         return occ_cursor_fail(c, c->pos, "truncated .ot data");
     }
-    const float f = occ_rd_f32(c->buf + c->pos);
-    if (!occ_f32_finite(f)) {
+    const float f = occi_rd_f32(c->buf + c->pos);
+    if (!occ_finite(f)) {
         return occ_cursor_fail(c, c->pos, "non-finite log-odds");
     }
     *v = ot_value(c, f);
@@ -141,8 +141,12 @@ static unsigned popcount8(const uint8_t m)
     return n;
 }
 
-occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64_t header_size,
-                       const size_t extra)
+/* -fanalyzer reads st[top] as uninitialised: st[] mirrors the builder's stack, frame for frame
+ * (occi_build_open_root / occi_build_open push b->sp exactly where st[0] / st[top + 1] are
+ * written, occi_build_close pops), which it cannot see across the calls. */
+OCC_ANALYZER_UNINIT_OFF
+occ_err_t occi_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64_t header_size,
+                        const size_t extra)
 {
     if (header_size == 0u) {
         return OCC_OK;
@@ -159,12 +163,12 @@ occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
         return e;
     }
     if (mask == 0u) {
-        occ_build_root_uniform(b, v);
+        occi_build_root_uniform(b, v);
     } else {
         if (1u + popcount8(mask) > header_size) {
             return occ_cursor_fail(c, c->pos - 1u, "more nodes than the header's size");
         }
-        occ_build_open_root(b);
+        occi_build_open_root(b);
         st[0].stored = v;
         st[0].mask = mask;
         st[0].next = 0u;
@@ -179,7 +183,7 @@ occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
             if (!occ_value_eq(b->st[top].vmax, st[top].stored)) {
                 c->warnings |= OCC_IO_WARN_INNER_VALUE;
             }
-            occ_build_close(b);
+            occi_build_close(b);
             continue;
         }
         st[top].next = (uint8_t)(i + 1u);
@@ -189,7 +193,7 @@ occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
             return e;
         }
         if (mask == 0u) {
-            occ_build_leaf(b, i, v);
+            occi_build_leaf(b, i, v);
             continue;
         }
         if (occ_build_level(b) <= 1u) {
@@ -198,7 +202,7 @@ occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
         if (b->nodes + 1u + popcount8(mask) > header_size) {
             return occ_cursor_fail(c, at, "more nodes than the header's size");
         }
-        occ_build_open(b, i);
+        occi_build_open(b, i);
         st[top + 1u].stored = v;
         st[top + 1u].mask = mask;
         st[top + 1u].next = 0u;
@@ -208,6 +212,7 @@ occ_err_t occ_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint64
     }
     return OCC_OK;
 }
+OCC_ANALYZER_UNINIT_ON
 
 /* ---- emitters ------------------------------------------------------------------------------- */
 
@@ -308,7 +313,7 @@ static uint16_t bt_codes_of(const occ_map_t *const m, const uint32_t block, cons
     return codes;
 }
 
-void occ_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const nodes)
+void occi_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const nodes)
 {
     *nodes = 0u;
     if (!occ_is_observed(m->root_value)) {
@@ -321,7 +326,7 @@ void occ_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const 
         for (unsigned i = 0; i < 8u; i++) {
             codes = (uint16_t)(codes | (k << (2u * i)));
         }
-        occ_sink_u16(s, codes);
+        occi_sink_u16(s, codes);
         *nodes = 9u;
         return;
     }
@@ -331,7 +336,7 @@ void occ_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const 
     st[0].level = m->cfg.depth_levels;
     st[0].next = 0u;
     st[0].codes = bt_codes_of(m, m->root_child, m->cfg.depth_levels);
-    occ_sink_u16(s, st[0].codes);
+    occi_sink_u16(s, st[0].codes);
     *nodes = 1u + bt_count(st[0].codes);
     sp = 1u;
     while (sp > 0u && s->err == OCC_OK) {
@@ -352,7 +357,7 @@ void occ_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const 
         g->level = (uint8_t)(f->level - 1u);
         g->next = 0u;
         g->codes = bt_codes_of(m, child, g->level);
-        occ_sink_u16(s, g->codes);
+        occi_sink_u16(s, g->codes);
         *nodes += bt_count(g->codes);
         sp++;
     }
@@ -373,11 +378,11 @@ static uint8_t observed_mask(const occ_map_t *const m, const uint32_t block, con
 
 static void ot_rec(occ_sink_t *const s, const occ_value_t v, const uint8_t mask)
 {
-    occ_sink_f32(s, occ_value_to_logodds(v));
-    occ_sink_u8(s, mask);
+    occi_sink_f32(s, occ_value_to_logodds(v));
+    occi_sink_u8(s, mask);
 }
 
-void occ_ot_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const nodes)
+void occi_ot_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const nodes)
 {
     *nodes = 0u;
     if (!occ_is_observed(m->root_value)) {

@@ -6,7 +6,7 @@
 
 #include "io_internal.h"
 
-void occ_sink_init(occ_sink_t *const s, const occ_io_write_fn fn, void *const ctx)
+void occi_sink_init(occ_sink_t *const s, const occ_io_write_fn fn, void *const ctx)
 {
     s->fn = fn;
     s->ctx = ctx;
@@ -17,7 +17,7 @@ void occ_sink_init(occ_sink_t *const s, const occ_io_write_fn fn, void *const ct
     s->fill = 0u;
 }
 
-occ_err_t occ_sink_flush(occ_sink_t *const s)
+occ_err_t occi_sink_flush(occ_sink_t *const s)
 {
     if (s->fill > 0u && s->err == OCC_OK) {
         if (s->crc_on) {
@@ -31,7 +31,7 @@ occ_err_t occ_sink_flush(occ_sink_t *const s)
     return s->err;
 }
 
-void occ_sink_put(occ_sink_t *const s, const void *const data, const size_t len)
+void occi_sink_put(occ_sink_t *const s, const void *const data, const size_t len)
 {
     const uint8_t *p = (const uint8_t *)data;
     size_t n = len;
@@ -46,42 +46,42 @@ void occ_sink_put(occ_sink_t *const s, const void *const data, const size_t len)
         p += k;
         n -= k;
         if (s->fill == OCC_SINK_BUF) {
-            (void)occ_sink_flush(s);
+            (void)occi_sink_flush(s);
         }
     }
 }
 
-void occ_sink_u8(occ_sink_t *const s, const uint8_t v)
+void occi_sink_u8(occ_sink_t *const s, const uint8_t v)
 {
-    occ_sink_put(s, &v, 1u);
+    occi_sink_put(s, &v, 1u);
 }
 
-void occ_sink_u16(occ_sink_t *const s, const uint16_t v)
+void occi_sink_u16(occ_sink_t *const s, const uint16_t v)
 {
     const uint8_t b[2] = {(uint8_t)(v & 0xFFu), (uint8_t)(v >> 8)};
-    occ_sink_put(s, b, 2u);
+    occi_sink_put(s, b, 2u);
 }
 
-void occ_sink_u32(occ_sink_t *const s, const uint32_t v)
+void occi_sink_u32(occ_sink_t *const s, const uint32_t v)
 {
     const uint8_t b[4] = {(uint8_t)(v & 0xFFu), (uint8_t)((v >> 8) & 0xFFu),
                           (uint8_t)((v >> 16) & 0xFFu), (uint8_t)(v >> 24)};
-    occ_sink_put(s, b, 4u);
+    occi_sink_put(s, b, 4u);
 }
 
-void occ_sink_f32(occ_sink_t *const s, const float v)
+void occi_sink_f32(occ_sink_t *const s, const float v)
 {
     uint32_t u;
     memcpy(&u, &v, sizeof u);
-    occ_sink_u32(s, u);
+    occi_sink_u32(s, u);
 }
 
-void occ_sink_str(occ_sink_t *const s, const char *const str)
+void occi_sink_str(occ_sink_t *const s, const char *const str)
 {
-    occ_sink_put(s, str, strlen(str));
+    occi_sink_put(s, str, strlen(str));
 }
 
-void occ_sink_dec(occ_sink_t *const s, const uint64_t v)
+void occi_sink_dec(occ_sink_t *const s, const uint64_t v)
 {
     char tmp[24];
     size_t n = 0u;
@@ -91,37 +91,30 @@ void occ_sink_dec(occ_sink_t *const s, const uint64_t v)
         n++;
         x /= 10u;
     } while (x != 0u);
-    occ_sink_put(s, tmp + sizeof tmp - n, n);
+    occi_sink_put(s, tmp + sizeof tmp - n, n);
 }
 
-uint16_t occ_rd_u16(const uint8_t *const p)
+uint16_t occi_rd_u16(const uint8_t *const p)
 {
     return (uint16_t)((unsigned)p[0] | ((unsigned)p[1] << 8));
 }
 
-uint32_t occ_rd_u32(const uint8_t *const p)
+uint32_t occi_rd_u32(const uint8_t *const p)
 {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-uint64_t occ_rd_u64(const uint8_t *const p)
+uint64_t occi_rd_u64(const uint8_t *const p)
 {
-    return (uint64_t)occ_rd_u32(p) | ((uint64_t)occ_rd_u32(p + 4) << 32);
+    return (uint64_t)occi_rd_u32(p) | ((uint64_t)occi_rd_u32(p + 4) << 32);
 }
 
-float occ_rd_f32(const uint8_t *const p)
+float occi_rd_f32(const uint8_t *const p)
 {
-    const uint32_t u = occ_rd_u32(p);
+    const uint32_t u = occi_rd_u32(p);
     float f;
     memcpy(&f, &u, sizeof f);
     return f;
-}
-
-bool occ_f32_finite(const float x)
-{
-    uint32_t u;
-    memcpy(&u, &x, sizeof u);
-    return (u & 0x7F800000u) != 0x7F800000u;
 }
 
 occ_err_t occ_io_buf_write(void *const ctx, const void *const data, const size_t len)

@@ -22,7 +22,7 @@ static const char magic[8] = {'O', 'C', 'C', 'M', 'A', 'P', 'S', 'N'};
 #define OWN_KIND 0u
 #endif
 
-occ_err_t occ_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const h)
+occ_err_t occi_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const h)
 {
     const uint8_t *const p = c->buf;
     if (c->len < 8u || memcmp(p, magic, 8u) != 0) {
@@ -31,23 +31,23 @@ occ_err_t occ_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const 
     if (c->len < OCC_SNAPSHOT_HEADER_BYTES + 4u) {
         return occ_cursor_fail(c, c->len, "truncated snapshot header");
     }
-    if (occ_rd_u16(p + 8) != OCC_SNAPSHOT_VERSION) {
+    if (occi_rd_u16(p + 8) != OCC_SNAPSHOT_VERSION) {
         c->error = "unsupported snapshot version";
         c->error_offset = 8u;
         return OCC_ERR_UNSUPPORTED;
     }
-    if (occ_rd_u16(p + 10) != OCC_SNAPSHOT_HEADER_BYTES || occ_rd_u16(p + 14) != 0u ||
-        occ_rd_u32(p + 60) != 0u) {
+    if (occi_rd_u16(p + 10) != OCC_SNAPSHOT_HEADER_BYTES || occi_rd_u16(p + 14) != 0u ||
+        occi_rd_u32(p + 60) != 0u) {
         return occ_cursor_fail(c, 10u, "bad snapshot header fields");
     }
-    h->payload_bytes = occ_rd_u64(p + 52);
+    h->payload_bytes = occi_rd_u64(p + 52);
     if (h->payload_bytes != (uint64_t)(c->len - OCC_SNAPSHOT_HEADER_BYTES - 4u)) {
         return occ_cursor_fail(c, 52u, h->payload_bytes > (uint64_t)(c->len - 68u)
                                            ? "truncated snapshot (payload length)"
                                            : "payload length does not match the file");
     }
     const size_t end = OCC_SNAPSHOT_HEADER_BYTES + (size_t)h->payload_bytes;
-    if (occ_crc32(0u, p, end) != occ_rd_u32(p + end)) {
+    if (occ_crc32(0u, p, end) != occi_rd_u32(p + end)) {
         return occ_cursor_fail(c, end, "CRC mismatch");
     }
     h->value_kind = p[12];
@@ -56,15 +56,15 @@ occ_err_t occ_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const 
     }
     occ_map_config_t *const cfg = &h->cfg;
     cfg->depth_levels = p[13];
-    cfg->resolution_m = occ_rd_f32(p + 16);
-    cfg->hit = occ_rd_f32(p + 20);
-    cfg->miss = occ_rd_f32(p + 24);
-    cfg->clamp_min = occ_rd_f32(p + 28);
-    cfg->clamp_max = occ_rd_f32(p + 32);
-    cfg->free_max = occ_rd_f32(p + 36);
-    cfg->occupied_min = occ_rd_f32(p + 40);
-    h->inner_blocks = occ_rd_u32(p + 44);
-    h->leaf_blocks = occ_rd_u32(p + 48);
+    cfg->resolution_m = occi_rd_f32(p + 16);
+    cfg->hit = occi_rd_f32(p + 20);
+    cfg->miss = occi_rd_f32(p + 24);
+    cfg->clamp_min = occi_rd_f32(p + 28);
+    cfg->clamp_max = occi_rd_f32(p + 32);
+    cfg->free_max = occi_rd_f32(p + 36);
+    cfg->occupied_min = occi_rd_f32(p + 40);
+    h->inner_blocks = occi_rd_u32(p + 44);
+    h->leaf_blocks = occi_rd_u32(p + 48);
     /* Config validity (occ_map_init's rules) on a tiny scratch arena; no map is touched. */
     uint64_t scratch[16];
     occ_map_t probe;
@@ -83,7 +83,7 @@ static occ_err_t read_value(occ_cursor_t *const c, const uint8_t kind, occ_value
         return occ_cursor_fail(c, c->pos, "truncated snapshot payload");
     }
     if (kind == 0u) {
-        const int16_t raw = (int16_t)occ_rd_u16(c->buf + c->pos);
+        const int16_t raw = (int16_t)occi_rd_u16(c->buf + c->pos);
         if (raw == INT16_MIN) {
             return occ_cursor_fail(c, c->pos, "unobserved value stored as observed");
         }
@@ -93,8 +93,8 @@ static occ_err_t read_value(occ_cursor_t *const c, const uint8_t kind, occ_value
         *v = raw;
 #endif
     } else {
-        const float f = occ_rd_f32(c->buf + c->pos);
-        if (!occ_f32_finite(f)) {
+        const float f = occi_rd_f32(c->buf + c->pos);
+        if (!occ_finite(f)) {
             return occ_cursor_fail(c, c->pos, "non-finite value");
         }
         *v = occ_value_from_logodds(f);
@@ -130,13 +130,13 @@ static occ_err_t read_node(occ_cursor_t *const c, occ_build_t *const b, const ui
             if (e != OCC_OK) {
                 return e;
             }
-            occ_build_leaf(b, i, v);
+            occi_build_leaf(b, i, v);
         }
     }
     return OCC_OK;
 }
 
-occ_err_t occ_snap_parse(occ_cursor_t *const c, occ_build_t *const b, const occ_snap_header_t *const h)
+occ_err_t occi_snap_parse(occ_cursor_t *const c, occ_build_t *const b, const occ_snap_header_t *const h)
 {
     if (c->pos >= c->len) {
         return occ_cursor_fail(c, c->pos, "truncated snapshot payload");
@@ -153,9 +153,9 @@ occ_err_t occ_snap_parse(occ_cursor_t *const c, occ_build_t *const b, const occ_
         if (e != OCC_OK) {
             return e;
         }
-        occ_build_root_uniform(b, v);
+        occi_build_root_uniform(b, v);
     } else if (tag == 2u) {
-        occ_build_open_root(b);
+        occi_build_open_root(b);
         e = read_node(c, b, h->value_kind, &st[0].blk);
         st[0].next = 0u;
     } else if (tag != 0u) {
@@ -168,11 +168,11 @@ occ_err_t occ_snap_parse(occ_cursor_t *const c, occ_build_t *const b, const occ_
             i++;
         }
         if (i == 8u) {
-            occ_build_close(b);
+            occi_build_close(b);
             continue;
         }
         st[top].next = (uint8_t)(i + 1u);
-        occ_build_open(b, i);
+        occi_build_open(b, i);
         st[top + 1u].next = 0u;
         e = read_node(c, b, h->value_kind, &st[top + 1u].blk);
     }
@@ -200,9 +200,9 @@ typedef struct {
 static void put_value(occ_sink_t *const s, const occ_value_t v)
 {
 #if OCC_VALUE_FLOAT
-    occ_sink_f32(s, v);
+    occi_sink_f32(s, v);
 #else
-    occ_sink_u16(s, (uint16_t)v);
+    occi_sink_u16(s, (uint16_t)v);
 #endif
 }
 
@@ -217,8 +217,8 @@ static uint8_t put_node(const occ_map_t *const m, occ_sink_t *const s, const uin
         for (unsigned i = 0; i < 8u; i++) {
             obs = (uint8_t)(obs | (occ_is_observed(lb->value[i]) ? 1u << i : 0u));
         }
-        occ_sink_u8(s, obs);
-        occ_sink_u8(s, 0u);
+        occi_sink_u8(s, obs);
+        occi_sink_u8(s, 0u);
         for (unsigned i = 0; i < 8u; i++) {
             if ((((unsigned)obs >> i) & 1u) != 0u) {
                 put_value(s, lb->value[i]);
@@ -231,8 +231,8 @@ static uint8_t put_node(const occ_map_t *const m, occ_sink_t *const s, const uin
         obs = (uint8_t)(obs | (occ_is_observed(ib->value[i]) ? 1u << i : 0u));
         blk = (uint8_t)(blk | (ib->child[i] != OCC_NONE ? 1u << i : 0u));
     }
-    occ_sink_u8(s, obs);
-    occ_sink_u8(s, blk);
+    occi_sink_u8(s, obs);
+    occi_sink_u8(s, blk);
     for (unsigned i = 0; i < 8u; i++) {
         if (((((unsigned)obs & ~(unsigned)blk) >> i) & 1u) != 0u) {
             put_value(s, ib->value[i]);
@@ -244,15 +244,15 @@ static uint8_t put_node(const occ_map_t *const m, occ_sink_t *const s, const uin
 static void put_payload(const occ_map_t *const m, occ_sink_t *const s)
 {
     if (!occ_is_observed(m->root_value)) {
-        occ_sink_u8(s, 0u);
+        occi_sink_u8(s, 0u);
         return;
     }
     if (m->root_child == OCC_NONE) {
-        occ_sink_u8(s, 1u);
+        occi_sink_u8(s, 1u);
         put_value(s, m->root_value);
         return;
     }
-    occ_sink_u8(s, 2u);
+    occi_sink_u8(s, 2u);
     snap_frame_t st[OCC_MAX_DEPTH + 1];
     unsigned sp = 1u;
     st[0].block = m->root_child;
@@ -279,36 +279,36 @@ static void put_payload(const occ_map_t *const m, occ_sink_t *const s)
     }
 }
 
-occ_err_t occ_snap_write(const occ_map_t *const m, occ_sink_t *const s)
+occ_err_t occi_snap_write(const occ_map_t *const m, occ_sink_t *const s)
 {
     occ_sink_t counter;
-    occ_sink_init(&counter, NULL, NULL);
+    occi_sink_init(&counter, NULL, NULL);
     put_payload(m, &counter);
     const occ_map_config_t *const cfg = &m->cfg;
     s->crc_on = true;
     s->crc = 0u;
-    occ_sink_put(s, magic, 8u);
-    occ_sink_u16(s, (uint16_t)OCC_SNAPSHOT_VERSION);
-    occ_sink_u16(s, (uint16_t)OCC_SNAPSHOT_HEADER_BYTES);
-    occ_sink_u8(s, (uint8_t)OWN_KIND);
-    occ_sink_u8(s, cfg->depth_levels);
-    occ_sink_u16(s, 0u);
-    occ_sink_f32(s, cfg->resolution_m);
-    occ_sink_f32(s, cfg->hit);
-    occ_sink_f32(s, cfg->miss);
-    occ_sink_f32(s, cfg->clamp_min);
-    occ_sink_f32(s, cfg->clamp_max);
-    occ_sink_f32(s, cfg->free_max);
-    occ_sink_f32(s, cfg->occupied_min);
-    occ_sink_u32(s, m->inner.used);
-    occ_sink_u32(s, m->leaf.used);
+    occi_sink_put(s, magic, 8u);
+    occi_sink_u16(s, (uint16_t)OCC_SNAPSHOT_VERSION);
+    occi_sink_u16(s, (uint16_t)OCC_SNAPSHOT_HEADER_BYTES);
+    occi_sink_u8(s, (uint8_t)OWN_KIND);
+    occi_sink_u8(s, cfg->depth_levels);
+    occi_sink_u16(s, 0u);
+    occi_sink_f32(s, cfg->resolution_m);
+    occi_sink_f32(s, cfg->hit);
+    occi_sink_f32(s, cfg->miss);
+    occi_sink_f32(s, cfg->clamp_min);
+    occi_sink_f32(s, cfg->clamp_max);
+    occi_sink_f32(s, cfg->free_max);
+    occi_sink_f32(s, cfg->occupied_min);
+    occi_sink_u32(s, m->inner.used);
+    occi_sink_u32(s, m->leaf.used);
     const uint64_t pl = (uint64_t)counter.total;
-    occ_sink_u32(s, (uint32_t)(pl & 0xFFFFFFFFu));
-    occ_sink_u32(s, (uint32_t)(pl >> 32));
-    occ_sink_u32(s, 0u);
+    occi_sink_u32(s, (uint32_t)(pl & 0xFFFFFFFFu));
+    occi_sink_u32(s, (uint32_t)(pl >> 32));
+    occi_sink_u32(s, 0u);
     put_payload(m, s);
-    (void)occ_sink_flush(s);
+    (void)occi_sink_flush(s);
     s->crc_on = false;
-    occ_sink_u32(s, s->crc);
-    return occ_sink_flush(s);
+    occi_sink_u32(s, s->crc);
+    return occi_sink_flush(s);
 }

@@ -147,15 +147,19 @@ static void set_unsafe(occ_ray_result_t *out, occ_vec3_t origin)
  * without looking anything up while the next voxel is still in the node and (when the range is
  * bounded) entered before `safe_t`, where the centre distance test cannot fail. Same events, same
  * order, same arithmetic as stepping. */
+/* Steps left on one axis before the walk leaves the aligned node of edge `size` holding `key`. */
+static inline int32_t coast_room(int32_t step, uint32_t key, uint32_t size)
+{
+    const uint32_t base = key & ~(size - 1u);
+    return step > 0 ? (int32_t)(base + size - 1u - key) : (step < 0 ? (int32_t)(key - base) : 0);
+}
+
 static inline void dda_coast(dda_t *d, uint32_t key[3], unsigned lu, bool bounded, real_t safe_t)
 {
     const uint32_t size = (uint32_t)1 << lu;
-    int32_t room[3];
-    for (unsigned i = 0; i < 3u; i++) {
-        const uint32_t base = key[i] & ~(size - 1u);
-        room[i] = d->step[i] > 0 ? (int32_t)(base + size - 1u - key[i])
-                                 : (d->step[i] < 0 ? (int32_t)(key[i] - base) : 0);
-    }
+    const int32_t room0 = coast_room(d->step[0], key[0], size);
+    const int32_t room1 = coast_room(d->step[1], key[1], size);
+    const int32_t room2 = coast_room(d->step[2], key[2], size);
     /* Registers only: the loop-carried chain is one add and two compares per step. */
     real_t t0 = d->tmax[0];
     real_t t1 = d->tmax[1];
@@ -170,19 +174,19 @@ static inline void dda_coast(dda_t *d, uint32_t key[3], unsigned lu, bool bounde
     for (;;) {
         const unsigned dim = occ_dda_axis(t0, t1, t2);
         if (dim == 0u) {
-            if (n0 == room[0] || !(t0 < stop)) {
+            if (n0 == room0 || !(t0 < stop)) {
                 break;
             }
             n0++;
             t0 += dt0;
         } else if (dim == 1u) {
-            if (n1 == room[1] || !(t1 < stop)) {
+            if (n1 == room1 || !(t1 < stop)) {
                 break;
             }
             n1++;
             t1 += dt1;
         } else {
-            if (n2 == room[2] || !(t2 < stop)) {
+            if (n2 == room2 || !(t2 < stop)) {
                 break;
             }
             n2++;
@@ -218,8 +222,8 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
         return OCC_ERR_ARG;
     }
     set_unsafe(out, origin); /* until the walk decides */
-    if (map == NULL || !occ_q_finite3(origin) || !occ_q_finite3(direction) ||
-        !occ_q_finite(max_range_m)) {
+    if (map == NULL || !occ_finite3(origin) || !occ_finite3(direction) ||
+        !occ_finite(max_range_m)) {
         return OCC_ERR_ARG;
     }
     float dir[3];
@@ -238,7 +242,7 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
     const unsigned states = OCC_PRED_OCCUPIED | (ignore_unknown ? 0u : OCC_PRED_UNKNOWN);
     cursor_init(&c, map, k0.k, (uint8_t)occ_q_has_bits(states));
     {
-        const occ_state_t s = occ_q_state(map, c.val);
+        const occ_state_t s = occ_value_state(map, c.val);
         if (s == OCC_STATE_OCCUPIED) {
             set_result(&c, res, tmv, out, true, OCC_RAY_HIT);
             return OCC_OK;
@@ -321,7 +325,7 @@ static occ_err_t set_visible(bool *visible, occ_ray_result_t *blocker)
 
 static bool blocks(const occ_map_t *map, occ_value_t v, occ_unknown_policy_t policy)
 {
-    return (occ_q_state_bit(occ_q_state(map, v)) & occ_q_blocking_states(policy)) != 0u;
+    return (occ_q_state_bit(occ_value_state(map, v)) & occ_q_blocking_states(policy)) != 0u;
 }
 
 occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
@@ -335,8 +339,8 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     if (blocker != NULL) {
         set_unsafe(blocker, a);
     }
-    if (map == NULL || visible == NULL || check_policy(policy) != OCC_OK || !occ_q_finite3(a) ||
-        !occ_q_finite3(b)) {
+    if (map == NULL || visible == NULL || check_policy(policy) != OCC_OK || !occ_finite3(a) ||
+        !occ_finite3(b)) {
         return OCC_ERR_ARG;
     }
     const real_t res = occ_geom_res(map);
@@ -351,6 +355,7 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     }
     const int32_t tmv = occ_geom_half(map);
     occ_ray_result_t scratch;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_ray_result_t *const res_out = blocker != NULL ? blocker : &scratch;
     const uint8_t stop = (uint8_t)occ_q_has_bits(occ_q_blocking_states(policy));
     cursor_t c;

@@ -50,7 +50,7 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
         ck.k[2] |= ((slot >> 2) & 1u) << l;
         const occ_entry_t e = occ_entry_at(m, f->block, l, slot);
         if (e.child == OCC_NONE) { /* a voxel, or a uniform node: it blocks and touches */
-            occ_q_fill_node(m, ck, l, e.value, e.flags, true, out);
+            occi_q_fill_node(m, ck, l, e.value, e.flags, true, out);
             return true;
         }
         OCC_ASSERT(sp < OCC_MAX_DEPTH && l >= 1u);
@@ -64,12 +64,16 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
 }
 
 /* The start cells (query.c) in Morton order, each reached from the root along the path of the
- * previous one (only the levels below their highest differing key bit are walked again). */
+ * previous one (only the levels below their highest differing key bit are walked again).
+ * -fanalyzer reads blk[level] as uninitialised: blk[stopped + 1 .. depth] always hold the path
+ * of the last cell descended (the first starts at the root, each later one rewrites from its
+ * common ancestor down), and a jump reads only level = hb + 1 > stopped. */
+OCC_ANALYZER_UNINIT_OFF
 static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_query_node_t *out)
 {
     occ_key_t start[8];
     unsigned lc;
-    const unsigned n = occ_q_start_cells(m, v, 0u, start, &lc);
+    const unsigned n = occi_q_start_cells(m, v, 0u, start, &lc);
     const unsigned depth = m->cfg.depth_levels;
     uint32_t blk[OCC_MAX_DEPTH + 1u]; /* blk[L]: children block of the path node at level L */
     unsigned stopped = depth + 1u;     /* level where the previous descent ended */
@@ -110,11 +114,11 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
         const bool wanted = occ_q_node_wanted(m, val, flags, uniform, states);
         const occ_key_t nk = occ_key_at_level(key, level);
         if (!wanted ||
-            !occ_volume_hits_box(v, occ_q_center(m, nk, level), occ_q_half(m, level))) {
+            !occ_volume_hits_box(v, occ_geom_center(m, nk, level), occ_q_half(m, level))) {
             continue;
         }
         if (uniform) {
-            occ_q_fill_node(m, nk, level, val, flags, true, out);
+            occi_q_fill_node(m, nk, level, val, flags, true, out);
             return true;
         }
         if (walk_below(m, v, states, nk, level - 1u, child, out)) {
@@ -123,8 +127,9 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
     }
     return false;
 }
+OCC_ANALYZER_UNINIT_ON
 
-void occ_q_collision_unsafe(occ_collision_t *out)
+void occi_q_collision_unsafe(occ_collision_t *out)
 {
     if (out == NULL) {
         return;
@@ -148,7 +153,7 @@ static bool leaves_map(const occ_map_t *map, const occ_volume_t *vol)
 occ_err_t occ_collide_volume(const occ_map_t *map, const occ_volume_t *vol,
                              occ_unknown_policy_t policy, occ_collision_t *out)
 {
-    occ_q_collision_unsafe(out); /* until the walk proves otherwise */
+    occi_q_collision_unsafe(out); /* until the walk proves otherwise */
     if (map == NULL || vol == NULL || out == NULL ||
         (policy != OCC_UNKNOWN_UNSAFE && policy != OCC_UNKNOWN_SAFE)) {
         return OCC_ERR_ARG;
@@ -166,7 +171,7 @@ occ_err_t occ_collide_sphere(const occ_map_t *map, occ_vec3_t center, float radi
                              occ_unknown_policy_t policy, occ_collision_t *out)
 {
     occ_volume_t v;
-    occ_q_collision_unsafe(out); /* also when the volume is refused */
+    occi_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_sphere(&v, center, radius_m);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }
@@ -175,7 +180,7 @@ occ_err_t occ_collide_aabb(const occ_map_t *map, occ_vec3_t min, occ_vec3_t max,
                            occ_unknown_policy_t policy, occ_collision_t *out)
 {
     occ_volume_t v;
-    occ_q_collision_unsafe(out); /* also when the volume is refused */
+    occi_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_aabb(&v, min, max);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }
@@ -185,7 +190,7 @@ occ_err_t occ_collide_obb(const occ_map_t *map, occ_vec3_t center, const float h
                           occ_collision_t *out)
 {
     occ_volume_t v;
-    occ_q_collision_unsafe(out); /* also when the volume is refused */
+    occi_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_obb(&v, center, half_m, axes);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }
@@ -194,7 +199,7 @@ occ_err_t occ_collide_capsule(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b, 
                               occ_unknown_policy_t policy, occ_collision_t *out)
 {
     occ_volume_t v;
-    occ_q_collision_unsafe(out); /* also when the volume is refused */
+    occi_q_collision_unsafe(out); /* also when the volume is refused */
     const occ_err_t e = occ_volume_capsule(&v, a, b, radius_m);
     return e != OCC_OK ? e : occ_collide_volume(map, &v, policy, out);
 }

@@ -47,9 +47,9 @@ occ_err_t occ_collide_convex(const occ_map_t *map, const occ_convex_t *shape,
                              occ_unknown_policy_t policy, occ_ccd_algo_t algo,
                              occ_collision_t *out)
 {
-    occ_q_collision_unsafe(out); /* until the walk proves otherwise */
+    occi_q_collision_unsafe(out); /* until the walk proves otherwise */
     if (map == NULL || shape == NULL || out == NULL || shape->support == NULL ||
-        !occ_q_finite3(shape->center) || (policy != OCC_UNKNOWN_UNSAFE && policy != OCC_UNKNOWN_SAFE) ||
+        !occ_finite3(shape->center) || (policy != OCC_UNKNOWN_UNSAFE && policy != OCC_UNKNOWN_SAFE) ||
         (algo != OCC_CCD_GJK && algo != OCC_CCD_MPR)) {
         return OCC_ERR_ARG;
     }

@@ -49,7 +49,7 @@ static occ_vec3_t sensor_origin(const occ_volume_t *v)
 static bool visible(const occ_map_t *m, occ_vec3_t from, occ_key_t cell, unsigned level)
 {
     bool vis = false;
-    const occ_vec3_t to = occ_q_center(m, cell, level);
+    const occ_vec3_t to = occ_geom_center(m, cell, level);
     if (occ_line_of_sight(m, from, to, OCC_UNKNOWN_SAFE, &vis, NULL) != OCC_OK) {
         return false;
     }

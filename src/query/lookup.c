@@ -43,10 +43,10 @@ occ_state_t occ_map_state_at(const occ_map_t *const map, const occ_vec3_t p)
         return OCC_STATE_UNKNOWN;
     }
     if (map->root_child == OCC_NONE) {
-        return occ_q_state(map, map->root_value);
+        return occ_value_state(map, map->root_value);
     }
     unsigned lu;
-    return occ_q_state(map, descend(map, &k, map->cfg.depth_levels, map->root_child, NULL, &lu));
+    return occ_value_state(map, descend(map, &k, map->cfg.depth_levels, map->root_child, NULL, &lu));
 }
 
 void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map)
@@ -79,7 +79,7 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
                            (k.k[2] ^ lk->key.k[2]);
         lk->key = k;
         if ((x >> lk->lu) == 0u) {
-            return occ_q_state(m, lk->val); /* same uniform node (or voxel) */
+            return occ_value_state(m, lk->val); /* same uniform node (or voxel) */
         }
         level = occ_bit_length32(x); /* highest changed bit + 1 */
         OCC_ASSERT(level > lk->lu && level <= depth); /* blk[level] is on the cached path */
@@ -90,7 +90,7 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
         if (m->root_child == OCC_NONE) {
             lk->lu = (uint8_t)depth;
             lk->val = m->root_value;
-            return occ_q_state(m, lk->val);
+            return occ_value_state(m, lk->val);
         }
         level = depth;
         b = m->root_child;
@@ -99,7 +99,7 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
     unsigned lu;
     lk->val = descend(m, &k, level, b, lk->blk, &lu);
     lk->lu = (uint8_t)lu;
-    return occ_q_state(m, lk->val);
+    return occ_value_state(m, lk->val);
 }
 
 occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
@@ -119,7 +119,7 @@ occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state)
     occ_err_t e = occ_lookup_status(lk);
     occ_key_t k;
     if (e == OCC_OK && !point_key(lk->map, p, &k)) {
-        e = occ_q_finite3(p) ? OCC_ERR_RANGE : OCC_ERR_ARG;
+        e = occ_finite3(p) ? OCC_ERR_RANGE : OCC_ERR_ARG;
     } else if (e == OCC_OK) {
         s = occ_lookup_state(lk, p);
     }

@@ -70,8 +70,8 @@ occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t 
     if (it != NULL) {
         it->map = NULL; /* refused: occ_nearest_next answers OCC_ERR_ARG */
     }
-    if (it == NULL || map == NULL || buf == NULL || cap == 0u || !occ_q_finite3(p) ||
-        !occ_q_finite(max_dist_m) || max_dist_m < 0.0f || (pred.states & ~OCC_PRED_ANY) != 0u ||
+    if (it == NULL || map == NULL || buf == NULL || cap == 0u || !occ_finite3(p) ||
+        !occ_finite(max_dist_m) || max_dist_m < 0.0f || (pred.states & ~OCC_PRED_ANY) != 0u ||
         pred.min_level > map->cfg.depth_levels) {
         return OCC_ERR_ARG;
     }
@@ -93,7 +93,7 @@ occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t 
     e.value = map->root_value;
     e.flags = map->root_flags;
     if (matches(it, e.value, e.flags, e.child == OCC_NONE)) {
-        e.dist2 = box_d2(p, occ_q_center(map, e.key, e.level), occ_q_half(map, e.level));
+        e.dist2 = box_d2(p, occ_geom_center(map, e.key, e.level), occ_q_half(map, e.level));
         if (e.dist2 <= it->max_dist2) {
             (void)push(it, &e);
         }
@@ -119,7 +119,7 @@ occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist
         pop(it, &top);
         const bool uniform = top.child == OCC_NONE;
         if (uniform || top.level <= it->pred.min_level) {
-            occ_q_fill_node(m, top.key, top.level, top.value, top.flags, uniform, out);
+            occi_q_fill_node(m, top.key, top.level, top.value, top.flags, uniform, out);
             if (dist_m != NULL) {
                 *dist_m = sqrtf(top.dist2);
             }
@@ -144,7 +144,7 @@ occ_err_t occ_nearest_next(occ_nearest_t *it, occ_query_node_t *out, float *dist
             if (!matches(it, e.value, e.flags, e.child == OCC_NONE)) {
                 continue;
             }
-            e.dist2 = box_d2(it->p, occ_q_center(m, e.key, level), h);
+            e.dist2 = box_d2(it->p, occ_geom_center(m, e.key, level), h);
             if (e.dist2 > it->max_dist2) {
                 continue;
             }

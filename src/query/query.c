@@ -5,18 +5,18 @@
  */
 #include "query_internal.h"
 
-void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
-                     uint8_t flags, bool uniform, occ_query_node_t *out)
+void occi_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
+                      uint8_t flags, bool uniform, occ_query_node_t *out)
 {
     out->key = occ_key_at_level(key, level);
     out->level = (uint8_t)level;
     out->uniform = uniform;
     out->inside = false;
     out->observed = occ_is_observed(v);
-    out->state = occ_q_state(m, v);
-    out->flags = uniform ? occ_q_uniform_flags(m, v) : flags;
+    out->state = occ_value_state(m, v);
+    out->flags = uniform ? (uint8_t)(occ_value_flags(m, v) | OCC_NODE_UNIFORM) : flags;
     out->logodds = out->observed ? occ_value_to_logodds(v) : 0.0f;
-    out->center = occ_q_center(m, out->key, level);
+    out->center = occ_geom_center(m, out->key, level);
     out->size_m = occ_map_node_size(m, level);
 }
 
@@ -26,14 +26,14 @@ static bool same_above(occ_key_t a, occ_key_t b, unsigned level)
            ((a.k[2] ^ b.k[2]) >> level) == 0u;
 }
 
-unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
-                           occ_key_t start[8], unsigned *level)
+unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                            occ_key_t start[8], unsigned *level)
 {
     const unsigned depth = map->cfg.depth_levels;
     *level = depth;
     uint32_t lo[3];
     uint32_t hi[3];
-    if (!occ_q_bounds_keys(map, vol, lo, hi)) {
+    if (!occi_q_bounds_keys(map, vol, lo, hi)) {
         return 0u; /* nothing of the map is near the volume */
     }
     /* Smallest level whose cells are at least as wide as the key range: the range then spans
@@ -62,6 +62,7 @@ unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsign
     }
     unsigned rank[3] = {0u, 0u, 0u};
     for (unsigned j = 0; j < na; j++) {
+        /* cppcheck-suppress uninitvar ; ax[0..na) were written by the loop above, j < na */
         const uint32_t x = c0[ax[j]] ^ (c0[ax[j]] + 1u);
         rank[j] = (occ_bit_length32(x) - 1u) * 3u + ax[j];
     }
@@ -116,7 +117,7 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
     it->istart = 0;
     it->gen = map->write_gen;
     unsigned lc = depth;
-    it->nstart = (uint8_t)occ_q_start_cells(map, vol, pred.min_level, it->start, &lc);
+    it->nstart = (uint8_t)occi_q_start_cells(map, vol, pred.min_level, it->start, &lc);
     it->start_level = (uint8_t)lc;
     return OCC_OK;
 }
@@ -175,7 +176,7 @@ static inline bool take(occ_query_iter_t *it, occ_key_t key, unsigned level, occ
             return false;
         }
         if ((it->pred.options & OCC_ITER_SPLIT) != 0u) {
-            inside = occ_volume_holds_box(it->vol, occ_q_center(it->map, key, level),
+            inside = occ_volume_holds_box(it->vol, occ_geom_center(it->map, key, level),
                                           occ_q_half(it->map, level));
             if (!inside) {
                 push(it, key, level - 1u, OCC_NONE, v, i);
@@ -183,7 +184,7 @@ static inline bool take(occ_query_iter_t *it, occ_key_t key, unsigned level, occ
             }
         }
     }
-    occ_q_fill_node(it->map, key, level, v, flags, uniform, out);
+    occi_q_fill_node(it->map, key, level, v, flags, uniform, out);
     out->inside = inside;
     return true;
 }
@@ -193,7 +194,7 @@ static bool enter(occ_query_iter_t *it, occ_key_t key, unsigned level, occ_value
                   uint8_t flags, uint32_t child, unsigned i, occ_query_node_t *out)
 {
     if (!pred_match(it, v, flags, child == OCC_NONE) ||
-        !occ_volume_hits_box(it->vol, occ_q_center(it->map, key, level), occ_q_half(it->map, level))) {
+        !occ_volume_hits_box(it->vol, occ_geom_center(it->map, key, level), occ_q_half(it->map, level))) {
         return false;
     }
     return take(it, key, level, v, flags, child, i, out);

@@ -9,17 +9,6 @@
 #include <string.h>
 #include "../core/tree_internal.h"
 
-static inline occ_state_t occ_q_state(const occ_map_t *m, occ_value_t v)
-{
-    if (!occ_is_observed(v)) {
-        return OCC_STATE_UNKNOWN;
-    }
-    if (v >= m->q_occ_min) {
-        return OCC_STATE_OCCUPIED;
-    }
-    return (v < m->q_free_max) ? OCC_STATE_FREE : OCC_STATE_UNKNOWN;
-}
-
 static inline uint8_t occ_q_state_bit(occ_state_t s)
 {
     switch (s) {
@@ -31,20 +20,6 @@ static inline uint8_t occ_q_state_bit(occ_state_t s)
         return (uint8_t)OCC_PRED_UNKNOWN;
     default:
         return 0u;
-    }
-}
-
-/* Flags of a uniform value. */
-static inline uint8_t occ_q_uniform_flags(const occ_map_t *m, occ_value_t v)
-{
-    switch (occ_q_state(m, v)) {
-    case OCC_STATE_OCCUPIED:
-        return (uint8_t)(OCC_NODE_HAS_OCCUPIED | OCC_NODE_UNIFORM);
-    case OCC_STATE_FREE:
-        return (uint8_t)(OCC_NODE_HAS_FREE | OCC_NODE_UNIFORM);
-    case OCC_STATE_UNKNOWN:
-    default:
-        return (uint8_t)(OCC_NODE_HAS_UNKNOWN | OCC_NODE_UNIFORM);
     }
 }
 
@@ -68,7 +43,7 @@ static inline bool occ_q_contains(uint8_t flags, unsigned states)
 static inline bool occ_q_node_wanted(const occ_map_t *m, occ_value_t v, uint8_t flags,
                                      bool uniform, unsigned states)
 {
-    return uniform ? (states & occ_q_state_bit(occ_q_state(m, v))) != 0u
+    return uniform ? (states & occ_q_state_bit(occ_value_state(m, v))) != 0u
                    : occ_q_contains(flags, states);
 }
 
@@ -78,35 +53,9 @@ static inline unsigned occ_q_blocking_states(occ_unknown_policy_t policy)
     return OCC_PRED_OCCUPIED | (policy == OCC_UNKNOWN_UNSAFE ? OCC_PRED_UNKNOWN : 0u);
 }
 
-/* Centre coordinate (metres) of the node at `level` whose first voxel key on an axis is `k`
- * (the map's one geometry, as occ_map_key_center). */
-static inline float occ_q_center1(const occ_map_t *m, uint32_t k, unsigned level)
-{
-    return occ_geom_center1(m, k, level);
-}
-
-static inline occ_vec3_t occ_q_center(const occ_map_t *m, occ_key_t k, unsigned level)
-{
-    occ_vec3_t c;
-    c.x = occ_q_center1(m, k.k[0], level);
-    c.y = occ_q_center1(m, k.k[1], level);
-    c.z = occ_q_center1(m, k.k[2], level);
-    return c;
-}
-
 static inline float occ_q_half(const occ_map_t *m, unsigned level)
 {
     return (float)(1u << level) * 0.5f * m->cfg.resolution_m;
-}
-
-static inline bool occ_q_finite(float f)
-{
-    return isfinite(f) != 0;
-}
-
-static inline bool occ_q_finite3(occ_vec3_t v)
-{
-    return occ_q_finite(v.x) && occ_q_finite(v.y) && occ_q_finite(v.z);
 }
 
 /* Little-endian targets test the 8 flag bytes of a block as one 64-bit word. */
@@ -226,10 +175,10 @@ static inline unsigned occ_q_aabb_touch(const occ_volume_t *v, occ_vec3_t pc, fl
 
 /* volume.c: key range [lo, hi] per axis of the voxels that can touch the volume's closed bounds
  * (one voxel of slack for faces on a border); false when the bounds miss the map. */
-bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
+bool occi_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
 /* volume.c: occ_q_touch_mask for the other kinds, child by child with the exact cube tests. */
-unsigned occ_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                                unsigned level);
+unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                 unsigned level);
 
 /* Which of the 8 children (at `level`) of the node with first voxel `pkey` touch the volume
  * (bit s for child slot s; exact, as occ_volume_hits_box). Spheres and boxes inline: they are
@@ -238,26 +187,26 @@ static inline unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *
                                         unsigned level)
 {
     if (v->kind == OCC_VOL_SPHERE) {
-        return occ_q_sphere_touch(v, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
+        return occ_q_sphere_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
     }
     if (v->kind == OCC_VOL_AABB) {
-        return occ_q_aabb_touch(v, occ_q_center(m, pkey, level + 1u), occ_q_half(m, level));
+        return occ_q_aabb_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
     }
-    return occ_q_touch_mask_cubes(m, v, pkey, level);
+    return occi_q_touch_mask_cubes(m, v, pkey, level);
 }
 
 /* query.c: the cells a walk over the volume starts from: at most 8, at the smallest level
  * (>= min_level) whose cells are as wide as the volume's key range, in Morton order; *level gets
  * that level (depth_levels with the root as the one start). 0 when the volume misses the map. */
-unsigned occ_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
-                           occ_key_t start[8], unsigned *level);
+unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                            occ_key_t start[8], unsigned *level);
 
 /* collide.c: the answer of a collision check that has not decided yet or failed: not safe,
  * not outside, an unobserved UNKNOWN node. Every collision entry point starts with it. */
-void occ_q_collision_unsafe(occ_collision_t *out);
+void occi_q_collision_unsafe(occ_collision_t *out);
 
 /* Fill a reported node. */
-void occ_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
-                     uint8_t flags, bool uniform, occ_query_node_t *out);
+void occi_q_fill_node(const occ_map_t *m, occ_key_t key, unsigned level, occ_value_t v,
+                      uint8_t flags, bool uniform, occ_query_node_t *out);
 
 #endif /* OCC_QUERY_INTERNAL_H_INCLUDED */

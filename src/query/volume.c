@@ -30,7 +30,7 @@ static float maxf(float a, float b) { return a > b ? a : b; }
 static bool axes_ok(const occ_vec3_t axes[3])
 {
     for (unsigned i = 0; i < 3u; i++) {
-        if (!occ_q_finite3(axes[i]) || fabsf(vdot(axes[i], axes[i]) - 1.0f) > 2e-3f) {
+        if (!occ_finite3(axes[i]) || fabsf(vdot(axes[i], axes[i]) - 1.0f) > 2e-3f) {
             return false;
         }
         for (unsigned j = i + 1u; j < 3u; j++) {
@@ -45,7 +45,7 @@ static bool axes_ok(const occ_vec3_t axes[3])
 /* ---- constructors ----------------------------------------------------------------------------- */
 occ_err_t occ_volume_aabb(occ_volume_t *v, occ_vec3_t min, occ_vec3_t max)
 {
-    if (v == NULL || !occ_q_finite3(min) || !occ_q_finite3(max) || min.x > max.x ||
+    if (v == NULL || !occ_finite3(min) || !occ_finite3(max) || min.x > max.x ||
         min.y > max.y || min.z > max.z) {
         return OCC_ERR_ARG;
     }
@@ -57,7 +57,7 @@ occ_err_t occ_volume_aabb(occ_volume_t *v, occ_vec3_t min, occ_vec3_t max)
 
 occ_err_t occ_volume_sphere(occ_volume_t *v, occ_vec3_t center, float radius_m)
 {
-    if (v == NULL || !occ_q_finite3(center) || !occ_q_finite(radius_m) || radius_m < 0.0f) {
+    if (v == NULL || !occ_finite3(center) || !occ_finite(radius_m) || radius_m < 0.0f) {
         return OCC_ERR_ARG;
     }
     v->kind = OCC_VOL_SPHERE;
@@ -71,11 +71,11 @@ occ_err_t occ_volume_sphere(occ_volume_t *v, occ_vec3_t center, float radius_m)
 occ_err_t occ_volume_obb(occ_volume_t *v, occ_vec3_t center, const float half_m[3],
                          const occ_vec3_t axes[3])
 {
-    if (v == NULL || half_m == NULL || axes == NULL || !occ_q_finite3(center) || !axes_ok(axes)) {
+    if (v == NULL || half_m == NULL || axes == NULL || !occ_finite3(center) || !axes_ok(axes)) {
         return OCC_ERR_ARG;
     }
     for (unsigned i = 0; i < 3u; i++) {
-        if (!occ_q_finite(half_m[i]) || half_m[i] < 0.0f) {
+        if (!occ_finite(half_m[i]) || half_m[i] < 0.0f) {
             return OCC_ERR_ARG;
         }
     }
@@ -100,7 +100,7 @@ occ_err_t occ_volume_obb(occ_volume_t *v, occ_vec3_t center, const float half_m[
 occ_err_t occ_volume_obb_yaw(occ_volume_t *v, occ_vec3_t center, const float half_m[3],
                              float yaw_rad)
 {
-    if (!occ_q_finite(yaw_rad)) {
+    if (!occ_finite(yaw_rad)) {
         return OCC_ERR_ARG;
     }
     const float c = cosf(yaw_rad);
@@ -115,7 +115,7 @@ occ_err_t occ_volume_obb_yaw(occ_volume_t *v, occ_vec3_t center, const float hal
 static occ_err_t capsule_like(occ_volume_t *v, occ_vec3_t a, occ_vec3_t b, float r,
                               occ_volume_kind_t kind)
 {
-    if (v == NULL || !occ_q_finite3(a) || !occ_q_finite3(b) || !occ_q_finite(r) || r < 0.0f) {
+    if (v == NULL || !occ_finite3(a) || !occ_finite3(b) || !occ_finite(r) || r < 0.0f) {
         return OCC_ERR_ARG;
     }
     v->kind = kind;
@@ -141,9 +141,9 @@ occ_err_t occ_volume_frustum(occ_volume_t *v, occ_vec3_t origin, const occ_vec3_
                              float hfov_rad, float vfov_rad, float near_m, float far_m)
 {
     const float pi = 3.14159265f;
-    if (v == NULL || axes == NULL || !occ_q_finite3(origin) || !axes_ok(axes) ||
-        !occ_q_finite(hfov_rad) || !occ_q_finite(vfov_rad) || !occ_q_finite(near_m) ||
-        !occ_q_finite(far_m) || !(hfov_rad > 0.0f) || !(hfov_rad < pi) || !(vfov_rad > 0.0f) ||
+    if (v == NULL || axes == NULL || !occ_finite3(origin) || !axes_ok(axes) ||
+        !occ_finite(hfov_rad) || !occ_finite(vfov_rad) || !occ_finite(near_m) ||
+        !occ_finite(far_m) || !(hfov_rad > 0.0f) || !(hfov_rad < pi) || !(vfov_rad > 0.0f) ||
         !(vfov_rad < pi) || !(near_m >= 0.0f) || !(far_m > near_m)) {
         return OCC_ERR_ARG;
     }
@@ -467,7 +467,7 @@ bool occ_volume_holds_box(const occ_volume_t *v, occ_vec3_t c, float h)
 /* ---- what a volume can touch ---------------------------------------------------------------- */
 /* Key range [lo, hi] per axis of the voxels that can touch the closed bounds (one voxel of slack
  * for faces lying exactly on a border); false when the bounds miss the map. */
-bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3])
+bool occi_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3])
 {
     /* Slack for rounding, in voxels: the exact tests work on float node boxes, whose step at the
      * map's far corners is half * 2^-23 voxels; four of those, and a lower face on a border
@@ -479,18 +479,18 @@ bool occ_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3]
     const float bmin[3] = {v->bmin.x, v->bmin.y, v->bmin.z};
     const float bmax[3] = {v->bmax.x, v->bmax.y, v->bmax.z};
     for (unsigned i = 0; i < 3u; i++) {
-        if (!occ_geom_key_range(m, bmin[i], bmax[i], slack, &lo[i], &hi[i])) {
+        if (!occi_geom_key_range(m, bmin[i], bmax[i], slack, &lo[i], &hi[i])) {
             return false;
         }
     }
     return true;
 }
 
-unsigned occ_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                                unsigned level)
+unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                 unsigned level)
 {
     const float h = occ_q_half(m, level);
-    const occ_vec3_t pc = occ_q_center(m, pkey, level + 1u);
+    const occ_vec3_t pc = occ_geom_center(m, pkey, level + 1u);
     unsigned mask = 0u;
     for (unsigned s = 0; s < 8u; s++) {
         occ_vec3_t c;

@@ -629,6 +629,7 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
                 continue;
             }
             unsigned j = nk++;
+            /* cppcheck-suppress uninitvar ; kid_d[0..nk) are written, j - 1 < nk */
             while (j > 0u && kid_d[j - 1u] < dm) {
                 kid[j] = kid[j - 1u];
                 kid_d[j] = kid_d[j - 1u];
