@@ -176,43 +176,34 @@ static int32_t sector_of_point(const ctx_t *c, const occ_sectors_t *out, float x
     return p;
 }
 
+/* Clip [*tmin, *tmax] to the parameters where the ray component d lies in [lo, hi] (one slab of
+ * the rectangle); false when the ray misses that slab. */
+static bool clip_slab(float d, float lo, float hi, float *tmin, float *tmax)
+{
+    if (fabsf(d) < 1e-20f) {
+        return !(lo > 0.0f || hi < 0.0f);
+    }
+    float t1 = lo / d;
+    float t2 = hi / d;
+    if (t1 > t2) {
+        const float t = t1;
+        t1 = t2;
+        t2 = t;
+    }
+    *tmin = t1 > *tmin ? t1 : *tmin;
+    *tmax = t2 < *tmax ? t2 : *tmax;
+    return true;
+}
+
 /* Entry distance of boundary ray k into the rectangle (vehicle-relative), or -1 on a miss. */
 static float ray_entry(const occ_sectors_t *out, unsigned k, float ax0, float ay0, float ax1,
                        float ay1)
 {
-    const float dc = out->ray_c[k];
-    const float ds = out->ray_s[k];
     float tmin = 0.0f;
     float tmax = OCC_SECTORS_FAR;
-    if (fabsf(dc) < 1e-20f) {
-        if (ax0 > 0.0f || ax1 < 0.0f) {
-            return -1.0f;
-        }
-    } else {
-        float t1 = ax0 / dc;
-        float t2 = ax1 / dc;
-        if (t1 > t2) {
-            const float t = t1;
-            t1 = t2;
-            t2 = t;
-        }
-        tmin = t1 > tmin ? t1 : tmin;
-        tmax = t2 < tmax ? t2 : tmax;
-    }
-    if (fabsf(ds) < 1e-20f) {
-        if (ay0 > 0.0f || ay1 < 0.0f) {
-            return -1.0f;
-        }
-    } else {
-        float t1 = ay0 / ds;
-        float t2 = ay1 / ds;
-        if (t1 > t2) {
-            const float t = t1;
-            t1 = t2;
-            t2 = t;
-        }
-        tmin = t1 > tmin ? t1 : tmin;
-        tmax = t2 < tmax ? t2 : tmax;
+    if (!clip_slab(out->ray_c[k], ax0, ax1, &tmin, &tmax) ||
+        !clip_slab(out->ray_s[k], ay0, ay1, &tmin, &tmax)) {
+        return -1.0f;
     }
     return tmin <= tmax ? tmin : -1.0f;
 }
