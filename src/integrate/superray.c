@@ -113,48 +113,66 @@ static inline bool rank_of(const occ_rr_t *ed, uint32_t ne, occ_rr_t sg, uint32_
              (lo > 0u && sg - ed[lo - 1u] <= SR_TIE * sg));
 }
 
-/* Rays of one end voxel (point indices idx[0..cnt), cnt <= SR_MAX_GROUP). */
-static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
-                       const uint32_t *const idx, const size_t cnt, const uint32_t ke[3],
-                       sr_ws_t *const ws)
-{
+/* What every ray of one end voxel shares: per axis, the voxel steps from the origin's voxel
+ * (nax), their direction (sgn) and the distance from the origin to the first plane ahead (dx0). */
+typedef struct {
     uint32_t nax[3];
     int32_t sgn[3];
     occ_rr_t dx0[3];
+    occ_rr_t margin; /* end points nearer than this (voxels) to their voxel's faces go singly */
+} sr_axes_t;
+
+static void bundle_axes(const occ_ictx_t *const x, const uint32_t ke[3], sr_axes_t *const ax)
+{
     for (unsigned a = 0; a < 3u; a++) {
-        nax[a] = ke[a] > x->ko[a] ? ke[a] - x->ko[a] : x->ko[a] - ke[a];
-        sgn[a] = ke[a] > x->ko[a] ? 1 : -1;
+        ax->nax[a] = ke[a] > x->ko[a] ? ke[a] - x->ko[a] : x->ko[a] - ke[a];
+        ax->sgn[a] = ke[a] > x->ko[a] ? 1 : -1;
         /* OctoMap's voxelBorder for this step direction, as a distance ahead of the origin. */
         occ_rr_t border = ((occ_rr_t)((int32_t)x->ko[a] - x->g.tmv) + (occ_rr_t)0.5) * x->g.res;
-        border += (occ_rr_t)(float)((occ_rr_t)sgn[a] * x->g.res * (occ_rr_t)0.5);
-        dx0[a] = (border - (occ_rr_t)x->o[a]) * (occ_rr_t)sgn[a];
+        border += (occ_rr_t)(float)((occ_rr_t)ax->sgn[a] * x->g.res * (occ_rr_t)0.5);
+        ax->dx0[a] = (border - (occ_rr_t)x->o[a]) * (occ_rr_t)ax->sgn[a];
     }
-    const occ_rr_t margin =
-        (occ_rr_t)1e-4 + (occ_rr_t)1e-6 * (occ_rr_t)(nax[0] + nax[1] + nax[2]);
-    occ_rr_t lo[3], hi[3];
+    ax->margin =
+        (occ_rr_t)1e-4 + (occ_rr_t)1e-6 * (occ_rr_t)(ax->nax[0] + ax->nax[1] + ax->nax[2]);
+}
+
+/* The ray to e: its DDA direction d (float difference, float length, float division), and
+ * whether it may share a traversal - it steps the bundle's way on every axis, and its end lies
+ * away from its voxel's faces, so the DDA reaches the end voxel by its crossings, not by the
+ * length test. */
+static bool ray_shareable(const occ_ictx_t *const x, const float e[3], const uint32_t ke[3],
+                          const sr_axes_t *const ax, float d[3])
+{
+    const float len = (float)occi_raygeo_dist(x->o, e);
+    bool safe = true;
+    for (unsigned a = 0; a < 3u; a++) {
+        d[a] = (e[a] - x->o[a]) / len;
+        const int32_t st = d[a] > 0.0f ? 1 : (d[a] < 0.0f ? -1 : 0);
+        if (ax->nax[a] > 0u && st != ax->sgn[a]) {
+            safe = false;
+        }
+        /* The end voxel's key is ke, so its lower face is at ke - tmv (key units). */
+        const occ_rr_t frac = x->g.rf * (occ_rr_t)e[a] - (occ_rr_t)((int32_t)ke[a] - x->g.tmv);
+        if (frac < ax->margin || frac > (occ_rr_t)1 - ax->margin) {
+            safe = false;
+        }
+    }
+    return safe;
+}
+
+/* The shareable rays of idx[0..cnt) into ws->rays with their slopes, and per projection the
+ * slopes' range [lo, hi]; the others are cast singly. Returns how many were kept. */
+static size_t collect_rays(occ_ictx_t *const x, const occ_vec3_t *const points,
+                           const uint32_t *const idx, const size_t cnt, const uint32_t ke[3],
+                           const sr_axes_t *const ax, sr_ws_t *const ws, occ_rr_t lo[3],
+                           occ_rr_t hi[3])
+{
     size_t nr = 0;
     for (size_t j = 0; j < cnt; j++) {
         const occ_vec3_t p = points[idx[j]];
         const float e[3] = {p.x, p.y, p.z};
-        /* The DDA's direction: float difference, float length, float division. */
-        const float len = (float)occi_raygeo_dist(x->o, e);
         float d[3];
-        bool safe = true;
-        for (unsigned a = 0; a < 3u; a++) {
-            d[a] = (e[a] - x->o[a]) / len;
-            const int32_t st = d[a] > 0.0f ? 1 : (d[a] < 0.0f ? -1 : 0);
-            if (nax[a] > 0u && st != sgn[a]) {
-                safe = false;
-            }
-            /* The end point away from its voxel's faces: the DDA then reaches the end voxel
-             * by its crossings, not by the length test. Its key is ke, so the voxel's lower
-             * face is at ke - tmv (key units). */
-            const occ_rr_t frac = x->g.rf * (occ_rr_t)e[a] - (occ_rr_t)((int32_t)ke[a] - x->g.tmv);
-            if (frac < margin || frac > (occ_rr_t)1 - margin) {
-                safe = false;
-            }
-        }
-        if (!safe) {
+        if (!ray_shareable(x, e, ke, ax, d)) {
             cast_one(x, p, ke);
             continue;
         }
@@ -172,27 +190,33 @@ static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
         r->point = idx[j];
         nr++;
     }
-    if (nr == 0u) {
-        return;
-    }
-    uint32_t ne[3] = {0, 0, 0};
-    bool ok = true;
-    for (unsigned q = 0; q < 3u && ok; q++) {
+    return nr;
+}
+
+/* Per projection, the critical slopes inside [lo, hi] into ws->edges, their counts into ne[].
+ * False when a projection has more than SR_MAX_EDGES. */
+static bool bundle_edges(const occ_ictx_t *const x, const sr_axes_t *const ax,
+                         const occ_rr_t lo[3], const occ_rr_t hi[3], sr_ws_t *const ws,
+                         uint32_t ne[3])
+{
+    for (unsigned q = 0; q < 3u; q++) {
         const unsigned a = PA[q], b = PB[q];
-        if (nax[a] > 0u && nax[b] > 0u) {
-            ok = list_edges(lo[q], hi[q], dx0[a], dx0[b], x->g.res, nax[a], nax[b],
-                            ws->edges + q * SR_MAX_EDGES, &ne[q]);
+        if (ax->nax[a] > 0u && ax->nax[b] > 0u &&
+            !list_edges(lo[q], hi[q], ax->dx0[a], ax->dx0[b], x->g.res, ax->nax[a], ax->nax[b],
+                        ws->edges + q * SR_MAX_EDGES, &ne[q])) {
+            return false;
         }
     }
-    /* Edges split the bundle into at most edges + 1 super rays: with too many, signatures cost
-     * more than they save - cast singly. */
-    if (!ok || (size_t)(ne[0] + ne[1] + ne[2]) * 3u + 3u > nr) {
-        for (size_t j = 0; j < nr; j++) {
-            cast_one(x, points[ws->rays[j].point], ke);
-        }
-        return;
-    }
-    /* Signatures: per projection, how many critical slopes lie below the ray's slope. */
+    return true;
+}
+
+/* Each kept ray's signature (per projection, how many critical slopes lie below its slope).
+ * A ray near a slope is cast singly; with few signatures the first ray of each is cast here
+ * (stamp table), else its key goes to ws->keys for sorting. Returns the number of keys. */
+static size_t cast_signatures(occ_ictx_t *const x, const occ_vec3_t *const points,
+                              const uint32_t ke[3], const size_t nr, const uint32_t ne[3],
+                              sr_ws_t *const ws)
+{
     const uint32_t dim0 = ne[0] + 1u, dim1 = ne[1] + 1u;
     const bool stamped = (uint64_t)dim0 * dim1 * (ne[2] + 1u) <= SR_STAMPS;
     if (stamped) {
@@ -219,10 +243,13 @@ static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
             ws->keys[nk++] = (sig << 16) | (uint64_t)j; /* 45 + 16 bits, bit 63 clear */
         }
     }
-    /* Many signatures: one traversal per distinct one, found by sorting (Shell sort: bundles
-     * hold at most SR_MAX_GROUP rays). */
+    return nk;
+}
+
+/* Shell sort: keys come at most SR_MAX_GROUP at a time. */
+static void sort_keys(uint64_t *const sk, const size_t nk)
+{
     static const uint16_t gaps[] = {1750, 701, 301, 132, 57, 23, 10, 4, 1};
-    uint64_t *const sk = ws->keys;
     for (size_t gi = 0; gi < sizeof gaps / sizeof gaps[0] && nk > 1u; gi++) {
         const size_t gap = gaps[gi];
         for (size_t i = gap; i < nk; i++) {
@@ -235,9 +262,36 @@ static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
             sk[j] = v;
         }
     }
+}
+
+/* Rays of one end voxel (point indices idx[0..cnt), cnt <= SR_MAX_GROUP): one traversal per
+ * signature. */
+static void run_bundle(occ_ictx_t *const x, const occ_vec3_t *const points,
+                       const uint32_t *const idx, const size_t cnt, const uint32_t ke[3],
+                       sr_ws_t *const ws)
+{
+    sr_axes_t ax;
+    bundle_axes(x, ke, &ax);
+    occ_rr_t lo[3], hi[3];
+    const size_t nr = collect_rays(x, points, idx, cnt, ke, &ax, ws, lo, hi);
+    if (nr == 0u) {
+        return;
+    }
+    uint32_t ne[3] = {0, 0, 0};
+    /* Edges split the bundle into at most edges + 1 super rays: with too many, signatures cost
+     * more than they save - cast singly. */
+    if (!bundle_edges(x, &ax, lo, hi, ws, ne) || (size_t)(ne[0] + ne[1] + ne[2]) * 3u + 3u > nr) {
+        for (size_t j = 0; j < nr; j++) {
+            cast_one(x, points[ws->rays[j].point], ke);
+        }
+        return;
+    }
+    /* Many signatures: one traversal per distinct one, found by sorting their keys. */
+    const size_t nk = cast_signatures(x, points, ke, nr, ne, ws);
+    sort_keys(ws->keys, nk);
     for (size_t i = 0; i < nk; i++) {
-        if (i == 0u || (sk[i] >> 16) != (sk[i - 1u] >> 16)) {
-            cast_one(x, points[ws->rays[sk[i] & 0xFFFFu].point], ke);
+        if (i == 0u || (ws->keys[i] >> 16) != (ws->keys[i - 1u] >> 16)) {
+            cast_one(x, points[ws->rays[ws->keys[i] & 0xFFFFu].point], ke);
         }
     }
 }
@@ -294,32 +348,44 @@ static bool run_single(occ_ictx_t *const x, const occ_vec3_t *const points, cons
     return true;
 }
 
-bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
-                       const uint16_t k_min)
-{
-    /* Workspace in the dense path's free scratch: end cells and point indices (sorted as
-     * pairs), per-bundle rays, edges, signature keys and the signature stamps. */
-    const size_t need = occ_sat_add(occ_sat_mul(n, 24u),
-                                    SR_MAX_GROUP * (sizeof(sr_ray_t) + 8u) +
-                                        3u * SR_MAX_EDGES * sizeof(occ_rr_t) + SR_STAMPS * 4u + 64u);
-    if (x->bs == NULL || x->b_cap < need / 8u + 1u || n >= UINT32_MAX) {
-        return run_single(x, points, n);
-    }
-    occ_ictx_note(x, 0, need / 8u + 1u);
-    uint64_t *const keys = x->b;
-    uint64_t *const tkeys = keys + n;
-    uint32_t *const vals = (uint32_t *)(void *)(tkeys + n);
-    uint32_t *const tvals = vals + n;
-    sr_ws_t ws;
-    ws.rays = (sr_ray_t *)(void *)(keys + 3u * n);
-    ws.edges = (occ_rr_t *)(void *)(ws.rays + SR_MAX_GROUP);
-    ws.keys = (uint64_t *)(void *)(ws.edges + 3u * SR_MAX_EDGES);
-    ws.stamp = (uint32_t *)(void *)(ws.keys + SR_MAX_GROUP);
-    memset(ws.stamp, 0, SR_STAMPS * sizeof *ws.stamp);
-    ws.bundle = 0;
+/* The dense path's free scratch, carved: end cells and point indices (sorted as pairs, with
+ * room for the sort's second copy), then the per-bundle workspace. */
+typedef struct {
+    uint64_t *keys, *tkeys; /* end cell per point, and the sort's second buffer */
+    uint32_t *vals, *tvals; /* the point's index, and the sort's second buffer */
+    uint64_t bx, by;        /* the scan box's size in voxels along x and y */
+} sr_cells_t;
 
-    const uint64_t bx = (uint64_t)(x->box_hi[0] - x->box_lo[0]) + 1u;
-    const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
+static size_t superray_need(const size_t n)
+{
+    return occ_sat_add(occ_sat_mul(n, 24u), SR_MAX_GROUP * (sizeof(sr_ray_t) + 8u) +
+                                                3u * SR_MAX_EDGES * sizeof(occ_rr_t) +
+                                                SR_STAMPS * 4u + 64u);
+}
+
+static void carve_scratch(occ_ictx_t *const x, const size_t n, sr_cells_t *const c,
+                          sr_ws_t *const ws)
+{
+    c->keys = x->b;
+    c->tkeys = c->keys + n;
+    c->vals = (uint32_t *)(void *)(c->tkeys + n);
+    c->tvals = c->vals + n;
+    c->bx = (uint64_t)(x->box_hi[0] - x->box_lo[0]) + 1u;
+    c->by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
+    ws->rays = (sr_ray_t *)(void *)(c->keys + 3u * n);
+    ws->edges = (occ_rr_t *)(void *)(ws->rays + SR_MAX_GROUP);
+    ws->keys = (uint64_t *)(void *)(ws->edges + 3u * SR_MAX_EDGES);
+    ws->stamp = (uint32_t *)(void *)(ws->keys + SR_MAX_GROUP);
+    memset(ws->stamp, 0, SR_STAMPS * sizeof *ws->stamp);
+    ws->bundle = 0;
+}
+
+/* Each point's end cell (its voxel's index in the scan's box: grouping needs no Morton order,
+ * and the box index sorts in fewer radix passes) into c->keys / c->vals; points out of range
+ * or outside the map go through occi_ictx_point() right away. False when scratch ran out. */
+static bool bin_points(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                       const sr_cells_t *const c, size_t *const m_out)
+{
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         if (!occ_finite3(points[i])) {
@@ -338,51 +404,84 @@ bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, cons
             x->r->points_skipped += rc > 0 ? 1u : 0u;
             continue;
         }
-        /* Grouping needs no Morton order: the voxel's index in the scan's box sorts in fewer
-         * radix passes. */
-        keys[m] = (uint64_t)(k[0] - x->box_lo[0]) +
-                  bx * ((uint64_t)(k[1] - x->box_lo[1]) + by * (uint64_t)(k[2] - x->box_lo[2]));
-        vals[m] = (uint32_t)i;
+        c->keys[m] = (uint64_t)(k[0] - x->box_lo[0]) +
+                     c->bx * ((uint64_t)(k[1] - x->box_lo[1]) +
+                              c->by * (uint64_t)(k[2] - x->box_lo[2]));
+        c->vals[m] = (uint32_t)i;
         m++;
     }
     x->r->points_integrated += m;
-    const uint64_t cells = bx * by * ((uint64_t)(x->box_hi[2] - x->box_lo[2]) + 1u);
-    if (cells <= 2u * (uint64_t)m) {
-        /* A small box (coarse resolution): counting sort, the histogram in tkeys' room. */
-        uint32_t *const hist = (uint32_t *)(void *)tkeys;
-        memset(hist, 0, (size_t)cells * sizeof *hist);
-        for (size_t i = 0; i < m; i++) {
-            hist[keys[i]]++;
-        }
-        uint32_t sum = 0;
-        for (size_t c = 0; c < (size_t)cells; c++) {
-            const uint32_t h = hist[c];
-            hist[c] = sum;
-            sum += h;
-        }
-        for (size_t i = 0; i < m; i++) {
-            tvals[hist[keys[i]]++] = vals[i]; /* hist[c] ends as the end of cell c's run */
-        }
-        for (size_t c = 0, s0 = 0; c < (size_t)cells; c++) {
-            if (hist[c] > s0 &&
-                !run_voxel(x, points, tvals + s0, hist[c] - s0, c, bx, by, k_min, &ws)) {
-                return false;
-            }
-            s0 = hist[c];
-        }
-        return true;
+    *m_out = m;
+    return true;
+}
+
+/* A small box (coarse resolution): group the m binned points by counting sort, the histogram in
+ * tkeys' room, then run each cell. */
+static bool run_cells_counted(occ_ictx_t *const x, const occ_vec3_t *const points,
+                              const sr_cells_t *const c, const size_t m, const uint64_t cells,
+                              const uint16_t k_min, sr_ws_t *const ws)
+{
+    uint32_t *const hist = (uint32_t *)(void *)c->tkeys;
+    memset(hist, 0, (size_t)cells * sizeof *hist);
+    for (size_t i = 0; i < m; i++) {
+        hist[c->keys[i]]++;
     }
-    const uint64_t *const sk = occi_keyset_sort_pairs(keys, vals, tkeys, tvals, m, x->hist);
-    const uint32_t *const sv = sk == keys ? vals : tvals;
+    uint32_t sum = 0;
+    for (size_t cell = 0; cell < (size_t)cells; cell++) {
+        const uint32_t h = hist[cell];
+        hist[cell] = sum;
+        sum += h;
+    }
+    for (size_t i = 0; i < m; i++) {
+        c->tvals[hist[c->keys[i]]++] = c->vals[i]; /* hist[cell] ends as the end of its run */
+    }
+    for (size_t cell = 0, s0 = 0; cell < (size_t)cells; cell++) {
+        if (hist[cell] > s0 && !run_voxel(x, points, c->tvals + s0, hist[cell] - s0, cell, c->bx,
+                                          c->by, k_min, ws)) {
+            return false;
+        }
+        s0 = hist[cell];
+    }
+    return true;
+}
+
+/* A large box: group the m binned points by radix sort, then run each run of equal cells. */
+static bool run_cells_sorted(occ_ictx_t *const x, const occ_vec3_t *const points,
+                             const sr_cells_t *const c, const size_t m, const uint16_t k_min,
+                             sr_ws_t *const ws)
+{
+    const uint64_t *const sk =
+        occi_keyset_sort_pairs(c->keys, c->vals, c->tkeys, c->tvals, m, x->hist);
+    const uint32_t *const sv = sk == c->keys ? c->vals : c->tvals;
     for (size_t s0 = 0; s0 < m;) {
         size_t e = s0 + 1u;
         while (e < m && sk[e] == sk[s0]) {
             e++;
         }
-        if (!run_voxel(x, points, sv + s0, e - s0, sk[s0], bx, by, k_min, &ws)) {
+        if (!run_voxel(x, points, sv + s0, e - s0, sk[s0], c->bx, c->by, k_min, ws)) {
             return false;
         }
         s0 = e;
     }
     return true;
+}
+
+bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                       const uint16_t k_min)
+{
+    const size_t need = superray_need(n);
+    if (x->bs == NULL || x->b_cap < need / 8u + 1u || n >= UINT32_MAX) {
+        return run_single(x, points, n);
+    }
+    occ_ictx_note(x, 0, need / 8u + 1u);
+    sr_cells_t c;
+    sr_ws_t ws;
+    carve_scratch(x, n, &c, &ws);
+    size_t m = 0;
+    if (!bin_points(x, points, n, &c, &m)) {
+        return false;
+    }
+    const uint64_t cells = c.bx * c.by * ((uint64_t)(x->box_hi[2] - x->box_lo[2]) + 1u);
+    return cells <= 2u * (uint64_t)m ? run_cells_counted(x, points, &c, m, cells, k_min, &ws)
+                                     : run_cells_sorted(x, points, &c, m, k_min, &ws);
 }
