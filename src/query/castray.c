@@ -215,102 +215,137 @@ static bool normalize(const occ_vec3_t v, float out[3])
     return true;
 }
 
-occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
-                       bool ignore_unknown, float max_range_m, occ_ray_result_t *out)
+/* The fixed numbers of one walk: the map's grid, the origin, and (castRay) the range. */
+typedef struct {
+    real_t res;
+    int32_t tmv;
+    float o[3];
+    bool range_set; /* max_range_m > 0 */
+    real_t range_sq;
+    real_t safe_t;  /* entry parameter below which the range test cannot fail */
+} walk_t;
+
+static void walk_set(walk_t *w, const occ_map_t *map, occ_vec3_t origin, float max_range_m)
+{
+    w->res = occ_geom_res(map);
+    w->tmv = occ_geom_half(map);
+    w->o[0] = origin.x;
+    w->o[1] = origin.y;
+    w->o[2] = origin.z;
+    w->range_set = max_range_m > 0.0f;
+    w->range_sq = (real_t)max_range_m * (real_t)max_range_m;
+    /* A voxel entered at ray parameter t has its centre within t + 0.87 res of the origin, so
+     * OctoMap's exact centre-distance test can only fail once t passes this (with margin). */
+    w->safe_t = (real_t)max_range_m - w->res * (real_t)1.01 - (real_t)1e-5 * (real_t)max_range_m;
+}
+
+/* castRay's arguments checked, its direction normalized into dir and the origin's key into k.
+ * On error *out keeps the unsafe answer. */
+static occ_err_t cast_args(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
+                           float max_range_m, occ_ray_result_t *out, float dir[3], uint32_t k[3])
 {
     if (out == NULL) {
         return OCC_ERR_ARG;
     }
     set_unsafe(out, origin); /* until the walk decides */
     if (map == NULL || !occ_finite3(origin) || !occ_finite3(direction) ||
-        !occ_finite(max_range_m)) {
+        !occ_finite(max_range_m) || !normalize(direction, dir)) {
         return OCC_ERR_ARG;
     }
-    float dir[3];
-    if (!normalize(direction, dir)) {
-        return OCC_ERR_ARG;
+    return ray_key(map, origin, k);
+}
+
+/* OctoMap's centre-distance test for the voxel at key: float centre minus float origin, squared
+ * in float, summed in double. */
+static inline bool beyond_range(const walk_t *w, const uint32_t key[3])
+{
+    real_t dist_sq = (real_t)0;
+    for (unsigned j = 0; j < 3u; j++) {
+        const float ej = (float)key_coord(w->res, w->tmv, key[j]);
+        const float dj = ej - w->o[j];
+        dist_sq += (real_t)(dj * dj);
     }
-    const real_t res = occ_geom_res(map);
-    occ_key_t k0;
-    const occ_err_t e = ray_key(map, origin, k0.k);
-    if (e != OCC_OK) {
-        return e;
-    }
-    const int32_t tmv = occ_geom_half(map);
+    return dist_sq > w->range_sq;
+}
+
+/* castRay's walk from the origin's voxel (already let through) to the first voxel that stops it:
+ * occupied, unknown (unless ignored), the range or the map's edge. The one hot loop: the node
+ * tests are inline here, and a node the cursor lets through is coasted without lookups. */
+static void cast_walk(const occ_map_t *map, cursor_t *c, dda_t *d, const walk_t *w,
+                      bool ignore_unknown, occ_ray_result_t *out)
+{
     const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
-    cursor_t c;
-    const unsigned states = OCC_PRED_OCCUPIED | (ignore_unknown ? 0u : OCC_PRED_UNKNOWN);
-    cursor_init(&c, map, k0.k, (uint8_t)occ_q_has_bits(states));
-    {
-        const occ_state_t s = occ_value_state(map, c.val);
-        if (s == OCC_STATE_OCCUPIED) {
-            set_result(&c, res, tmv, out, true, OCC_RAY_HIT);
-            return OCC_OK;
-        }
-        if (s == OCC_STATE_UNKNOWN && !ignore_unknown) {
-            set_result(&c, res, tmv, out, false, OCC_RAY_UNKNOWN);
-            return OCC_OK;
-        }
-    }
-    const float o[3] = {origin.x, origin.y, origin.z};
-    dda_t d;
-    dda_init(&d, &c, res, tmv, o, dir);
-    if (d.step[0] == 0 && d.step[1] == 0 && d.step[2] == 0) {
-        return OCC_ERR_ARG; /* direction too small to normalize to a non-zero float vector */
-    }
-    const bool range_set = max_range_m > 0.0f;
-    const real_t range_sq = (real_t)max_range_m * (real_t)max_range_m;
-    /* A voxel entered at ray parameter t has its centre within t + 0.87 res of the origin, so
-     * OctoMap's exact centre-distance test can only fail once t passes this (with margin). */
-    const real_t safe_t = (real_t)max_range_m - res * (real_t)1.01 - (real_t)1e-5 * (real_t)max_range_m;
     const occ_value_t occ_min = map->q_occ_min;
     const occ_value_t free_max = map->q_free_max;
     /* The last key a step may leave from, per axis (never reached for a zero step). */
-    const uint32_t lim[3] = {d.step[0] > 0 ? kmax : 0u, d.step[1] > 0 ? kmax : 0u,
-                             d.step[2] > 0 ? kmax : 0u};
+    const uint32_t lim[3] = {d->step[0] > 0 ? kmax : 0u, d->step[1] > 0 ? kmax : 0u,
+                             d->step[2] > 0 ? kmax : 0u};
     bool entered = true; /* in a node the ray passes through, not yet coasted */
     for (;;) {
-        if (entered && c.lu > 0u) {
-            dda_coast(&d, c.key, c.lu, range_set, safe_t);
+        if (entered && c->lu > 0u) {
+            dda_coast(d, c->key, c->lu, w->range_set, w->safe_t);
         }
         entered = false;
-        const unsigned dim = occ_dda_axis(d.tmax[0], d.tmax[1], d.tmax[2]);
-        const real_t t_entry = d.tmax[dim];
-        const uint32_t old = c.key[dim];
+        const unsigned dim = occ_dda_axis(d->tmax[0], d->tmax[1], d->tmax[2]);
+        const real_t t_entry = d->tmax[dim];
+        const uint32_t old = c->key[dim];
         if (old == lim[dim]) {
-            set_result(&c, res, tmv, out, false, OCC_RAY_MAP_EDGE);
-            return OCC_OK;
+            set_result(c, w->res, w->tmv, out, false, OCC_RAY_MAP_EDGE);
+            return;
         }
-        c.key[dim] = (uint32_t)((int32_t)old + d.step[dim]);
-        d.tmax[dim] += d.tdelta[dim];
-        if (range_set && !(t_entry < safe_t)) {
-            /* OctoMap: float centre minus float origin, squared in float, summed in double. */
-            real_t dist_sq = (real_t)0;
-            for (unsigned j = 0; j < 3u; j++) {
-                const float ej = (float)key_coord(res, tmv, c.key[j]);
-                const float dj = ej - o[j];
-                dist_sq += (real_t)(dj * dj);
-            }
-            if (dist_sq > range_sq) {
-                set_result(&c, res, tmv, out, false, OCC_RAY_MAX_RANGE);
-                return OCC_OK;
-            }
+        c->key[dim] = (uint32_t)((int32_t)old + d->step[dim]);
+        d->tmax[dim] += d->tdelta[dim];
+        if (w->range_set && !(t_entry < w->safe_t) && beyond_range(w, c->key)) {
+            set_result(c, w->res, w->tmv, out, false, OCC_RAY_MAX_RANGE);
+            return;
         }
-        if (((old ^ c.key[dim]) >> c.lu) == 0u) {
+        if (((old ^ c->key[dim]) >> c->lu) == 0u) {
             continue; /* same node, already let through */
         }
-        cursor_moved(&c, dim, old);
-        const occ_value_t v = c.val;
+        cursor_moved(c, dim, old);
+        const occ_value_t v = c->val;
         if (v >= occ_min && occ_is_observed(v)) {
-            set_result(&c, res, tmv, out, true, OCC_RAY_HIT);
-            return OCC_OK;
+            set_result(c, w->res, w->tmv, out, true, OCC_RAY_HIT);
+            return;
         }
         if (!(v < free_max && occ_is_observed(v)) && !ignore_unknown) {
-            set_result(&c, res, tmv, out, false, OCC_RAY_UNKNOWN);
-            return OCC_OK;
+            set_result(c, w->res, w->tmv, out, false, OCC_RAY_UNKNOWN);
+            return;
         }
         entered = true;
     }
+}
+
+occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direction,
+                       bool ignore_unknown, float max_range_m, occ_ray_result_t *out)
+{
+    float dir[3];
+    occ_key_t k0;
+    const occ_err_t e = cast_args(map, origin, direction, max_range_m, out, dir, k0.k);
+    if (e != OCC_OK) {
+        return e;
+    }
+    walk_t w;
+    walk_set(&w, map, origin, max_range_m);
+    cursor_t c;
+    const unsigned states = OCC_PRED_OCCUPIED | (ignore_unknown ? 0u : OCC_PRED_UNKNOWN);
+    cursor_init(&c, map, k0.k, (uint8_t)occ_q_has_bits(states));
+    const occ_state_t s = occ_value_state(map, c.val);
+    if (s == OCC_STATE_OCCUPIED) {
+        set_result(&c, w.res, w.tmv, out, true, OCC_RAY_HIT);
+        return OCC_OK;
+    }
+    if (s == OCC_STATE_UNKNOWN && !ignore_unknown) {
+        set_result(&c, w.res, w.tmv, out, false, OCC_RAY_UNKNOWN);
+        return OCC_OK;
+    }
+    dda_t d;
+    dda_init(&d, &c, w.res, w.tmv, w.o, dir);
+    if (d.step[0] == 0 && d.step[1] == 0 && d.step[2] == 0) {
+        return OCC_ERR_ARG; /* direction too small to normalize to a non-zero float vector */
+    }
+    cast_walk(map, &c, &d, &w, ignore_unknown, out);
+    return OCC_OK;
 }
 
 /* Nothing blocks: the blocker (if asked for) names no voxel. */
@@ -328,11 +363,12 @@ static bool blocks(const occ_map_t *map, occ_value_t v, occ_unknown_policy_t pol
     return (occ_q_state_bit(occ_value_state(map, v)) & occ_q_blocking_states(policy)) != 0u;
 }
 
-occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
-                            occ_unknown_policy_t policy, bool *visible,
-                            occ_ray_result_t *blocker)
+/* Line of sight's arguments checked and both end keys into ka, kb; fail closed until then: not
+ * visible, blocked at a. */
+static occ_err_t los_args(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
+                          occ_unknown_policy_t policy, bool *visible, occ_ray_result_t *blocker,
+                          uint32_t ka[3], uint32_t kb[3])
 {
-    /* Fail closed: not visible, blocked at a, until the walk says otherwise. */
     if (visible != NULL) {
         *visible = false;
     }
@@ -343,17 +379,83 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
         !occ_finite3(b)) {
         return OCC_ERR_ARG;
     }
-    const real_t res = occ_geom_res(map);
+    const occ_err_t e = ray_key(map, a, ka);
+    return e == OCC_OK ? ray_key(map, b, kb) : e;
+}
+
+static inline bool same_key(const uint32_t p[3], const uint32_t q[3])
+{
+    return p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+}
+
+/* How a walk from a towards b ended. */
+typedef enum { LOS_BLOCKED, LOS_AT_B, LOS_PAST_B } los_end_t;
+
+/* The walk from a's voxel (already let through) to b's: LOS_BLOCKED at the first voxel that
+ * blocks (the cursor on it), LOS_AT_B when b's voxel was reached and let through, LOS_PAST_B when
+ * the walk passed b (or the map's border) by rounding without checking b's voxel. The one hot
+ * loop, as in cast_walk. */
+static los_end_t los_walk(const occ_map_t *map, cursor_t *c, dda_t *d, const uint32_t kb[3],
+                          real_t len, bool unknown_blocks)
+{
+    const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
+    const occ_value_t occ_min = map->q_occ_min;
+    const occ_value_t free_max = map->q_free_max;
+    bool entered = true;
+    for (;;) {
+        if (entered && c->lu > 0u) {
+            /* b inside this pass-through node: the rest of the segment is in it too (convex),
+             * and b's voxel has this node's (passable) value. */
+            const uint32_t sh = c->lu;
+            if (((c->key[0] ^ kb[0]) >> sh) == 0u && ((c->key[1] ^ kb[1]) >> sh) == 0u &&
+                ((c->key[2] ^ kb[2]) >> sh) == 0u) {
+                return LOS_AT_B;
+            }
+            dda_coast(d, c->key, c->lu, false, (real_t)0);
+        }
+        entered = false;
+        const unsigned dim = occ_dda_axis(d->tmax[0], d->tmax[1], d->tmax[2]);
+        if (d->tmax[dim] > len) {
+            return LOS_PAST_B;
+        }
+        const uint32_t old = c->key[dim];
+        if ((d->step[dim] < 0 && old == 0u) || (d->step[dim] > 0 && old == kmax)) {
+            return LOS_PAST_B; /* rounding at the map border: nothing beyond */
+        }
+        c->key[dim] = (uint32_t)((int32_t)old + d->step[dim]);
+        d->tmax[dim] += d->tdelta[dim];
+        const bool at_b = same_key(c->key, kb);
+        if (((old ^ c->key[dim]) >> c->lu) == 0u) {
+            if (at_b) {
+                return LOS_AT_B;
+            }
+            continue; /* same node, already let through */
+        }
+        cursor_moved(c, dim, old);
+        const occ_value_t v = c->val;
+        const bool obs = occ_is_observed(v);
+        if ((obs && v >= occ_min) || (unknown_blocks && !(obs && v < free_max))) {
+            return LOS_BLOCKED;
+        }
+        if (at_b) {
+            return LOS_AT_B;
+        }
+        entered = true;
+    }
+}
+
+occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
+                            occ_unknown_policy_t policy, bool *visible,
+                            occ_ray_result_t *blocker)
+{
     occ_key_t ka;
     occ_key_t kb;
-    occ_err_t e = ray_key(map, a, ka.k);
-    if (e == OCC_OK) {
-        e = ray_key(map, b, kb.k);
-    }
+    const occ_err_t e = los_args(map, a, b, policy, visible, blocker, ka.k, kb.k);
     if (e != OCC_OK) {
         return e;
     }
-    const int32_t tmv = occ_geom_half(map);
+    walk_t w;
+    walk_set(&w, map, a, 0.0f);
     occ_ray_result_t scratch;
     /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_ray_result_t *const res_out = blocker != NULL ? blocker : &scratch;
@@ -361,74 +463,25 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     cursor_t c;
     cursor_init(&c, map, ka.k, stop);
     if (blocks(map, c.val, policy)) {
-        set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
+        set_result(&c, w.res, w.tmv, res_out, true, OCC_RAY_HIT);
         return OCC_OK;
     }
     const occ_vec3_t dv = {b.x - a.x, b.y - a.y, b.z - a.z};
     float dir[3];
-    if (!normalize(dv, dir) || (ka.k[0] == kb.k[0] && ka.k[1] == kb.k[1] && ka.k[2] == kb.k[2])) {
+    if (!normalize(dv, dir) || same_key(ka.k, kb.k)) {
         return set_visible(visible, blocker);
     }
-    bool reached_b = false; /* b's voxel checked on the way (else looked up at the end) */
-    const float o[3] = {a.x, a.y, a.z};
-    const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
     const real_t len = RSQRT((real_t)dv.x * (real_t)dv.x + (real_t)dv.y * (real_t)dv.y +
                              (real_t)dv.z * (real_t)dv.z);
     dda_t d;
-    dda_init(&d, &c, res, tmv, o, dir);
-    const occ_value_t occ_min = map->q_occ_min;
-    const occ_value_t free_max = map->q_free_max;
-    const bool unknown_blocks = policy == OCC_UNKNOWN_UNSAFE;
-    bool entered = true;
-    for (;;) {
-        if (entered && c.lu > 0u) {
-            /* b inside this pass-through node: the rest of the segment is in it too (convex). */
-            const uint32_t sh = c.lu;
-            if (((c.key[0] ^ kb.k[0]) >> sh) == 0u && ((c.key[1] ^ kb.k[1]) >> sh) == 0u &&
-                ((c.key[2] ^ kb.k[2]) >> sh) == 0u) {
-                reached_b = true; /* b's voxel has this node's (passable) value */
-                break;
-            }
-            dda_coast(&d, c.key, c.lu, false, (real_t)0);
-        }
-        entered = false;
-        const unsigned dim = occ_dda_axis(d.tmax[0], d.tmax[1], d.tmax[2]);
-        if (d.tmax[dim] > len) {
-            break; /* past b (its voxel was checked above) */
-        }
-        const uint32_t old = c.key[dim];
-        if ((d.step[dim] < 0 && old == 0u) || (d.step[dim] > 0 && old == kmax)) {
-            break; /* rounding at the map border: nothing beyond */
-        }
-        c.key[dim] = (uint32_t)((int32_t)old + d.step[dim]);
-        d.tmax[dim] += d.tdelta[dim];
-        const bool at_b = c.key[0] == kb.k[0] && c.key[1] == kb.k[1] && c.key[2] == kb.k[2];
-        if (((old ^ c.key[dim]) >> c.lu) == 0u) {
-            if (at_b) {
-                reached_b = true;
-                break;
-            }
-            continue; /* same node, already let through */
-        }
-        cursor_moved(&c, dim, old);
-        const occ_value_t v = c.val;
-        const bool obs = occ_is_observed(v);
-        if ((obs && v >= occ_min) || (unknown_blocks && !(obs && v < free_max))) {
-            set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
-            return OCC_OK;
-        }
-        if (at_b) {
-            reached_b = true;
-            break;
-        }
-        entered = true;
-    }
-    if (!reached_b) {
+    dda_init(&d, &c, w.res, w.tmv, w.o, dir);
+    const los_end_t end = los_walk(map, &c, &d, kb.k, len, policy == OCC_UNKNOWN_UNSAFE);
+    if (end == LOS_PAST_B) {
         cursor_init(&c, map, kb.k, stop); /* the walk is over: reuse its cursor for b's voxel */
-        if (blocks(map, c.val, policy)) {
-            set_result(&c, res, tmv, res_out, true, OCC_RAY_HIT);
-            return OCC_OK;
-        }
+    }
+    if (end == LOS_BLOCKED || (end == LOS_PAST_B && blocks(map, c.val, policy))) {
+        set_result(&c, w.res, w.tmv, res_out, true, OCC_RAY_HIT);
+        return OCC_OK;
     }
     return set_visible(visible, blocker);
 }
