@@ -1,0 +1,262 @@
+// ab_split.cpp - the library built from AB_BASE (its symbols renamed old_*, bench/ab_split.mk)
+// against this tree's, in one process, on the same inputs, in interleaved rounds (the order
+// flips every round, so drift and cache warmth hit both alike):
+//   super rays: occ_map_insert_cloud(SUPER_RAYS) of scan.dat into a fresh map, 0.1 and 0.05 m;
+//   castRay:    occ_cast_ray 10 m from random free points of geb079.bt (ignore / stop at unknown);
+//   los:        occ_line_of_sight between free points 1..10.8 m apart on geb079.bt.
+// Prints, per case, each side's median and range (min..max) over the rounds and the median and
+// quartiles of the per-round ratio new / old (< 1: the new code is faster). Both sides must give
+// the same answers (checked on every input first).
+// usage: ab_split [--rounds N] SCAN.dat MAP.bt
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <random>
+#include <vector>
+
+extern "C" {
+#include "occmap/occmap.h"
+#include "occmap/host/occ_file.h"
+#include "occmap/host/occ_scan.h"
+}
+
+extern "C" decltype(occ_map_init) old_occ_map_init;
+extern "C" decltype(occ_map_insert_cloud) old_occ_map_insert_cloud;
+extern "C" decltype(occ_cast_ray) old_occ_cast_ray;
+extern "C" decltype(occ_line_of_sight) old_occ_line_of_sight;
+
+static double cpu_ms()
+{
+    timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return (double)t.tv_sec * 1e3 + (double)t.tv_nsec / 1e6;
+}
+
+static double quantile(std::vector<double> v, double q)
+{
+    std::sort(v.begin(), v.end());
+    return v[(size_t)(q * (double)(v.size() - 1) + 0.5)];
+}
+
+// Rounds of (old, new) or (new, old), alternating; fa / fb return their CPU ms.
+template <class FA, class FB>
+static void ab(const char *name, int rounds, const FA &fa, const FB &fb)
+{
+    std::vector<double> ta, tb, r;
+    for (int i = 0; i < rounds; i++) {
+        double a, b;
+        if (i % 2 == 0) {
+            a = fa();
+            b = fb();
+        } else {
+            b = fb();
+            a = fa();
+        }
+        ta.push_back(a);
+        tb.push_back(b);
+        r.push_back(b / a);
+    }
+    std::printf("%-34s old %8.3f ms [%8.3f..%8.3f]  new %8.3f ms [%8.3f..%8.3f]  new/old %.3f "
+                "(q1 %.3f, q3 %.3f)\n",
+                name, quantile(ta, 0.5), quantile(ta, 0), quantile(ta, 1), quantile(tb, 0.5),
+                quantile(tb, 0), quantile(tb, 1), quantile(r, 0.5), quantile(r, 0.25),
+                quantile(r, 0.75));
+    std::fflush(stdout);
+}
+
+static std::vector<uint8_t> arena((size_t)768 << 20), scratch;
+
+static double insert_once(decltype(occ_map_init) *init, decltype(occ_map_insert_cloud) *insert,
+                          const std::vector<occ_vec3_t> &pts, float res, occ_insert_result_t *out)
+{
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.resolution_m = res;
+    occ_map_t m;
+    if (init(&m, &cfg, arena.data(), arena.size()) != OCC_OK) std::abort();
+    occ_insert_params_t p = occ_insert_params_default();
+    p.method = OCC_INSERT_SUPER_RAYS;
+    const occ_vec3_t origin = {0, 0, 0};
+    const double t0 = cpu_ms();
+    const occ_err_t e =
+        insert(&m, &origin, pts.data(), pts.size(), &p, scratch.data(), scratch.size(), out);
+    const double t = cpu_ms() - t0;
+    if (e != OCC_OK) {
+        std::fprintf(stderr, "ab_split: insert: %s\n", occ_err_str(e));
+        std::exit(1);
+    }
+    return t;
+}
+
+static void bench_superrays(const std::vector<occ_vec3_t> &pts, float res, int rounds)
+{
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.resolution_m = res;
+    occ_map_t tmp;
+    static uint8_t small[OCC_ARENA_BYTES(2, 2)];
+    occ_map_init(&tmp, &cfg, small, sizeof small);
+    occ_insert_params_t p = occ_insert_params_default();
+    p.method = OCC_INSERT_SUPER_RAYS;
+    const occ_vec3_t origin = {0, 0, 0};
+    scratch.assign(occ_insert_scratch_bytes_scan(&tmp, &origin, pts.data(), pts.size(), &p), 0);
+    occ_insert_result_t ro, rn;
+    insert_once(old_occ_map_init, old_occ_map_insert_cloud, pts, res, &ro);
+    insert_once(occ_map_init, occ_map_insert_cloud, pts, res, &rn);
+    if (std::memcmp(&ro, &rn, sizeof ro) != 0) {
+        std::fprintf(stderr, "ab_split: super rays at %.2f m: old and new results differ\n", res);
+        std::exit(1);
+    }
+    char name[64];
+    std::snprintf(name, sizeof name, "super rays scan.dat %.2f m (%zu rays)", res,
+                  (size_t)rn.rays_cast);
+    ab(name, rounds,
+       [&] { return insert_once(old_occ_map_init, old_occ_map_insert_cloud, pts, res, &ro); },
+       [&] { return insert_once(occ_map_init, occ_map_insert_cloud, pts, res, &rn); });
+}
+
+struct Box {
+    occ_vec3_t lo, hi;
+};
+
+static Box map_box(const occ_map_t &m)
+{
+    Box b = {{1e30f, 1e30f, 1e30f}, {-1e30f, -1e30f, -1e30f}};
+    occ_walk_t w;
+    occ_walk_node_t n;
+    occ_walk_begin(&w, &m);
+    while (occ_walk_next(&w, &n)) {
+        if (n.has_children || !n.observed) continue;
+        const occ_vec3_t c = occ_map_key_center(&m, n.key, n.level);
+        const float h = occ_map_node_size(&m, n.level) * 0.5f;
+        b.lo = {std::min(b.lo.x, c.x - h), std::min(b.lo.y, c.y - h), std::min(b.lo.z, c.z - h)};
+        b.hi = {std::max(b.hi.x, c.x + h), std::max(b.hi.y, c.y + h), std::max(b.hi.z, c.z + h)};
+    }
+    return b;
+}
+
+static bool same_ray(const occ_ray_result_t &a, const occ_ray_result_t &b)
+{
+    return a.hit == b.hit && a.stop == b.stop && std::memcmp(&a.key, &b.key, sizeof a.key) == 0 &&
+           std::memcmp(&a.end, &b.end, sizeof a.end) == 0;
+}
+
+static void bench_queries(const occ_map_t &m, int rounds)
+{
+    const Box b = map_box(m);
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<float> ux(b.lo.x, b.hi.x), uy(b.lo.y, b.hi.y),
+        uz(b.lo.z, b.hi.z), u01(0, 1);
+    std::normal_distribution<float> g(0, 1);
+    const auto free_point = [&] {
+        for (;;) {
+            const occ_vec3_t p = {ux(rng), uy(rng), uz(rng)};
+            if (occ_map_state_at(&m, p) == OCC_STATE_FREE) return p;
+        }
+    };
+    const auto inside = [&](occ_vec3_t p) {
+        return p.x >= b.lo.x && p.x <= b.hi.x && p.y >= b.lo.y && p.y <= b.hi.y &&
+               p.z >= b.lo.z && p.z <= b.hi.z;
+    };
+    const size_t N = 20000;
+    std::vector<occ_vec3_t> o(N), d(N), e(N);
+    for (size_t i = 0; i < N; i++) {
+        o[i] = free_point();
+        d[i] = {g(rng), g(rng), g(rng)};
+        // A free end point 1..10.8 m away, for line of sight.
+        for (;;) {
+            const float len = 1.0f + 9.8f * u01(rng);
+            const float n = std::sqrt(d[i].x * d[i].x + d[i].y * d[i].y + d[i].z * d[i].z);
+            e[i] = {o[i].x + d[i].x / n * len, o[i].y + d[i].y / n * len, o[i].z + d[i].z / n * len};
+            if (inside(e[i]) && occ_map_state_at(&m, e[i]) == OCC_STATE_FREE) break;
+            d[i] = {g(rng), g(rng), g(rng)};
+        }
+    }
+    for (int ignore = 1; ignore >= 0; ignore--) {
+        for (size_t i = 0; i < N; i++) {
+            occ_ray_result_t ro, rn;
+            const occ_err_t eo = old_occ_cast_ray(&m, o[i], d[i], ignore != 0, 10.0f, &ro);
+            const occ_err_t en = occ_cast_ray(&m, o[i], d[i], ignore != 0, 10.0f, &rn);
+            if (eo != en || !same_ray(ro, rn)) {
+                std::fprintf(stderr, "ab_split: castRay %zu differs\n", i);
+                std::exit(1);
+            }
+        }
+        const auto cast_all = [&](decltype(occ_cast_ray) *cast) {
+            size_t hits = 0;
+            const double t0 = cpu_ms();
+            for (size_t i = 0; i < N; i++) {
+                occ_ray_result_t r;
+                cast(&m, o[i], d[i], ignore != 0, 10.0f, &r);
+                hits += r.hit;
+            }
+            const double t = cpu_ms() - t0;
+            if (hits > N) std::abort();
+            return t;
+        };
+        ab(ignore ? "castRay 10 m ignore unknown (20k)" : "castRay 10 m stop at unknown (20k)",
+           rounds, [&] { return cast_all(old_occ_cast_ray); },
+           [&] { return cast_all(occ_cast_ray); });
+    }
+    for (size_t i = 0; i < N; i++) {
+        bool vo = false, vn = false;
+        occ_ray_result_t ro, rn;
+        old_occ_line_of_sight(&m, o[i], e[i], OCC_UNKNOWN_SAFE, &vo, &ro);
+        occ_line_of_sight(&m, o[i], e[i], OCC_UNKNOWN_SAFE, &vn, &rn);
+        if (vo != vn || (!vo && !same_ray(ro, rn))) {
+            std::fprintf(stderr, "ab_split: line of sight %zu differs\n", i);
+            std::exit(1);
+        }
+    }
+    const auto los_all = [&](decltype(occ_line_of_sight) *los) {
+        size_t vis = 0;
+        const double t0 = cpu_ms();
+        for (size_t i = 0; i < N; i++) {
+            bool v = false;
+            los(&m, o[i], e[i], OCC_UNKNOWN_SAFE, &v, nullptr);
+            vis += v;
+        }
+        const double t = cpu_ms() - t0;
+        if (vis > N) std::abort();
+        return t;
+    };
+    ab("line of sight 1..10.8 m (20k)", rounds, [&] { return los_all(old_occ_line_of_sight); },
+       [&] { return los_all(occ_line_of_sight); });
+}
+
+int main(int argc, char **argv)
+{
+    int rounds = 15;
+    int a = 1;
+    if (argc > 2 && std::strcmp(argv[1], "--rounds") == 0) {
+        rounds = std::max(1, std::atoi(argv[2]));
+        a = 3;
+    }
+    if (argc - a != 2) {
+        std::fprintf(stderr, "usage: ab_split [--rounds N] SCAN.dat MAP.bt\n");
+        return 2;
+    }
+    char msg[256] = "";
+    occ_vec3_t *pts = nullptr;
+    size_t n = 0;
+    if (occ_scan_read_xyz(argv[a], &pts, &n, msg, sizeof msg) != OCC_OK) {
+        std::fprintf(stderr, "ab_split: %s\n", msg);
+        return 1;
+    }
+    const std::vector<occ_vec3_t> scan(pts, pts + n);
+    std::free(pts);
+    occ_map_t m;
+    void *map_arena = nullptr;
+    if (occ_file_load_alloc(argv[a + 1], nullptr, &m, 0, &map_arena, nullptr, msg, sizeof msg) !=
+        OCC_OK) {
+        std::fprintf(stderr, "ab_split: %s\n", msg);
+        return 1;
+    }
+    std::printf("A/B old (AB_BASE) vs new (this tree), %d interleaved rounds, CPU time\n", rounds);
+    bench_superrays(scan, 0.1f, rounds);
+    bench_superrays(scan, 0.05f, rounds);
+    bench_queries(m, rounds);
+    std::free(map_arena);
+    return 0;
+}

@@ -1,0 +1,32 @@
+# ab_split.mk - `make bench-ab-split` (in neither `make test` nor `make bench`): the library as
+# of AB_BASE (default: main before the long functions were split) against this tree's, linked
+# into one program (bench/ab_split.cpp) with the old library's symbols renamed old_*, run in
+# interleaved rounds on scan.dat (super rays, 0.1 / 0.05 m) and geb079.bt (castRay, line of
+# sight). Proves a refactor of a hot path costs nothing: `make bench-ab-split AB_BASE=<commit>`.
+AB_BASE ?= 6e02855
+AB_DIR := $(BUILD)/ab
+AB_MAP := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt
+# The map modules only (no front ends). Rebuilt when AB_BASE names another commit (its id is kept in $(AB_DIR)/base).
+$(AB_DIR)/libocc_old.a: FORCE_AB
+	@set -e; sha=$$(git rev-parse --verify '$(AB_BASE)^{commit}'); \
+	if [ -f $@ ] && [ "$$(cat $(AB_DIR)/base 2>/dev/null)" = "$$sha" ]; then exit 0; fi; \
+	echo "ab: building the library at $(AB_BASE) ($$sha) as old_*"; \
+	rm -rf $(AB_DIR)/old && mkdir -p $(AB_DIR)/old; \
+	git archive "$$sha" src include | tar -x -C $(AB_DIR)/old; \
+	cd $(AB_DIR)/old; objs=""; \
+	for f in $$(find $(addprefix src/,$(OCC_MAP_MODULES)) -name '*.c' ! -name collide_ccd.c | sort); do \
+	  o=obj/$${f%.c}.o; mkdir -p $$(dirname $$o); \
+	  $(CC) $(WARN) -O2 -g -Iinclude -Isrc -c $$f -o $$o; objs="$$objs $$o"; \
+	done; \
+	rm -f lib.a; $(AR) rcs lib.a $$objs; \
+	nm -g --defined-only --format=posix lib.a | \
+	  awk 'NF >= 2 && $$2 ~ /^[A-Z]$$/ {print $$1 " old_" $$1}' | sort -u > rename.txt; \
+	objcopy --redefine-syms=rename.txt lib.a ../libocc_old.a; \
+	cd - > /dev/null; echo "$$sha" > $(AB_DIR)/base
+$(BUILD)/bench/ab_split: bench/ab_split.cpp $(BUILD)/relhost/port/posix/file_io.o \
+    $(BUILD)/relhost/port/posix/scan_xyz.o $(BUILD)/libocc.a $(AB_DIR)/libocc_old.a
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $^ -lccd -lm
+bench-ab-split: $(BUILD)/bench/ab_split $(BUILD)/data/scan.dat
+	./$(BUILD)/bench/ab_split --rounds $(or $(AB_ROUNDS),15) $(BUILD)/data/scan.dat $(AB_MAP)
+.PHONY: bench-ab-split FORCE_AB
