@@ -89,93 +89,108 @@ static bool check_block(const occ_map_t *const m, const uint32_t child, const un
     return !prunable && occ_value_eq(mx, value) && f == flags;
 }
 
+/* Pool counters agree with each other and the blocks fit the arena. */
+static bool pools_consistent(const occ_map_t *const m)
+{
+    const occ_pool_t *const pools[2] = {&m->inner, &m->leaf};
+    for (unsigned k = 0; k < 2u; k++) {
+        const occ_pool_t *const p = pools[k];
+        if ((uint64_t)p->used + p->free_count != p->hwm || p->used > p->peak) {
+            return false;
+        }
+    }
+    return (uint64_t)m->inner.hwm * sizeof(occ_inner_block_t) +
+               (uint64_t)m->leaf.hwm * sizeof(occ_leaf_block_t) <=
+           m->arena_bytes;
+}
+
+/* Child `c` of a node at level l + 1 with value and flags v, f: in range, consistent, and
+ * tallied (false, too, when more blocks were reached than exist: a cycle or shared blocks). */
+static bool check_child(const occ_map_t *const m, const uint32_t c, const unsigned l,
+                        const occ_value_t v, const uint8_t f, tally_t *const inner,
+                        tally_t *const leaf)
+{
+    if (c >= (l == 1u ? m->leaf.hwm : m->inner.hwm) || !check_block(m, c, l, v, f)) {
+        return false;
+    }
+    tally_t *const t = l == 1u ? leaf : inner;
+    tally_add(t, c);
+    return t->count <= (l == 1u ? m->leaf.hwm : m->inner.hwm);
+}
+
+/* Every block below the root's child (inner blocks at depth >= 2), checked and tallied by an
+ * iterative DFS: frame = block whose nodes sit at lvl, next slot. */
+static bool check_subtree(const occ_map_t *const m, const unsigned depth, tally_t *const inner,
+                          tally_t *const leaf)
+{
+    uint32_t blk[OCC_MAX_DEPTH + 1];
+    uint8_t lvl[OCC_MAX_DEPTH + 1], next[OCC_MAX_DEPTH + 1];
+    unsigned sp = 0;
+    blk[0] = m->root_child;
+    lvl[0] = (uint8_t)(depth - 1u);
+    next[0] = 0u;
+    for (;;) {
+        if (next[sp] >= 8u) {
+            if (sp == 0u) {
+                return true;
+            }
+            sp--;
+            continue;
+        }
+        const occ_inner_block_t *const b = occ_inner_at(m, blk[sp]);
+        const unsigned s = next[sp]++;
+        const uint32_t c = b->child[s];
+        if (c == OCC_NONE) {
+            continue;
+        }
+        const unsigned l = lvl[sp];
+        if (!check_child(m, c, l, b->value[s], b->flags[s], inner, leaf)) {
+            return false;
+        }
+        if (l > 1u) {
+            if (sp + 1u > OCC_MAX_DEPTH) {
+                return false;
+            }
+            sp++;
+            blk[sp] = c;
+            lvl[sp] = (uint8_t)(l - 1u);
+            next[sp] = 0u;
+        }
+    }
+}
+
+/* The tree from the root: every block reached is checked and tallied. */
+static bool check_tree(const occ_map_t *const m, tally_t *const inner, tally_t *const leaf)
+{
+    const unsigned depth = m->cfg.depth_levels;
+    if (m->root_child == OCC_NONE) {
+        return m->root_flags == occ_value_flags(m, m->root_value);
+    }
+    /* The auditor survives any bytes: depth, counters and every index are range-checked here
+     * before they are followed, so the accessors' asserts never see a bad one from this walk. */
+    if (depth < 1u || depth > OCC_MAX_DEPTH) {
+        return false;
+    }
+    if (!check_child(m, m->root_child, depth, m->root_value, m->root_flags, inner, leaf)) {
+        return false;
+    }
+    return depth == 1u || check_subtree(m, depth, inner, leaf);
+}
+
 occ_err_t occ_map_check(const occ_map_t *const m)
 {
     if (m == NULL) {
         return OCC_ERR_ARG;
     }
-    const occ_pool_t *const pools[2] = {&m->inner, &m->leaf};
-    for (unsigned k = 0; k < 2u; k++) {
-        const occ_pool_t *const p = pools[k];
-        if ((uint64_t)p->used + p->free_count != p->hwm || p->used > p->peak) {
-            return OCC_ERR_CORRUPT;
-        }
-    }
-    if ((uint64_t)m->inner.hwm * sizeof(occ_inner_block_t) +
-            (uint64_t)m->leaf.hwm * sizeof(occ_leaf_block_t) > m->arena_bytes) {
-        return OCC_ERR_CORRUPT;
-    }
     tally_t inner = {0u, 0u, 0u}, leaf = {0u, 0u, 0u};
-    if (!check_free_lists(m, &inner, &leaf)) {
+    if (!pools_consistent(m) || !check_free_lists(m, &inner, &leaf) ||
+        !check_tree(m, &inner, &leaf)) {
         return OCC_ERR_CORRUPT;
     }
-    /* Root. */
-    const unsigned depth = m->cfg.depth_levels;
-    if (m->root_child == OCC_NONE) {
-        return m->root_flags == occ_value_flags(m, m->root_value) &&
-                       tally_complete(&inner, m->inner.hwm) && tally_complete(&leaf, m->leaf.hwm)
-                   ? OCC_OK
-                   : OCC_ERR_CORRUPT;
-    }
-    /* The auditor survives any bytes: depth, counters and every index are range-checked here
-     * before they are followed, so the accessors' asserts never see a bad one from this walk. */
-    if (depth < 1u || depth > OCC_MAX_DEPTH) {
-        return OCC_ERR_CORRUPT;
-    }
-    const uint32_t root_hwm = depth == 1u ? m->leaf.hwm : m->inner.hwm;
-    if (m->root_child >= root_hwm ||
-        !check_block(m, m->root_child, depth, m->root_value, m->root_flags)) {
-        return OCC_ERR_CORRUPT;
-    }
-    if (depth == 1u) {
-        tally_add(&leaf, m->root_child);
-    } else {
-        tally_add(&inner, m->root_child);
-        /* Iterative DFS over inner blocks: frame = block whose nodes sit at lvl, next slot. */
-        uint32_t blk[OCC_MAX_DEPTH + 1];
-        uint8_t lvl[OCC_MAX_DEPTH + 1], next[OCC_MAX_DEPTH + 1];
-        unsigned sp = 0;
-        blk[0] = m->root_child;
-        lvl[0] = (uint8_t)(depth - 1u);
-        next[0] = 0u;
-        for (;;) {
-            if (next[sp] >= 8u) {
-                if (sp == 0u) {
-                    break;
-                }
-                sp--;
-                continue;
-            }
-            const occ_inner_block_t *const b = occ_inner_at(m, blk[sp]);
-            const unsigned s = next[sp]++;
-            const uint32_t c = b->child[s];
-            if (c == OCC_NONE) {
-                continue;
-            }
-            const unsigned l = lvl[sp];
-            if (c >= (l == 1u ? m->leaf.hwm : m->inner.hwm) ||
-                !check_block(m, c, l, b->value[s], b->flags[s])) {
-                return OCC_ERR_CORRUPT;
-            }
-            if (l == 1u) {
-                tally_add(&leaf, c);
-                if (leaf.count > m->leaf.hwm) {
-                    return OCC_ERR_CORRUPT; /* a cycle or shared blocks */
-                }
-            } else {
-                tally_add(&inner, c);
-                if (inner.count > m->inner.hwm || sp + 1u > OCC_MAX_DEPTH) {
-                    return OCC_ERR_CORRUPT;
-                }
-                sp++;
-                blk[sp] = c;
-                lvl[sp] = (uint8_t)(l - 1u);
-                next[sp] = 0u;
-            }
-        }
-    }
-    if (inner.count - m->inner.free_count != m->inner.used ||
-        leaf.count - m->leaf.free_count != m->leaf.used) {
+    /* Every block below the high-water marks owned exactly once, by the tree or a free list;
+     * an empty tree owns none (its blocks are all free). */
+    if (m->root_child != OCC_NONE && (inner.count - m->inner.free_count != m->inner.used ||
+                                      leaf.count - m->leaf.free_count != m->leaf.used)) {
         return OCC_ERR_CORRUPT;
     }
     return tally_complete(&inner, m->inner.hwm) && tally_complete(&leaf, m->leaf.hwm)
