@@ -435,6 +435,89 @@ static bool capture(ctx_t *const x)
     return true;
 }
 
+static void ctx_init(ctx_t *const x, occ_map_t *const map, const occ_vec3_t *const center,
+                     const occ_evict_policy_t *const policy, const uint32_t n_inner,
+                     const uint32_t n_leaf, const uint32_t budget, occ_evict_out_t *const out)
+{
+    x->m = map;
+    x->c = *center;
+    x->p = policy;
+    x->cur = &out->cursor;
+    x->need_inner = n_inner;
+    x->need_leaf = n_leaf;
+    x->budget = budget;
+    x->visited = 0u;
+    x->evictions = 0u;
+    /* Cube bounds are float: near a far-away centre their rounding is ~ulp(|centre|), so the
+     * protected test gets that much margin (a node that close counts as inside). */
+    const float far_c = maxf(maxf(absf(center->x), absf(center->y)), absf(center->z));
+    const float reach = policy->shape == OCC_EVICT_SPHERE
+                            ? policy->keep_radius_m
+                            : maxf(maxf(policy->keep_half_m.x, policy->keep_half_m.y),
+                                   policy->keep_half_m.z);
+    x->eps = map->cfg.resolution_m * 1.0e-3f + 8.0f * FLT_EPSILON * (far_c + reach);
+}
+
+/* Evict until the target is met, the budget is spent or nothing is left: the sweep left by an
+ * earlier call resumes, else a new one starts. *sweep_on says on return whether a sweep is left
+ * to resume. */
+static run_end_t sweep(ctx_t *const x, occ_evict_out_t *const out, bool *const sweep_on)
+{
+    occ_evict_cursor_t *const cur = x->cur;
+    run_end_t end = RUN_EXHAUSTED;
+    /* A sweep continues across calls; one that started in an earlier call may have passed over
+     * content added since, so without a budget "nothing left" is only believed from a sweep run
+     * entirely in this call. */
+    const unsigned attempts = x->budget == 0u ? 2u : 1u;
+    for (unsigned attempt = 0; attempt < attempts; attempt++) {
+        if (*sweep_on) {
+            resume(x);
+        } else {
+            begin_sweep(x, first_level(x));
+            cur->farthest_m = 0.0f;
+            (void)begin_pass(x);
+            cur->depth = x->m->cfg.depth_levels;
+            out->sweeps++;
+        }
+        end = run(x);
+        if (end != RUN_EXHAUSTED || !*sweep_on) {
+            break;
+        }
+        *sweep_on = false;
+    }
+    /* Reaching the target ends the sweep: the next call starts over from the far end (farthest
+     * first again, around the centre it is given). */
+    *sweep_on = end == RUN_BUDGET && capture(x);
+    settle(x);
+    return end;
+}
+
+/* This call's outcome and the running totals into *out. */
+static void report(const ctx_t *const x, const run_end_t end, const bool sweep_on,
+                   const uint32_t inner_before, const uint32_t leaf_before,
+                   occ_evict_out_t *const out)
+{
+    const occ_map_t *const map = x->m;
+    const uint32_t freed_inner = inner_before - map->inner.used;
+    const uint32_t freed_leaf = leaf_before - map->leaf.used;
+    out->calls++;
+    out->last_evictions = x->evictions;
+    out->last_blocks_freed = freed_inner + freed_leaf;
+    out->last_visited = x->visited;
+    out->evictions += x->evictions;
+    out->blocks_freed += (uint64_t)freed_inner + freed_leaf;
+    out->bytes_freed += (uint64_t)freed_inner * OCC_INNER_BLOCK_BYTES +
+                        (uint64_t)freed_leaf * OCC_LEAF_BLOCK_BYTES;
+    out->target_reached = target_ok(x);
+    out->exhausted = end == RUN_EXHAUSTED;
+    out->resumable = end == RUN_BUDGET;
+    out->sweep_active = sweep_on;
+    occ_map_stats_t st;
+    occ_map_pool_stats(map, &st);
+    out->bytes_used = st.bytes_used;
+    out->bytes_peak = st.bytes_peak;
+}
+
 static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
                        const occ_evict_policy_t *const policy, const uint32_t n_inner,
                        const uint32_t n_leaf, const uint32_t budget, occ_evict_out_t *const out)
@@ -447,80 +530,23 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
         return OCC_ERR_ARG;
     }
     ctx_t x;
-    x.m = map;
-    x.c = *center;
-    x.p = policy;
-    x.cur = &out->cursor;
-    x.need_inner = n_inner;
-    x.need_leaf = n_leaf;
-    x.budget = budget;
-    x.visited = 0u;
-    x.evictions = 0u;
-    /* Cube bounds are float: near a far-away centre their rounding is ~ulp(|centre|), so the
-     * protected test gets that much margin (a node that close counts as inside). */
-    const float far_c = maxf(maxf(absf(center->x), absf(center->y)), absf(center->z));
-    const float reach = policy->shape == OCC_EVICT_SPHERE
-                            ? policy->keep_radius_m
-                            : maxf(maxf(policy->keep_half_m.x, policy->keep_half_m.y),
-                                   policy->keep_half_m.z);
-    x.eps = map->cfg.resolution_m * 1.0e-3f + 8.0f * FLT_EPSILON * (far_c + reach);
+    ctx_init(&x, map, center, policy, n_inner, n_leaf, budget, out);
     const uint32_t inner_before = map->inner.used, leaf_before = map->leaf.used;
-    occ_evict_cursor_t *const cur = &out->cursor;
     run_end_t end = RUN_TARGET;
-    bool sweep_on = cur->phase == PHASE_RESUME && cur->depth == map->cfg.depth_levels;
+    bool sweep_on = out->cursor.phase == PHASE_RESUME && out->cursor.depth == map->cfg.depth_levels;
     if (!target_ok(&x)) {
         if (map->cfg.depth_levels < 2u) {
             end = RUN_EXHAUSTED; /* the root is a level-1 node: nothing to take apart */
             sweep_on = false;
         } else {
-            /* A sweep continues across calls; one that started in an earlier call may have
-             * passed over content added since, so without a budget "nothing left" is only
-             * believed from a sweep run entirely in this call. */
-            const unsigned attempts = budget == 0u ? 2u : 1u;
-            for (unsigned attempt = 0; attempt < attempts; attempt++) {
-                if (sweep_on) {
-                    resume(&x);
-                } else {
-                    begin_sweep(&x, first_level(&x));
-                    cur->farthest_m = 0.0f;
-                    (void)begin_pass(&x);
-                    cur->depth = map->cfg.depth_levels;
-                    out->sweeps++;
-                }
-                end = run(&x);
-                if (end != RUN_EXHAUSTED || !sweep_on) {
-                    break;
-                }
-                sweep_on = false;
-            }
-            /* Reaching the target ends the sweep: the next call starts over from the far end
-             * (farthest first again, around the centre it is given). */
-            sweep_on = end == RUN_BUDGET && capture(&x);
-            settle(&x);
+            end = sweep(&x, out, &sweep_on);
         }
     }
     if (x.evictions != 0u) {
         map->write_gen++; /* collapses are this path's only writes: handles on the map are stale */
     }
-    cur->phase = sweep_on ? PHASE_RESUME : PHASE_IDLE;
-    const uint32_t freed_inner = inner_before - map->inner.used;
-    const uint32_t freed_leaf = leaf_before - map->leaf.used;
-    out->calls++;
-    out->last_evictions = x.evictions;
-    out->last_blocks_freed = freed_inner + freed_leaf;
-    out->last_visited = x.visited;
-    out->evictions += x.evictions;
-    out->blocks_freed += (uint64_t)freed_inner + freed_leaf;
-    out->bytes_freed += (uint64_t)freed_inner * OCC_INNER_BLOCK_BYTES +
-                        (uint64_t)freed_leaf * OCC_LEAF_BLOCK_BYTES;
-    out->target_reached = target_ok(&x);
-    out->exhausted = end == RUN_EXHAUSTED;
-    out->resumable = end == RUN_BUDGET;
-    out->sweep_active = sweep_on;
-    occ_map_stats_t st;
-    occ_map_pool_stats(map, &st);
-    out->bytes_used = st.bytes_used;
-    out->bytes_peak = st.bytes_peak;
+    out->cursor.phase = sweep_on ? PHASE_RESUME : PHASE_IDLE;
+    report(&x, end, sweep_on, inner_before, leaf_before, out);
     return OCC_OK;
 }
 
