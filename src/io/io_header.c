@@ -58,70 +58,78 @@ static bool is_digit(const uint8_t ch)
 static const float pow10f_exact[11] = {1e0f, 1e1f, 1e2f, 1e3f, 1e4f, 1e5f,
                                        1e6f, 1e7f, 1e8f, 1e9f, 1e10f};
 
-/* A decimal number as istream >> double reads it; float result. */
-static bool parse_real(occ_cursor_t *const c, float *const out)
+/* A decimal mantissa: up to 19 significant digits, the rest only counted in the exponent. */
+typedef struct {
+    uint64_t mant;
+    int32_t exp10;
+    unsigned digits; /* significant digits in mant */
+    bool any;        /* a digit was seen */
+} decimal_t;
+
+/* The digits of "123.456" from p into *d; returns the position after them. */
+static size_t scan_mantissa(const occ_cursor_t *const c, size_t p, decimal_t *const d)
 {
-    size_t p = c->pos;
-    bool neg = false;
-    if (p < c->len && (c->buf[p] == '+' || c->buf[p] == '-')) {
-        neg = c->buf[p] == '-';
-        p++;
-    }
-    uint64_t mant = 0u;
-    int32_t exp10 = 0;
-    unsigned digits = 0u;
-    bool any = false;
     while (p < c->len && is_digit(c->buf[p])) {
-        any = true;
-        if (digits < 19u) {
-            mant = mant * 10u + (uint64_t)(c->buf[p] - '0');
-            if (mant != 0u) {
-                digits++;
+        d->any = true;
+        if (d->digits < 19u) {
+            d->mant = d->mant * 10u + (uint64_t)(c->buf[p] - '0');
+            if (d->mant != 0u) {
+                d->digits++;
             }
-        } else if (exp10 < 100000) { /* an int32_t that a 2 GiB run of digits cannot wrap */
-            exp10++;
+        } else if (d->exp10 < 100000) { /* an int32_t that a 2 GiB run of digits cannot wrap */
+            d->exp10++;
         }
         p++;
     }
     if (p < c->len && c->buf[p] == '.') {
         p++;
         while (p < c->len && is_digit(c->buf[p])) {
-            any = true;
-            if (digits < 19u && exp10 > -100000) {
-                mant = mant * 10u + (uint64_t)(c->buf[p] - '0');
-                exp10--;
-                if (mant != 0u) {
-                    digits++;
+            d->any = true;
+            if (d->digits < 19u && d->exp10 > -100000) {
+                d->mant = d->mant * 10u + (uint64_t)(c->buf[p] - '0');
+                d->exp10--;
+                if (d->mant != 0u) {
+                    d->digits++;
                 }
             }
             p++;
         }
     }
-    if (!any) {
-        return false;
+    return p;
+}
+
+/* An exponent "e-12" at p added to *exp10; returns the position after it (p itself when there
+ * is none: "1e" reads as 1). */
+static size_t scan_exponent(const occ_cursor_t *const c, const size_t p, int32_t *const exp10)
+{
+    if (!(p < c->len && (c->buf[p] == 'e' || c->buf[p] == 'E'))) {
+        return p;
     }
-    if (p < c->len && (c->buf[p] == 'e' || c->buf[p] == 'E')) {
-        size_t q = p + 1u;
-        bool eneg = false;
-        if (q < c->len && (c->buf[q] == '+' || c->buf[q] == '-')) {
-            eneg = c->buf[q] == '-';
-            q++;
-        }
-        if (q < c->len && is_digit(c->buf[q])) {
-            int32_t e = 0;
-            while (q < c->len && is_digit(c->buf[q])) {
-                if (e < 10000) {
-                    e = e * 10 + (int32_t)(c->buf[q] - '0');
-                }
-                q++;
-            }
-            exp10 += eneg ? -e : e;
-            p = q;
-        }
+    size_t q = p + 1u;
+    bool eneg = false;
+    if (q < c->len && (c->buf[q] == '+' || c->buf[q] == '-')) {
+        eneg = c->buf[q] == '-';
+        q++;
     }
-    c->pos = p;
+    if (!(q < c->len && is_digit(c->buf[q]))) {
+        return p;
+    }
+    int32_t e = 0;
+    while (q < c->len && is_digit(c->buf[q])) {
+        if (e < 10000) {
+            e = e * 10 + (int32_t)(c->buf[q] - '0');
+        }
+        q++;
+    }
+    *exp10 += eneg ? -e : e;
+    return q;
+}
+
+/* mant * 10^exp10 in float: one correctly rounded step when both parts are exact, else
+ * stepwise. */
+static float scale_pow10(const uint64_t mant, int32_t exp10)
+{
     float v = (float)mant;
-    /* One correctly rounded step when both parts are exact, else stepwise. */
     while (exp10 > 10 && v < 1e30f) {
         v *= 1e10f;
         exp10 -= 10;
@@ -131,12 +139,27 @@ static bool parse_real(occ_cursor_t *const c, float *const out)
         exp10 += 10;
     }
     if (exp10 > 10 || exp10 < -10) {
-        v = exp10 > 0 ? 3.0e38f * 10.0f : 0.0f;  /* saturates: rejected by the range check */
-    } else if (exp10 >= 0) {
-        v *= pow10f_exact[exp10];
-    } else {
-        v /= pow10f_exact[-exp10];
+        return exp10 > 0 ? 3.0e38f * 10.0f : 0.0f;  /* saturates: rejected by the range check */
     }
+    return exp10 >= 0 ? v * pow10f_exact[exp10] : v / pow10f_exact[-exp10];
+}
+
+/* A decimal number as istream >> double reads it; float result. */
+static bool parse_real(occ_cursor_t *const c, float *const out)
+{
+    size_t p = c->pos;
+    bool neg = false;
+    if (p < c->len && (c->buf[p] == '+' || c->buf[p] == '-')) {
+        neg = c->buf[p] == '-';
+        p++;
+    }
+    decimal_t d = {0u, 0, 0u, false};
+    p = scan_mantissa(c, p, &d);
+    if (!d.any) {
+        return false;
+    }
+    c->pos = scan_exponent(c, p, &d.exp10);
+    const float v = scale_pow10(d.mant, d.exp10);
     *out = neg ? -v : v;
     return true;
 }
@@ -166,9 +189,9 @@ static bool parse_uint(occ_cursor_t *const c, uint64_t *const out)
     return true;
 }
 
-occ_err_t occi_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
+/* The first line: which format's magic it is. */
+static occ_err_t read_magic(occ_cursor_t *const c, occ_om_header_t *const h)
 {
-    memset(h, 0, sizeof *h);
     const size_t nb = sizeof magic_bt - 1u, no = sizeof magic_ot - 1u;
     if (c->len >= nb && memcmp(c->buf, magic_bt, nb) == 0) {
         h->format = OCC_FORMAT_BT;
@@ -178,65 +201,67 @@ occ_err_t occi_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
         return occ_cursor_fail(c, 0u, "wrong magic: not an OctoMap .bt/.ot header");
     }
     c->pos = 0u;
-    if (!skip_line(c)) {
-        return occ_cursor_fail(c, c->len, "truncated header");
+    return skip_line(c) ? OCC_OK : occ_cursor_fail(c, c->len, "truncated header");
+}
+
+/* The id token after "id" (at c->pos, whitespace skipped) into h->id. */
+static occ_err_t read_id(occ_cursor_t *const c, occ_om_header_t *const h)
+{
+    const size_t k = token_len(c);
+    if (k == 0u) {
+        return occ_cursor_fail(c, c->pos, "truncated header: empty id");
     }
-    bool have_res = false;
-    for (;;) {
-        skip_ws(c);
-        if (c->pos >= c->len) {
-            return occ_cursor_fail(c, c->pos, "truncated header: no 'data' line");
-        }
-        const size_t at = c->pos;
-        const size_t n = token_len(c);
-        if (token_is(c, n, "data")) {
-            c->pos += n;
-            if (!skip_line(c)) {
-                return occ_cursor_fail(c, c->len, "truncated header after 'data'");
-            }
-            break;
-        }
-        if (c->buf[c->pos] == '#') {
-            c->pos += n;
-            if (!skip_line(c)) {
-                return occ_cursor_fail(c, c->len, "truncated header comment");
-            }
-        } else if (token_is(c, n, "id")) {
-            c->pos += n;
-            skip_ws(c);
-            const size_t k = token_len(c);
-            if (k == 0u) {
-                return occ_cursor_fail(c, c->pos, "truncated header: empty id");
-            }
-            if (k >= sizeof h->id) {
-                return occ_cursor_fail(c, c->pos, "tree id too long");
-            }
-            memcpy(h->id, c->buf + c->pos, k);
-            h->id[k] = '\0';
-            c->pos += k;
-        } else if (token_is(c, n, "res")) {
-            c->pos += n;
-            skip_ws(c);
-            if (!parse_real(c, &h->res)) {
-                return occ_cursor_fail(c, c->pos, "malformed res");
-            }
-            have_res = true;
-        } else if (token_is(c, n, "size")) {
-            c->pos += n;
-            skip_ws(c);
-            if (!parse_uint(c, &h->size)) {
-                return occ_cursor_fail(c, c->pos, "malformed or absurd size");
-            }
-        } else {
-            h->warnings |= OCC_IO_WARN_UNKNOWN_KEY;
-            c->pos += n;
-            if (!skip_line(c)) {
-                return occ_cursor_fail(c, c->len, "truncated header");
-            }
-        }
-        (void)at;
+    if (k >= sizeof h->id) {
+        return occ_cursor_fail(c, c->pos, "tree id too long");
     }
-    h->data_offset = c->pos;
+    memcpy(h->id, c->buf + c->pos, k);
+    h->id[k] = '\0';
+    c->pos += k;
+    return OCC_OK;
+}
+
+/* The value after a keyword of length n at c->pos, past the whitespace between them. */
+static void skip_keyword(occ_cursor_t *const c, const size_t n)
+{
+    c->pos += n;
+    skip_ws(c);
+}
+
+/* One entry: the token of length n at c->pos and what belongs to it - a comment line, "id",
+ * "res" or "size" and its value, an unknown keyword (skipped to the end of its line). */
+static occ_err_t read_entry(occ_cursor_t *const c, const size_t n, occ_om_header_t *const h,
+                            bool *const have_res)
+{
+    if (c->buf[c->pos] == '#') {
+        c->pos += n;
+        return skip_line(c) ? OCC_OK : occ_cursor_fail(c, c->len, "truncated header comment");
+    }
+    if (token_is(c, n, "id")) {
+        skip_keyword(c, n);
+        return read_id(c, h);
+    }
+    if (token_is(c, n, "res")) {
+        skip_keyword(c, n);
+        if (!parse_real(c, &h->res)) {
+            return occ_cursor_fail(c, c->pos, "malformed res");
+        }
+        *have_res = true;
+        return OCC_OK;
+    }
+    if (token_is(c, n, "size")) {
+        skip_keyword(c, n);
+        return parse_uint(c, &h->size) ? OCC_OK
+                                       : occ_cursor_fail(c, c->pos, "malformed or absurd size");
+    }
+    h->warnings |= OCC_IO_WARN_UNKNOWN_KEY;
+    c->pos += n;
+    return skip_line(c) ? OCC_OK : occ_cursor_fail(c, c->len, "truncated header");
+}
+
+/* After "data": an id and a sane resolution are there; the legacy id "1" reads as "OcTree". */
+static occ_err_t finish_header(occ_cursor_t *const c, occ_om_header_t *const h,
+                               const bool have_res)
+{
     if (h->id[0] == '\0') {
         return occ_cursor_fail(c, c->pos, "header without id");
     }
@@ -253,6 +278,30 @@ occ_err_t occi_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
     return OCC_OK;
 }
 
+occ_err_t occi_om_header_parse(occ_cursor_t *const c, occ_om_header_t *const h)
+{
+    memset(h, 0, sizeof *h);
+    occ_err_t e = read_magic(c, h);
+    bool have_res = false;
+    while (e == OCC_OK) {
+        skip_ws(c);
+        if (c->pos >= c->len) {
+            return occ_cursor_fail(c, c->pos, "truncated header: no 'data' line");
+        }
+        const size_t n = token_len(c);
+        if (token_is(c, n, "data")) {
+            c->pos += n;
+            if (!skip_line(c)) {
+                return occ_cursor_fail(c, c->len, "truncated header after 'data'");
+            }
+            h->data_offset = c->pos;
+            return finish_header(c, h, have_res);
+        }
+        e = read_entry(c, n, h, &have_res);
+    }
+    return e;
+}
+
 /* round(m * 10^p / 2^s), halves to even, exact in 64 bits for m < 2^24, p <= 11, s <= 62. */
 static uint64_t scaled_round(const uint32_t m, const unsigned p, const unsigned s)
 {
@@ -267,11 +316,12 @@ static uint64_t scaled_round(const uint32_t m, const unsigned p, const unsigned 
     return (r > half || (r == half && (q & 1u) != 0u)) ? q + 1u : q;
 }
 
-occ_err_t occi_om_header_write(occ_sink_t *const s, const occ_format_t format, const uint64_t size,
-                               const float res)
+/* res's six significant digits (as %g rounds them) into digits[0..*nd), trailing zeros dropped,
+ * and the decimal exponent of the first: res ~ d.ddddd * 10^e. False outside [1e-6, 1e6). */
+static bool res_digits(const float res, char digits[6], unsigned *const nd, int32_t *const e_out)
 {
     if (!occ_finite(res) || !(res >= 1e-6f) || !(res < 1e6f)) {
-        return OCC_ERR_UNSUPPORTED;
+        return false;
     }
     uint32_t bits;
     memcpy(&bits, &res, sizeof bits);
@@ -279,14 +329,14 @@ occ_err_t occi_om_header_write(occ_sink_t *const s, const occ_format_t format, c
     const uint32_t m = (bits & 0x7FFFFFu) | 0x800000u;
     const unsigned shift = (unsigned)(150 - bexp);  /* res = m / 2^shift; 1e-6..1e6 -> 24..63 */
     if (shift > 62u) {
-        return OCC_ERR_UNSUPPORTED;
+        return false;
     }
     /* Six significant digits: find e with 10^5 <= round(res * 10^(5-e)) < 10^6. */
     int32_t e = 0;
     uint64_t d = 0u;
     for (unsigned iter = 0; iter < 16u; iter++) {
         if (5 - e < 0 || 5 - e > 11) {
-            return OCC_ERR_UNSUPPORTED;
+            return false;
         }
         d = scaled_round(m, (unsigned)(5 - e), shift);
         if (d < 100000u) {
@@ -297,24 +347,37 @@ occ_err_t occi_om_header_write(occ_sink_t *const s, const occ_format_t format, c
             break;
         }
     }
-    char digits[7];
     for (int i = 5; i >= 0; i--) {
         digits[i] = (char)('0' + (int)(d % 10u));
         d /= 10u;
     }
-    unsigned nd = 6u;
-    while (nd > 1u && digits[nd - 1u] == '0') {
-        nd--;
+    *nd = 6u;
+    while (*nd > 1u && digits[*nd - 1u] == '0') {
+        (*nd)--;
     }
-    char out[24];
+    *e_out = e;
+    return true;
+}
+
+/* Appends digits[from..to) to out at *o. */
+static void put_digits(char *const out, unsigned *const o, const char *const digits,
+                       const unsigned from, const unsigned to)
+{
+    for (unsigned i = from; i < to; i++) {
+        out[(*o)++] = digits[i];
+    }
+}
+
+/* %g of d.ddddd * 10^e (nd digits, e >= -6) into out (24 bytes); returns its length. */
+static unsigned format_g(const char digits[6], const unsigned nd, const int32_t e,
+                         char out[24])
+{
     unsigned o = 0u;
     if (e < -4) {  /* %g switches to the exponent form: d.ddddde-0X */
         out[o++] = digits[0];
         if (nd > 1u) {
             out[o++] = '.';
-            for (unsigned i = 1; i < nd; i++) {
-                out[o++] = digits[i];
-            }
+            put_digits(out, &o, digits, 1u, nd);
         }
         out[o++] = 'e';
         out[o++] = '-';
@@ -326,21 +389,29 @@ occ_err_t occi_om_header_write(occ_sink_t *const s, const occ_format_t format, c
         for (int i = -1; i > e; i--) {
             out[o++] = '0';
         }
-        for (unsigned i = 0; i < nd; i++) {
-            out[o++] = digits[i];
-        }
+        put_digits(out, &o, digits, 0u, nd);
     } else {
         const unsigned ip = (unsigned)e + 1u;
-        for (unsigned i = 0; i < ip; i++) {
-            out[o++] = digits[i];
-        }
+        put_digits(out, &o, digits, 0u, ip);
         if (nd > ip) {
             out[o++] = '.';
-            for (unsigned i = ip; i < nd; i++) {
-                out[o++] = digits[i];
-            }
+            put_digits(out, &o, digits, ip, nd);
         }
     }
+    return o;
+}
+
+occ_err_t occi_om_header_write(occ_sink_t *const s, const occ_format_t format, const uint64_t size,
+                               const float res)
+{
+    char digits[6];
+    unsigned nd = 0u;
+    int32_t e = 0;
+    if (!res_digits(res, digits, &nd, &e)) {
+        return OCC_ERR_UNSUPPORTED;
+    }
+    char out[24];
+    const unsigned o = format_g(digits, nd, e, out);
     occi_sink_str(s, format == OCC_FORMAT_BT ? magic_bt : magic_ot);
     occi_sink_str(s, "\n");
     occi_sink_str(s, comment);
