@@ -103,6 +103,98 @@ static void take_ack(occ_mav_feed_t *f, const occ_mav_frame_t *fr)
     }
 }
 
+static void set_position(occ_mav_feed_t *f, float north, float east, float down, uint64_t now_us)
+{
+    f->north = north;
+    f->east = east;
+    f->down = down;
+    f->pos_us = now_us;
+    f->have_pos = true;
+    f->counters.positions_rx++;
+}
+
+static void set_attitude(occ_mav_feed_t *f, float yaw_ned, float roll, float pitch,
+                         uint64_t now_us)
+{
+    f->yaw_ned = yaw_ned;
+    f->roll = roll;
+    f->pitch = pitch;
+    f->att_us = now_us;
+    f->have_att = true;
+    f->counters.attitudes_rx++;
+}
+
+/* Each take_* below: true when the message was taken (it decoded, and what it says is finite
+ * and in a frame we use). */
+static bool take_position(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
+{
+    occ_mav_local_position_ned_t m;
+    if (occ_mav_decode_local_position_ned(fr, &m) != OCC_OK || !isfinite(m.x) ||
+        !isfinite(m.y) || !isfinite(m.z)) {
+        return false;
+    }
+    set_position(f, m.x, m.y, m.z, now_us);
+    return true;
+}
+
+static bool take_attitude(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
+{
+    occ_mav_attitude_t m;
+    if (occ_mav_decode_attitude(fr, &m) != OCC_OK || !isfinite(m.yaw)) {
+        return false;
+    }
+    set_attitude(f, m.yaw, m.roll, m.pitch, now_us);
+    return true;
+}
+
+static bool take_quaternion(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
+{
+    occ_mav_attitude_quaternion_t m;
+    if (occ_mav_decode_attitude_quaternion(fr, &m) != OCC_OK) {
+        return false;
+    }
+    /* roll and pitch are stored even when the yaw is rejected (as before the split). */
+    const float yaw = occ_mav_quat_yaw(m.q, &f->roll, &f->pitch);
+    if (!isfinite(yaw)) {
+        return false;
+    }
+    set_attitude(f, yaw, f->roll, f->pitch, now_us);
+    return true;
+}
+
+static bool take_odometry(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
+{
+    occ_mav_odometry_t m;
+    if (occ_mav_decode_odometry(fr, &m) != OCC_OK || !odometry_frame_ok(m.frame_id) ||
+        !isfinite(m.x) || !isfinite(m.y) || !isfinite(m.z)) {
+        return false;
+    }
+    float roll, pitch;
+    const float yaw = occ_mav_quat_yaw(m.q, &roll, &pitch);
+    if (!isfinite(yaw)) {
+        return false;
+    }
+    set_position(f, m.x, m.y, m.z, now_us);
+    set_attitude(f, yaw, roll, pitch, now_us);
+    return true;
+}
+
+static bool take_pose(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
+{
+    switch (fr->msgid) {
+    case OCC_MAV_MSG_LOCAL_POSITION_NED:
+        return take_position(f, fr, now_us);
+    case OCC_MAV_MSG_ATTITUDE:
+        return take_attitude(f, fr, now_us);
+    case OCC_MAV_MSG_ATTITUDE_QUATERNION:
+        return take_quaternion(f, fr, now_us);
+    case OCC_MAV_MSG_ODOMETRY:
+        return take_odometry(f, fr, now_us);
+    default:
+        return false;
+    }
+}
+
 static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
 {
     if (fr->sysid == f->cfg.sysid && fr->compid == f->cfg.compid) {
@@ -123,76 +215,9 @@ static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t no
         f->counters.ignored_rx++;
         return;
     }
-    switch (fr->msgid) {
-    case OCC_MAV_MSG_LOCAL_POSITION_NED: {
-        occ_mav_local_position_ned_t m;
-        if (occ_mav_decode_local_position_ned(fr, &m) == OCC_OK && isfinite(m.x) &&
-            isfinite(m.y) && isfinite(m.z)) {
-            f->north = m.x;
-            f->east = m.y;
-            f->down = m.z;
-            f->pos_us = now_us;
-            f->have_pos = true;
-            f->counters.positions_rx++;
-            return;
-        }
-        break;
+    if (!take_pose(f, fr, now_us)) {
+        f->counters.ignored_rx++;
     }
-    case OCC_MAV_MSG_ATTITUDE: {
-        occ_mav_attitude_t m;
-        if (occ_mav_decode_attitude(fr, &m) == OCC_OK && isfinite(m.yaw)) {
-            f->yaw_ned = m.yaw;
-            f->roll = m.roll;
-            f->pitch = m.pitch;
-            f->att_us = now_us;
-            f->have_att = true;
-            f->counters.attitudes_rx++;
-            return;
-        }
-        break;
-    }
-    case OCC_MAV_MSG_ATTITUDE_QUATERNION: {
-        occ_mav_attitude_quaternion_t m;
-        if (occ_mav_decode_attitude_quaternion(fr, &m) == OCC_OK) {
-            const float yaw = occ_mav_quat_yaw(m.q, &f->roll, &f->pitch);
-            if (isfinite(yaw)) {
-                f->yaw_ned = yaw;
-                f->att_us = now_us;
-                f->have_att = true;
-                f->counters.attitudes_rx++;
-                return;
-            }
-        }
-        break;
-    }
-    case OCC_MAV_MSG_ODOMETRY: {
-        occ_mav_odometry_t m;
-        if (occ_mav_decode_odometry(fr, &m) == OCC_OK && odometry_frame_ok(m.frame_id) &&
-            isfinite(m.x) && isfinite(m.y) && isfinite(m.z)) {
-            float roll, pitch;
-            const float yaw = occ_mav_quat_yaw(m.q, &roll, &pitch);
-            if (isfinite(yaw)) {
-                f->north = m.x;
-                f->east = m.y;
-                f->down = m.z;
-                f->yaw_ned = yaw;
-                f->roll = roll;
-                f->pitch = pitch;
-                f->pos_us = now_us;
-                f->att_us = now_us;
-                f->have_pos = true;
-                f->have_att = true;
-                f->counters.positions_rx++;
-                f->counters.attitudes_rx++;
-                return;
-            }
-        }
-        break;
-    }
-    default:
-        break;
-    }
-    f->counters.ignored_rx++;
 }
 
 void occ_mav_feed_rx(occ_mav_feed_t *f, const uint8_t *data, size_t n, uint64_t now_us)
