@@ -136,6 +136,18 @@ static Box map_box(const occ_map_t &m)
     return b;
 }
 
+// CPU ms of f(0..n-1); the results are summed so that the calls cannot be dropped.
+template <class F>
+static double time_all(size_t n, const F &f)
+{
+    size_t sum = 0;
+    const double t0 = cpu_ms();
+    for (size_t i = 0; i < n; i++) sum += f(i) ? 1u : 0u;
+    const double t = cpu_ms() - t0;
+    if (sum > n) std::abort();
+    return t;
+}
+
 static bool same_ray(const occ_ray_result_t &a, const occ_ray_result_t &b)
 {
     return a.hit == b.hit && a.stop == b.stop && std::memcmp(&a.key, &b.key, sizeof a.key) == 0 &&
@@ -184,16 +196,11 @@ static void bench_queries(const occ_map_t &m, int rounds)
             }
         }
         const auto cast_all = [&](decltype(occ_cast_ray) *cast) {
-            size_t hits = 0;
-            const double t0 = cpu_ms();
-            for (size_t i = 0; i < N; i++) {
+            return time_all(N, [&](size_t i) {
                 occ_ray_result_t r;
                 cast(&m, o[i], d[i], ignore != 0, 10.0f, &r);
-                hits += r.hit;
-            }
-            const double t = cpu_ms() - t0;
-            if (hits > N) std::abort();
-            return t;
+                return r.hit;
+            });
         };
         ab(ignore ? "castRay 10 m ignore unknown (20k)" : "castRay 10 m stop at unknown (20k)",
            rounds, [&] { return cast_all(old_occ_cast_ray); },
@@ -210,16 +217,11 @@ static void bench_queries(const occ_map_t &m, int rounds)
         }
     }
     const auto los_all = [&](decltype(occ_line_of_sight) *los) {
-        size_t vis = 0;
-        const double t0 = cpu_ms();
-        for (size_t i = 0; i < N; i++) {
+        return time_all(N, [&](size_t i) {
             bool v = false;
             los(&m, o[i], e[i], OCC_UNKNOWN_SAFE, &v, nullptr);
-            vis += v;
-        }
-        const double t = cpu_ms() - t0;
-        if (vis > N) std::abort();
-        return t;
+            return v;
+        });
     };
     ab("line of sight 1..10.8 m (20k)", rounds, [&] { return los_all(old_occ_line_of_sight); },
        [&] { return los_all(occ_line_of_sight); });
