@@ -5,7 +5,7 @@ Every src/<module>/*.c|h is read; each #include "..." is resolved the way the co
 (the including file's folder first, then include/ and src/ as -Iinclude -Isrc). An edge
 module -> module is allowed only downwards:
 
-    geom <- core <- {integrate, query, io, evict} <- front ends (sectors, mavlink, dronecan)
+    geom <- core <- {integrate, query, io, evict} <- front ends (sensors, sectors, mavlink, dronecan)
 
 geom is the bottom: it reads only the public occ_map_t, and core's key conversion calls it.
 The four map modules above core are peers and do not use each other's internals (their public
@@ -22,7 +22,7 @@ import sys
 import tempfile
 
 MAP = ["geom", "core", "integrate", "query", "io", "evict"]
-FRONT = ["sectors", "mavlink", "dronecan"]
+FRONT = ["sensors", "sectors", "mavlink", "dronecan"]
 # module -> the other modules whose internal headers it may include
 ALLOWED = {"geom": set(), "core": {"geom"}}
 for _m in ("integrate", "query", "io", "evict"):
@@ -200,7 +200,7 @@ def main():
           % (nfiles, nincs))
     for module in [m for m in MAP + FRONT if m in graph]:
         print("  %-10s -> %s" % (module, ", ".join(sorted(graph[module])) or "(nothing)"))
-    print("  allowed: geom <- core <- {integrate, query, io, evict} <- {sectors, mavlink, dronecan}"
+    print("  allowed: geom <- core <- {integrate, query, io, evict} <- {sensors, sectors, mavlink, dronecan}"
           " (front ends: include/occmap only)")
     for b in bad:
         print("deps_check: " + b)

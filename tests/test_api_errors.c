@@ -77,7 +77,7 @@ static void test_err_str(void **state)
     const occ_err_t codes[] = {OCC_OK,         OCC_ERR_ARG,   OCC_ERR_RANGE,
                                OCC_ERR_NOMEM,  OCC_ERR_FORMAT, OCC_ERR_IO,
                                OCC_ERR_STATE,  OCC_ERR_UNSUPPORTED, OCC_ERR_CORRUPT,
-                               OCC_ERR_SCRATCH};
+                               OCC_ERR_SCRATCH, OCC_ERR_TIME};
     const size_t n = sizeof codes / sizeof codes[0];
     for (size_t i = 0; i < n; i++) {
         const char *const s = occ_err_str(codes[i]);

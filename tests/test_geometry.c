@@ -248,7 +248,7 @@ static void check_sectors(const where_t *w, occ_key_t k)
 {
     const float res = w->res;
     const float dx = w->p.x > 0.0f ? -2.5f * res : 2.5f * res;
-    const occ_pose_t pose = {w->p.x + dx, w->p.y, w->p.z, 0.0f, 0.0f, 0.0f};
+    const occ_yaw_pose_t pose = {w->p.x + dx, w->p.y, w->p.z, 0.0f, 0.0f, 0.0f};
     const occ_sectors_config_t cfg = occ_sectors_config_default();
     CHECK(occ_sectors_compute(&map, &pose, &cfg, &sectors) == OCC_OK, w, "occ_sectors_compute");
     float best = OCC_SECTORS_FAR;

@@ -160,7 +160,7 @@ typedef struct {
 
 /* The ground rule of occ_sectors.h, in double: the first occupied voxel down the vehicle's column
  * (from its own voxel while the voxel reaches above za) lifts za to its top + clearance. */
-static double ref_band_lo(const occ_pose_t *p, const occ_sectors_config_t *cfg, double za,
+static double ref_band_lo(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg, double za,
                           double zb)
 {
     if (!cfg->ignore_ground) {
@@ -186,7 +186,7 @@ static double ref_band_lo(const occ_pose_t *p, const occ_sectors_config_t *cfg, 
     return za;
 }
 
-static void reference(const occ_pose_t *p, const occ_sectors_config_t *cfg, ref_t *r)
+static void reference(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg, ref_t *r)
 {
     const double res = map.cfg.resolution_m;
     const int64_t half = (int64_t)1 << (map.cfg.depth_levels - 1);
@@ -240,7 +240,7 @@ static void reference(const occ_pose_t *p, const occ_sectors_config_t *cfg, ref_
 
 /* Compare with 1 cm of slack for float vs double; a kind may differ only on a (near) tie or at
  * the edge of the search radius. Returns the number of mismatching sectors. */
-static unsigned compare(const occ_pose_t *p, const occ_sectors_config_t *cfg, const char *what)
+static unsigned compare(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg, const char *what)
 {
     static ref_t r;
     reference(p, cfg, &r);
@@ -352,7 +352,7 @@ static void test_random_maps(void **state)
     for (int m = 0; m < 6; m++) {
         random_map();
         for (int i = 0; i < 8; i++) {
-            occ_pose_t p;
+            occ_yaw_pose_t p;
             memset(&p, 0, sizeof p);
             p.x = (float)(urand() * 5.0 - 2.5);
             p.y = (float)(urand() * 5.0 - 2.5);
@@ -376,7 +376,7 @@ static void test_yaw_wrap(void **state)
     static occ_sectors_t a;
     const float yaws[] = {(float)M_PI, (float)-M_PI, 0.0f, 3.0f, -3.1f, 6.2f};
     for (unsigned i = 0; i < sizeof yaws / sizeof yaws[0]; i++) {
-        occ_pose_t p = {0.33f, -0.71f, 0.05f, yaws[i], 0.0f, 0.0f};
+        occ_yaw_pose_t p = {0.33f, -0.71f, 0.05f, yaws[i], 0.0f, 0.0f};
         assert_int_equal(compare(&p, &cfg, "yaw"), 0);
         memcpy(&a, &sect, sizeof a);
         p.yaw_rad = yaws[i] + 2.0f * (float)M_PI;
@@ -406,7 +406,7 @@ static void test_behind_180(void **state)
     }
     occ_sectors_config_t cfg = occ_sectors_config_default();
     cfg.max_distance_cm = 250;
-    occ_pose_t p = {0.05f, 0.05f, 0.0f, 0.0f, 0.0f, 0.0f}; /* facing east: wall behind */
+    occ_yaw_pose_t p = {0.05f, 0.05f, 0.0f, 0.0f, 0.0f, 0.0f}; /* facing east: wall behind */
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     /* Nearest wall point (-0.9, 0.05): 0.95 m. */
     assert_int_equal(sect.distance_cm[36], 95);
@@ -432,7 +432,7 @@ static void test_unknown_space(void **state)
 {
     (void)state;
     occ_sectors_config_t cfg = occ_sectors_config_default();
-    occ_pose_t p = {1.0f, 2.0f, 0.3f, 0.4f, 0.0f, 0.0f};
+    occ_yaw_pose_t p = {1.0f, 2.0f, 0.3f, 0.4f, 0.0f, 0.0f};
     /* Empty map: the vehicle stands in unknown space. */
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     for (unsigned s = 0; s < 72; s++) {
@@ -449,7 +449,7 @@ static void test_unknown_space(void **state)
     key_at(0.05, 0.05, 0.05, &k);
     assert_int_equal(occ_map_forget_key(&map, k, 4), OCC_OK);
     assert_int_equal(occ_map_set_key(&map, k, 0, -1.0f), OCC_OK);
-    occ_pose_t q = {0.05f, 0.05f, 0.05f, 1.0f, 0.0f, 0.0f};
+    occ_yaw_pose_t q = {0.05f, 0.05f, 0.05f, 1.0f, 0.0f, 0.0f};
     cfg.unknown_as_distance = false;
     assert_int_equal(compare(&q, &cfg, "bubble"), 0);
     cfg.unknown_as_distance = true;
@@ -471,13 +471,13 @@ static void test_map_edges(void **state)
     cfg.max_distance_cm = 300;
     cfg.unknown_as_distance = true;
     cfg.band_below_m = cfg.band_above_m = 0.3f;
-    occ_pose_t p = {1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    occ_yaw_pose_t p = {1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sect.distance_cm[0], 60);   /* volume edge 0.6 m ahead */
     assert_int_equal(sect.distance_cm[36], 260); /* 2.6 m behind */
     assert_int_equal(compare(&p, &cfg, "edge"), 0);
     for (int i = 0; i < 20; i++) {
-        occ_pose_t q;
+        occ_yaw_pose_t q;
         memset(&q, 0, sizeof q);
         q.x = (float)(urand() * 3.1 - 1.55);
         q.y = (float)(urand() * 3.1 - 1.55);
@@ -487,7 +487,7 @@ static void test_map_edges(void **state)
         random_config(&c2);
         assert_int_equal(compare(&q, &c2, "edges-random"), 0);
     }
-    occ_pose_t out = {1.7f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    occ_yaw_pose_t out = {1.7f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     assert_int_equal(occ_sectors_compute(&map, &out, &cfg, &sect), OCC_ERR_RANGE);
     assert_int_equal(sect.n, 0);
     occ_map_clear(&map);
@@ -520,7 +520,7 @@ static void test_ned_mirror(void **state)
                              OCC_OK);
         }
         for (int i = 0; i < 6; i++) {
-            occ_pose_t p;
+            occ_yaw_pose_t p;
             memset(&p, 0, sizeof p);
             p.x = (float)(urand() * 5.0 - 2.5);
             p.y = (float)(urand() * 5.0 - 2.5);
@@ -529,7 +529,7 @@ static void test_ned_mirror(void **state)
             occ_sectors_config_t sc;
             random_config(&sc);
             assert_int_equal(occ_sectors_compute(&map, &p, &sc, &a), OCC_OK);
-            occ_pose_t q = p;
+            occ_yaw_pose_t q = p;
             q.x = p.y;
             q.y = p.x;
             q.z = -p.z;
@@ -590,7 +590,7 @@ static void test_floor_standing(void **state)
     floor_room();
     occ_sectors_config_t cfg = occ_sectors_config_default();
     cfg.max_distance_cm = 300; /* the free room reaches 3.15 m */
-    occ_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f}; /* 5 cm above the floor, facing east */
+    occ_yaw_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f}; /* 5 cm above the floor, facing east */
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sectors_below(61), 0);
     assert_int_equal(sect.distance_cm[0], 195);   /* the wall ahead */
@@ -637,7 +637,7 @@ static void test_band_below_above(void **state)
     }
     occ_sectors_config_t cfg = occ_sectors_config_default();
     cfg.max_distance_cm = 300; /* the free room reaches 3.15 m */
-    occ_pose_t p = {0.05f, 0.05f, 0.6f, (float)(M_PI / 2.0), 0.0f, 0.0f}; /* facing north */
+    occ_yaw_pose_t p = {0.05f, 0.05f, 0.6f, (float)(M_PI / 2.0), 0.0f, 0.0f}; /* facing north */
     cfg.band_below_m = 0.2f;
     cfg.band_above_m = 0.1f; /* [0.4, 0.7): neither */
     assert_int_equal(compare(&p, &cfg, "band-none"), 0);
@@ -670,7 +670,7 @@ static void test_fail_closed(void **state)
     (void)state;
     floor_room();
     occ_sectors_config_t cfg = occ_sectors_config_default();
-    occ_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f};
+    occ_yaw_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f};
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_true(sect.distance_cm[36] > cfg.min_distance_cm);
     assert_int_equal(occ_sectors_compute(NULL, &p, &cfg, &sect), OCC_ERR_ARG);
@@ -709,7 +709,7 @@ static void test_args(void **state)
 {
     (void)state;
     occ_sectors_config_t cfg = occ_sectors_config_default();
-    occ_pose_t p = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    occ_yaw_pose_t p = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     assert_int_equal(occ_sectors_config_check(&cfg), OCC_OK);
     assert_int_equal(occ_sectors_compute(NULL, &p, &cfg, &sect), OCC_ERR_ARG);
     assert_int_equal(occ_sectors_compute(&map, NULL, &cfg, &sect), OCC_ERR_ARG);
@@ -756,16 +756,16 @@ static void test_pose_from_ned(void **state)
 {
     (void)state;
     /* North 2, east 3, down -1.5 (1.5 m up), heading east (90 deg): map yaw 0. */
-    occ_pose_t p = occ_pose_from_ned(2.0f, 3.0f, -1.5f, (float)(M_PI / 2.0));
+    occ_yaw_pose_t p = occ_yaw_pose_from_ned(2.0f, 3.0f, -1.5f, (float)(M_PI / 2.0));
     assert_true(fabsf(p.x - 3.0f) < 1e-6f && fabsf(p.y - 2.0f) < 1e-6f);
     assert_true(fabsf(p.z - 1.5f) < 1e-6f && fabsf(p.yaw_rad) < 1e-6f);
-    p = occ_pose_from_ned(0.0f, 0.0f, 0.0f, 0.0f); /* north: +y, map yaw +90 deg */
+    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, 0.0f); /* north: +y, map yaw +90 deg */
     assert_true(fabsf(p.yaw_rad - (float)(M_PI / 2.0)) < 1e-6f);
-    p = occ_pose_from_ned(0.0f, 0.0f, 0.0f, (float)M_PI); /* south: -90 deg */
+    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, (float)M_PI); /* south: -90 deg */
     assert_true(fabsf(p.yaw_rad + (float)(M_PI / 2.0)) < 1e-6f);
-    p = occ_pose_from_ned(0.0f, 0.0f, 0.0f, -(float)(M_PI / 2.0)); /* west: 180 deg */
+    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, -(float)(M_PI / 2.0)); /* west: 180 deg */
     assert_true(fabsf(fabsf(p.yaw_rad) - (float)M_PI) < 1e-5f);
-    p = occ_pose_from_ned(0.0f, 0.0f, 0.0f, 20.0f);
+    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, 20.0f);
     assert_true(p.yaw_rad > -(float)M_PI - 1e-6f && p.yaw_rad <= (float)M_PI + 1e-6f);
 }
 

@@ -280,7 +280,7 @@ occ_err_t occ_dronecan_ingest(occ_dronecan_node_t *node, const occ_can_frame_t *
  * outside the map), the node still publishes - a NO_DATA reading and NodeStatus - and the
  * sector error is returned. Otherwise errors as occ_dronecan_poll. */
 occ_err_t occ_dronecan_poll_map(occ_dronecan_node_t *node, uint64_t now_us, const occ_map_t *map,
-                                uint64_t map_stamp_us, const occ_pose_t *pose,
+                                uint64_t map_stamp_us, const occ_yaw_pose_t *pose,
                                 uint64_t pose_stamp_us, const occ_sectors_config_t *sectors_cfg);
 
 /* ---- Ports (host side: port/posix; not part of the firmware build) ---------------------------- */

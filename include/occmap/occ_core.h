@@ -111,8 +111,10 @@ typedef enum {
     OCC_ERR_STATE = -6,       /* call not valid in the object's current state */
     OCC_ERR_UNSUPPORTED = -7, /* valid input this build does not handle */
     OCC_ERR_CORRUPT = -8,     /* occ_map_check() found broken invariants */
-    OCC_ERR_SCRATCH = -9      /* the caller's scratch is too small for this call (oom_count is
+    OCC_ERR_SCRATCH = -9,     /* the caller's scratch is too small for this call (oom_count is
                                  not bumped: it counts the pools); nothing was changed */
+    OCC_ERR_TIME = -10        /* no pose for that time (pose history: empty, too old, too new,
+                                 a gap) or a sample out of time order; nothing was changed */
 } occ_err_t;
 
 /* Short constant English text for an error code (never NULL). */

@@ -314,7 +314,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
                          size_t cap);
 
 /* The current pose in the map frame, true if fresh at now_us. */
-bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose);
+bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_yaw_pose_t *pose);
 
 /* The next time poll() may have something to send (for a sleeping loop). */
 uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f);

@@ -8,7 +8,7 @@
  *    given in it (x north, y east, z down, yaw_rad = NED heading, clockwise from +x), and the
  *    band's "above" side is -z.
  *  - An autopilot's NED pose converts as map x = NED y (east), map y = NED x (north),
- *    map z = -NED z, yaw_map = pi/2 - yaw_ned (occ_pose_from_ned).
+ *    map z = -NED z, yaw_map = pi/2 - yaw_ned (occ_yaw_pose_from_ned).
  *  - Sectors are in the vehicle's heading frame, MAV_FRAME_BODY_FRD seen from above: body angle 0
  *    is forward, angles grow clockwise. Sector i is centred on body angle
  *    angle_offset_deg + i * increment_deg and covers [centre - inc/2, centre + inc/2).
@@ -65,11 +65,11 @@ typedef struct {
     float yaw_rad;                 /* ENU map: 0 = +x (east), counter-clockwise positive;
                                     * NED map (cfg.map_ned): 0 = +x (north), clockwise */
     float roll_rad, pitch_rad;     /* optional, 0 when unknown; not used by the sectors */
-} occ_pose_t;
+} occ_yaw_pose_t;
 
 /* Convert an autopilot pose (NED metres, yaw from north clockwise, radians) to the ENU map
  * frame; yaw_map is wrapped to (-pi, pi]. Roll and pitch are set to 0. O(1). */
-occ_pose_t occ_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad);
+occ_yaw_pose_t occ_yaw_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad);
 
 typedef struct {
     uint8_t n_sectors;             /* 1..72 */
@@ -134,7 +134,7 @@ occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg);
  * map volume), OCC_ERR_NOMEM (the walk's stack in `out` is full: cannot happen with
  * OCC_SECTORS_STACK, checked anyway), or the error of occ_map_node_child() (a map written
  * during the call). On error `out` holds the unsafe answer (see "Fail closed" above). */
-occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
+occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_yaw_pose_t *pose,
                               const occ_sectors_config_t *cfg, occ_sectors_t *out);
 
 #ifdef __cplusplus

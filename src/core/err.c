@@ -14,6 +14,7 @@ const char *occ_err_str(const occ_err_t err)
     case OCC_ERR_UNSUPPORTED: return "unsupported";
     case OCC_ERR_CORRUPT: return "map invariants broken";
     case OCC_ERR_SCRATCH: return "scratch buffer too small";
+    case OCC_ERR_TIME: return "no pose for that time, or out of time order";
     default: return "unknown error";
     }
 }

@@ -238,7 +238,7 @@ static bool fresh_at(const occ_mav_feed_t *f, bool have, uint64_t at_us, uint64_
     return have && now_us >= at_us && now_us - at_us <= f->cfg.pose_timeout_us;
 }
 
-bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose)
+bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_yaw_pose_t *pose)
 {
     if (f == NULL || !f->have_pos || !f->have_att) {
         return false;
@@ -252,7 +252,7 @@ bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pos
             pose->z = f->down;
             pose->yaw_rad = f->yaw_ned;
         } else {
-            *pose = occ_pose_from_ned(f->north, f->east, f->down, f->yaw_ned);
+            *pose = occ_yaw_pose_from_ned(f->north, f->east, f->down, f->yaw_ned);
         }
         pose->roll_rad = f->roll;
         pose->pitch_rad = f->pitch;
@@ -348,7 +348,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         return 0;
     }
     f->next_obstacle_us = advance(f->next_obstacle_us, f->cfg.period_us, now_us);
-    occ_pose_t pose;
+    occ_yaw_pose_t pose;
     if (map == NULL || !occ_mav_feed_pose(f, now_us, &pose)) {
         f->counters.stale_skips++;
         return 0;

@@ -31,9 +31,9 @@ typedef struct {
     bool dirty;
 } ctx_t;
 
-occ_pose_t occ_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad)
+occ_yaw_pose_t occ_yaw_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad)
 {
-    occ_pose_t p;
+    occ_yaw_pose_t p;
     float yaw = 0.5f * PI_F - yaw_ned_rad;
     if (isfinite(yaw)) {
         yaw = fmodf(yaw, TWO_PI_F);
@@ -426,7 +426,7 @@ static void fill_unsafe(occ_sectors_t *out, const occ_sectors_config_t *cfg)
  * (from its voxel to the band's lower edge) is the ground it stands on or flies over; the band
  * then starts ground_clearance_m above that voxel's top face. Heights here are "up" metres
  * (z in an ENU map, -z in a NED one). Returns the band's lower edge. O(band / resolution). */
-static float ground_lift(const occ_map_t *map, const occ_pose_t *pose,
+static float ground_lift(const occ_map_t *map, const occ_yaw_pose_t *pose,
                          const occ_sectors_config_t *cfg, float up_lo, float up_hi)
 {
     const occ_vec3_t at = {pose->x, pose->y, pose->z};
@@ -455,7 +455,7 @@ static float ground_lift(const occ_map_t *map, const occ_pose_t *pose,
     }
 }
 
-occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *pose,
+occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_yaw_pose_t *pose,
                               const occ_sectors_config_t *cfg, occ_sectors_t *out)
 {
     if (out == NULL) {
