@@ -81,7 +81,7 @@ static void quat_of(float roll, float pitch, float yaw, float q[4])
 
 static void expect_pose(float n, float e, float d, float roll, float pitch, float yaw)
 {
-    occ_pose_t p;
+    occ_yaw_pose_t p;
     memset(&p, 0, sizeof p);
     assert_true(occ_mav_feed_pose(&feed, 1000000, &p));
     assert_true(feq(p.x, n) && feq(p.y, e) && feq(p.z, d));
