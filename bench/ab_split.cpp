@@ -7,7 +7,7 @@
 // Prints, per case, each side's median and range (min..max) over the rounds and the median and
 // quartiles of the per-round ratio new / old (< 1: the new code is faster). Both sides must give
 // the same answers (checked on every input first).
-// usage: ab_split [--rounds N] SCAN.dat MAP.bt
+// usage: ab_split [--rounds N] [--queries-only] SCAN.dat MAP.bt
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -230,13 +230,19 @@ static void bench_queries(const occ_map_t &m, int rounds)
 int main(int argc, char **argv)
 {
     int rounds = 15;
+    bool queries_only = false;
     int a = 1;
-    if (argc > 2 && std::strcmp(argv[1], "--rounds") == 0) {
-        rounds = std::max(1, std::atoi(argv[2]));
-        a = 3;
+    for (; a < argc && argv[a][0] == '-'; a++) {
+        if (std::strcmp(argv[a], "--rounds") == 0 && a + 1 < argc) {
+            rounds = std::max(1, std::atoi(argv[++a]));
+        } else if (std::strcmp(argv[a], "--queries-only") == 0) {
+            queries_only = true; /* e.g. under callgrind, where the inserts take minutes */
+        } else {
+            break;
+        }
     }
     if (argc - a != 2) {
-        std::fprintf(stderr, "usage: ab_split [--rounds N] SCAN.dat MAP.bt\n");
+        std::fprintf(stderr, "usage: ab_split [--rounds N] [--queries-only] SCAN.dat MAP.bt\n");
         return 2;
     }
     char msg[256] = "";
@@ -256,8 +262,10 @@ int main(int argc, char **argv)
         return 1;
     }
     std::printf("A/B old (AB_BASE) vs new (this tree), %d interleaved rounds, CPU time\n", rounds);
-    bench_superrays(scan, 0.1f, rounds);
-    bench_superrays(scan, 0.05f, rounds);
+    if (!queries_only) {
+        bench_superrays(scan, 0.1f, rounds);
+        bench_superrays(scan, 0.05f, rounds);
+    }
     bench_queries(m, rounds);
     std::free(map_arena);
     return 0;

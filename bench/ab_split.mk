@@ -14,7 +14,8 @@ $(AB_DIR)/libocc_old.a: FORCE_AB
 	rm -rf $(AB_DIR)/old && mkdir -p $(AB_DIR)/old; \
 	git archive "$$sha" src include | tar -x -C $(AB_DIR)/old; \
 	cd $(AB_DIR)/old; objs=""; \
-	for f in $$(find $(addprefix src/,$(OCC_MAP_MODULES)) -name '*.c' ! -name collide_ccd.c | sort); do \
+	for f in $$(for m in $(OCC_MAP_MODULES); do [ ! -d src/$$m ] || find src/$$m -name '*.c'; done | \
+	           grep -v collide_ccd.c | sort); do \
 	  o=obj/$${f%.c}.o; mkdir -p $$(dirname $$o); \
 	  $(CC) $(WARN) -O2 -g -Iinclude -Isrc -c $$f -o $$o; objs="$$objs $$o"; \
 	done; \

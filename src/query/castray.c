@@ -215,7 +215,7 @@ static bool normalize(const occ_vec3_t v, float out[3])
     return true;
 }
 
-/* The fixed numbers of one walk: the map's grid, the origin, and (castRay) the range. */
+/* The fixed numbers of one walk: the map's grid, the origin, and (castRay only) the range. */
 typedef struct {
     real_t res;
     int32_t tmv;
@@ -225,13 +225,18 @@ typedef struct {
     real_t safe_t;  /* entry parameter below which the range test cannot fail */
 } walk_t;
 
-static void walk_set(walk_t *w, const occ_map_t *map, occ_vec3_t origin, float max_range_m)
+static void walk_set(walk_t *w, const occ_map_t *map, occ_vec3_t origin)
 {
     w->res = occ_geom_res(map);
     w->tmv = occ_geom_half(map);
     w->o[0] = origin.x;
     w->o[1] = origin.y;
     w->o[2] = origin.z;
+}
+
+/* castRay's range (0: none). */
+static void walk_range(walk_t *w, float max_range_m)
+{
     w->range_set = max_range_m > 0.0f;
     w->range_sq = (real_t)max_range_m * (real_t)max_range_m;
     /* A voxel entered at ray parameter t has its centre within t + 0.87 res of the origin, so
@@ -326,7 +331,8 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
         return e;
     }
     walk_t w;
-    walk_set(&w, map, origin, max_range_m);
+    walk_set(&w, map, origin);
+    walk_range(&w, max_range_m);
     cursor_t c;
     const unsigned states = OCC_PRED_OCCUPIED | (ignore_unknown ? 0u : OCC_PRED_UNKNOWN);
     cursor_init(&c, map, k0.k, (uint8_t)occ_q_has_bits(states));
@@ -454,8 +460,8 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
     if (e != OCC_OK) {
         return e;
     }
-    walk_t w;
-    walk_set(&w, map, a, 0.0f);
+    walk_t w; /* no range: los_walk stops at b */
+    walk_set(&w, map, a);
     occ_ray_result_t scratch;
     /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_ray_result_t *const res_out = blocker != NULL ? blocker : &scratch;
