@@ -85,16 +85,23 @@ static unsigned sweep_in_slices(occ_map_t *m, uint32_t budget, unsigned max_call
     return max_calls + 1u;
 }
 
+/* A fresh map swept in slices of 8 blocks to the end: the number of calls it takes. */
+static unsigned calls_to_sweep(occ_map_t *m, occ_evict_out_t *out)
+{
+    make_map(m);
+    occ_evict_out_init(out);
+    const unsigned k = sweep_in_slices(m, 8u, 100000u, out);
+    assert_true(k > 2u && k <= 100000u);
+    assert_true(out->evictions > 0u);
+    return k;
+}
+
 static void test_slices_flags(void **state)
 {
     (void)state;
     occ_map_t m;
-    make_map(&m);
     occ_evict_out_t out;
-    occ_evict_out_init(&out);
-    const unsigned k = sweep_in_slices(&m, 8u, 100000u, &out);
-    assert_true(k > 2u && k <= 100000u);
-    assert_true(out.evictions > 0u);
+    (void)calls_to_sweep(&m, &out);
     /* Nothing left: a fresh sweep finds nothing. */
     const occ_evict_policy_t p = policy(0u);
     assert_int_equal(occ_map_evict(&m, &centre, &p, unreachable(&m), &out), OCC_OK);
@@ -106,11 +113,8 @@ static void test_resumed_sweep_retried(void **state)
 {
     (void)state;
     occ_map_t m;
-    make_map(&m);
     occ_evict_out_t out;
-    occ_evict_out_init(&out);
-    const unsigned k = sweep_in_slices(&m, 8u, 100000u, &out);
-    assert_true(k > 2u && k <= 100000u);
+    const unsigned k = calls_to_sweep(&m, &out);
     /* The same map again, stopped one slice before the end: the sweep stands in its last pass,
      * late in Morton order. */
     make_map(&m);
