@@ -25,6 +25,11 @@ HOST_WARN := $(WARN) -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 CXXWARN := -std=c++14 -Wall -Wextra -Werror -Wno-deprecated-copy -Wno-class-memaccess
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 INC := -Iinclude -Isrc
+# Firmware objects (make cross) see only the portable public headers: FW_INC holds copies of include/occmap/*.h
+# without host/, so a firmware source that includes a host-only header does not compile.
+FW_INC_DIR := $(BUILD)/fwinc
+FW_HEADERS := $(patsubst include/%,$(FW_INC_DIR)/%,$(wildcard include/occmap/*.h))
+FW_INC := -I$(FW_INC_DIR) -Isrc
 # Live asserts for test builds of the core: OCC_ASSERT -> mock_assert (libcmocka's in CMocka
 # tests; other programs linking such a build include tests/support/occ_assert_abort.h). Release
 # and cross builds keep OCC_ASSERT at nothing. Defined before the fragments so they can use it.
@@ -51,6 +56,11 @@ PORT_SRC := $(wildcard port/posix/*.c)
 TOOL_SRC := $(wildcard tools/*.c)
 TEST_SUPPORT_SRC := $(wildcard tests/support/*.c tests/support/*.cpp)
 TEST_C := $(wildcard tests/test_*.c)
+# Test oracles (tests/support) that run millions of reference checks: plain OctoMap/Eigen code,
+# built with ORACLE_FLAGS (optimized, no sanitizer) in every test build (here and tests/i386.mk)
+# while the core and the test drivers keep ASan+UBSan, so the tests take seconds.
+ORACLE_SRC := tests/support/oracle_query.cpp
+ORACLE_FLAGS := -O2 -g
 TEST_STEPS := cross symcheck
 DEMO_STEPS :=
 BENCH_STEPS :=
@@ -105,6 +115,9 @@ $(BUILD)/asanhost/%.o: %.cpp
 $(BUILD)/relhost/%.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXWARN) -O2 -g $(INC) -I/usr/include/eigen3 -MMD -MP -c $< -o $@
+$(ORACLE_SRC:%.cpp=$(BUILD)/asanhost/%.o): $(BUILD)/asanhost/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXWARN) $(ORACLE_FLAGS) $(INC) -I/usr/include/eigen3 -MMD -MP -c $< -o $@
 
 LIB_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC) $(OCC_CCD_SRC)
 $(BUILD)/libocc.a: $(LIB_SRC:%.c=$(BUILD)/rel/%.o)
@@ -140,15 +153,18 @@ test: $(DEPS_STAMP)
 
 # ---- cross (Cortex-M) ---------------------------------------------------------------------------
 CROSS_CC := arm-none-eabi-gcc
-CROSS_COMMON := $(WARN) -Os -ffunction-sections -fdata-sections -ffreestanding -fstack-usage $(INC)
+CROSS_COMMON := $(WARN) -Os -ffunction-sections -fdata-sections -ffreestanding -fstack-usage $(FW_INC)
 CROSS_M4 := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 CROSS_M0 := -mcpu=cortex-m0plus -mthumb -mfloat-abi=soft
 CROSS_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC)
 
-$(BUILD)/cross/m4/%.o: %.c
+$(FW_INC_DIR)/occmap/%.h: include/occmap/%.h
+	@mkdir -p $(dir $@)
+	cp $< $@
+$(BUILD)/cross/m4/%.o: %.c | $(FW_HEADERS)
 	@mkdir -p $(dir $@)
 	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M4) $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
-$(BUILD)/cross/m0/%.o: %.c
+$(BUILD)/cross/m0/%.o: %.c | $(FW_HEADERS)
 	@mkdir -p $(dir $@)
 	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M0) $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
 

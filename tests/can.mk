@@ -11,13 +11,14 @@ APT_PKGS += qemu-system-x86 busybox-static cpio can-utils
 CAN_BUILD := $(BUILD)/can
 CAN_HOST_CFLAGS = $(HOST_WARN) -O2 -g $(INC) $(EXTRA_CFLAGS)
 
-$(CAN_BUILD)/golden_dump: tests/can/golden_dump.c $(BUILD)/libocc.a include/occmap/occ_can.h
+$(CAN_BUILD)/golden_dump: tests/can/golden_dump.c $(BUILD)/libocc.a include/occmap/occ_dronecan.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CAN_HOST_CFLAGS) -o $@ $< $(BUILD)/libocc.a -lm
 
 # Static, so the guest's initramfs needs no libraries for it.
 $(CAN_BUILD)/socketcan_guest: tests/can/socketcan_guest.c port/posix/socketcan.c \
-                              port/posix/fd_wait.c $(BUILD)/libocc.a include/occmap/occ_can.h
+                              port/posix/fd_wait.c $(BUILD)/libocc.a include/occmap/occ_dronecan.h \
+                              include/occmap/host/occ_socketcan.h
 	@mkdir -p $(dir $@)
 	$(CC) $(CAN_HOST_CFLAGS) -static -o $@ tests/can/socketcan_guest.c port/posix/socketcan.c \
 	  port/posix/fd_wait.c $(BUILD)/libocc.a -lm

@@ -11,6 +11,9 @@ geom is the bottom: it reads only the public occ_map_t, and core's key conversio
 The four map modules above core are peers and do not use each other's internals (their public
 headers are fine). Front ends use only include/occmap (public headers). Nothing in src may
 include port/ or tools/, and a portable module may not include include/occmap/host/.
+The public headers: occmap.h includes only the chapters, no include cycle, and a portable header
+(include/occmap/*.h, not host/) includes only freestanding C headers and declares nothing of an
+OS (FILE, file descriptors, sockets, threads, libccd).
 Prints the graph it found, then proves itself on planted wrong-way includes in a scratch copy.
 Exit 1 on a wrong-way edge, an include it cannot resolve, or a planted edge it misses.
 usage: deps_check.py [ROOT]
@@ -126,11 +129,38 @@ PLANTED = [
 ]
 
 
+# Host-only declarations planted one at a time in a portable header: each must be reported.
+PLANTED_HEADER = [
+    ("include/occmap/occ_port.h", "#include <stdio.h>", "<stdio.h>"),
+    ("include/occmap/occ_port.h", "typedef struct { int fd; } occ_x_t;", "`fd`"),
+    ("include/occmap/occ_core.h", "void occ_x(FILE *f);", "`FILE`"),
+    ("include/occmap/occ_port.h", '#include "occmap/host/occ_file.h"', "host/occ_file.h"),
+]
+
+
+def selftest_headers(tmp):
+    ok = True
+    for rel, line, what in PLANTED_HEADER:
+        path = os.path.join(tmp, rel)
+        with open(path, encoding="utf-8") as fh:
+            before = fh.read()
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(line + "\n" + before)
+        name = os.path.basename(rel)
+        caught = any(name in b and what in b for b in check_headers(tmp))
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(before)
+        print("deps_check selftest: planted %-20s in %-12s %s" % (what, name, "caught" if caught else "MISSED"))
+        ok = ok and caught
+    return ok
+
+
 def selftest(root):
     ok = True
     with tempfile.TemporaryDirectory() as tmp:
         for top in ("src", "include", "port"):
             shutil.copytree(os.path.join(root, top), os.path.join(tmp, top))
+        ok = selftest_headers(tmp)
         for rel, line, what in PLANTED:
             path = os.path.join(tmp, rel)
             if not os.path.isfile(path):
@@ -149,6 +179,22 @@ def selftest(root):
 
 
 CHAPTERS = ["occ_core.h", "occ_integrate.h", "occ_query.h", "occ_io.h", "occ_evict.h"]
+# A portable header (include/occmap/*.h, what firmware sees) includes only freestanding C headers
+# and declares nothing of an OS: no FILE, file descriptors, sockets, threads or libccd. The
+# firmware compile of every portable header alone (make fw-headers) is the other half.
+FREESTANDING = {"stddef.h", "stdint.h", "stdbool.h", "float.h", "limits.h", "stdarg.h"}
+SYS_INCLUDE = re.compile(r"^\s*#\s*include\s*<([^>]+)>", re.M)
+HOST_ONLY = re.compile(r"\b(FILE|fopen|sockaddr\w*|socklen_t|pthread_\w+|ccd\w*|fd|\w+_fd)\b")
+
+
+def portable_problems(name, text):
+    """Why a portable header is not portable (empty list when it is)."""
+    code = re.sub(r"/\*.*?\*/|//[^\n]*", " ", text, flags=re.S)
+    bad = ["include/occmap/%s (portable) includes <%s>" % (name, h)
+           for h in SYS_INCLUDE.findall(code) if h not in FREESTANDING]
+    bad += ["include/occmap/%s (portable) declares host-only `%s`" % (name, w)
+            for w in sorted(set(m.group(1) for m in HOST_ONLY.finditer(code)))]
+    return bad
 
 
 def check_headers(root):
@@ -162,7 +208,10 @@ def check_headers(root):
                 continue
             name = os.path.relpath(os.path.join(folder, f), inc)
             with open(os.path.join(folder, f), encoding="utf-8") as fh:
-                deps = [m.group(1)[len("occmap/"):] for m in map(INCLUDE.match, fh) if m]
+                text = fh.read()
+            deps = [m.group(1)[len("occmap/"):] for m in map(INCLUDE.match, text.split("\n")) if m]
+            if not name.startswith("host/"):
+                bad += portable_problems(name, text)
             edges[name] = deps
             allowed = (set(CHAPTERS) if name == "occmap.h" else
                        {"occ_core.h"} if name in CHAPTERS else None)
@@ -194,7 +243,8 @@ def main():
     graph, bad, nfiles, nincs = check(root)
     header_bad = check_headers(root)
     print("deps_check: public headers: occmap.h -> %s; %s"
-          % (", ".join(CHAPTERS), "chapters include only occ_core.h, no cycle" if not header_bad else "PROBLEMS below"))
+          % (", ".join(CHAPTERS), "chapters include only occ_core.h, no cycle, portable headers declare nothing host-only"
+          if not header_bad else "PROBLEMS below"))
     bad += header_bad
     print("deps_check: module graph of src/ (%d files, %d includes), module -> what it includes:"
           % (nfiles, nincs))

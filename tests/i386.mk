@@ -49,6 +49,7 @@ TEST_BINS_EXTRA += $(I386_BINS)
 i386-build: $(I386_BINS)
 .PHONY: i386-build
 
-# As in query.mk: OctoMap's query oracle runs without sanitizers (it is the reference, and slow).
-$(I386_DIR)/host/tests/support/oracle_query.o: SAN :=
-$(I386_DIR)/host/tests/support/oracle_query.o: INC += -O2
+# The oracles (ORACLE_SRC, top Makefile) with ORACLE_FLAGS: optimized, no sanitizer.
+$(ORACLE_SRC:%.cpp=$(I386_DIR)/host/%.o): $(I386_DIR)/host/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXWARN) $(ORACLE_FLAGS) $(INC) -I/usr/include/eigen3 $(I386_CFLAGS) -MMD -MP -c $< -o $@

@@ -14,7 +14,8 @@ CPPCHECK_CONFIGS := -DOCC_RAY_DOUBLE=1 -DOCC_RAY_DOUBLE=0
 ANALYZER_CFLAGS := $(WARN) -O2 -fanalyzer $(INC)
 
 # One stamp per source, so a re-run analyses only what changed (headers via the .d files).
-# EXTRA_CFLAGS and `mavgen` (tests/mavlink.mk): the generated MAVLink headers src/mavlink includes.
+# EXTRA_CFLAGS (MAVLINK_FLAGS for src/mavlink/mavlink.c) and `mavgen` (tests/mavlink.mk): the
+# generated MAVLink headers src/mavlink includes.
 $(LINT_DIR)/%.analyzer.ok: %.c | mavgen
 	@mkdir -p $(dir $@)
 	$(CC) $(ANALYZER_CFLAGS) $(EXTRA_CFLAGS) -MMD -MP -MT $@ -MF $@.d -c $< -o /dev/null

@@ -6,7 +6,12 @@
 MAVGEN_DIR := $(BUILD)/gen/mavlink
 MAVGEN_STAMP := $(MAVGEN_DIR)/.stamp
 MAVGEN_DIALECT := ardupilotmega
-EXTRA_CFLAGS += -isystem $(MAVGEN_DIR)
+# MAVLINK_FLAGS only for the sources that include generated headers (directly or through
+# tests/support/mav_frames.h), in every build of them (rel, asan, host, cross, i386, lint):
+# a new includer is added to MAVLINK_INCLUDERS (without it, its compile fails on the include).
+MAVLINK_FLAGS := -isystem $(MAVGEN_DIR)
+MAVLINK_INCLUDERS := src/mavlink/mavlink tests/test_mavlink tests/test_mavlink_feed
+$(foreach f,$(MAVLINK_INCLUDERS),%/$(f).o %/$(f).analyzer.ok): EXTRA_CFLAGS += $(MAVLINK_FLAGS)
 
 $(MAVGEN_STAMP): | $(BUILD)/.deps-ok
 	@rm -rf $(MAVGEN_DIR).tmp && mkdir -p $(MAVGEN_DIR).tmp
@@ -55,7 +60,7 @@ FUZZ_MAV := $(BUILD)/fuzz/fuzz_mavlink
 $(FUZZ_MAV): tests/mavlink/fuzz_mavlink.c src/mavlink/mavlink.c include/occmap/occ_mavlink.h $(MAVGEN_STAMP)
 	@mkdir -p $(dir $@)
 	clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-	  $(INC) -isystem $(MAVGEN_DIR) -o $@ tests/mavlink/fuzz_mavlink.c src/mavlink/mavlink.c
+	  $(INC) $(MAVLINK_FLAGS) -o $@ tests/mavlink/fuzz_mavlink.c src/mavlink/mavlink.c
 fuzz-mavlink: $(FUZZ_MAV) $(MAV_REF)/py_frames.bin
 	@mkdir -p $(BUILD)/fuzz/corpus-mavlink
 	@cp -f $(MAV_REF)/py_frames.bin $(BUILD)/fuzz/corpus-mavlink/seed-pymavlink.bin

@@ -14,7 +14,9 @@ table shared between library files but not declared publicly carries the interna
   symbols.py selftest LIB DIR     the check must fail on two broken copies of LIB made in DIR.
   symbols.py check LIB [ROOT]     the `make test` step: nm -g --defined-only LIB must export only
                                   public occ_ names and occi_ names, and every public declaration
-                                  must be defined in LIB or, for host-only APIs, in port/.
+                                  must be defined in LIB or, for host-only APIs, in port/; a
+                                  portable header (include/occmap/*.h, not host/) declares none
+                                  that only port/posix defines.
 
 Why here (tests/) and one file: the rename and the check read "what is public" with the same
 parser, and the check is what keeps the rename true; tools/ is the shipped `occmap` CLI.
@@ -145,9 +147,12 @@ def read(path):
         return fh.read()
 
 
-def public_declarations(root):
+def public_declarations(root, portable_only=False):
+    """Names declared under include/occmap/ (portable_only: not in its host/ folder)."""
     names = set()
     for path in walk(root, "include/occmap", (".h",)):
+        if portable_only and os.path.basename(os.path.dirname(path)) == "host":
+            continue
         names.update(n for n, _ in external_items(read(path)))
     return names
 
@@ -264,6 +269,12 @@ def problems(lib, root):
     for name in sorted(public - exported - host_only):
         errors.append(f"declared in include/occmap but defined neither in {lib} nor in port/: "
                       f"{name}")
+    # What firmware sees (include/occmap/*.h) is defined in the library or by every platform:
+    # a function only port/posix defines is host-only and belongs under include/occmap/host/.
+    posix_only = set(definitions(root, "port/posix")) - set(definitions(root, "port/baremetal"))
+    for name in sorted(public_declarations(root, True) & posix_only - exported):
+        errors.append(f"a portable header declares {name}, defined only in port/posix: "
+                      f"declare it under include/occmap/host/")
     # The parser against nm: every library definition it saw must be exported, and the reverse.
     parsed = set(definitions(root, "src"))
     for name in sorted(parsed ^ exported):
@@ -288,6 +299,22 @@ def check(lib, root):
     return 0
 
 
+def selftest_portable(lib, root, work):
+    """The check must fail on a tree whose portable occ_port.h declares a POSIX-only link call."""
+    tree = os.path.join(work, "tree")
+    shutil.rmtree(tree, ignore_errors=True)
+    shutil.copytree(os.path.join(root, "include"), os.path.join(tree, "include"))
+    for top in ("src", "port"):
+        os.symlink(os.path.abspath(os.path.join(root, top)), os.path.join(tree, top))
+    with open(os.path.join(tree, "include", "occmap", "occ_port.h"), "a") as fh:
+        fh.write("void occ_link_close(void *link);\n")
+    expect = "a portable header declares occ_link_close, defined only in port/posix"
+    seen = any(e.startswith(expect) for e in problems(lib, tree)[0])
+    print(f"{'PASS' if seen else 'FAIL'} symbols-selftest portable: the check "
+          f"{'reports' if seen else 'misses'} \"{expect}\"")
+    return 0 if seen else 1
+
+
 def selftest(lib, root, work):
     """The check must fail on two broken copies of LIB: one with an extra occ_ function that no
     public header declares, one without the member that defines occ_err_str."""
@@ -305,7 +332,7 @@ def selftest(lib, root, work):
               "exported but not declared in include/occmap: occ_symbols_selftest_extra"),
              ("missing", ["ar", "d", None, err_member],
               "declared in include/occmap but defined neither in")]
-    status = 0
+    status = selftest_portable(lib, root, work)
     for name, cmd, expect in cases:
         broken = os.path.join(work, f"libocc-{name}.a")
         shutil.copyfile(lib, broken)

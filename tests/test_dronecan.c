@@ -9,7 +9,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
+#include "occmap/host/occ_can_mcast.h"
 #include "support/can_capture.h"
 
 static void assert_frame(const occ_can_frame_t *f, uint32_t id, const uint8_t *data, size_t len)

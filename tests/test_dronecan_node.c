@@ -10,7 +10,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 #include "support/can_capture.h"
 
 /* ---- The node -------------------------------------------------------------------------------- */

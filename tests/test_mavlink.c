@@ -19,7 +19,7 @@
 #include <unistd.h>
 
 #include "occmap/occ_mavlink.h"
-#include "occmap/occ_port.h"
+#include "occmap/host/occ_link_posix.h"
 #include "ardupilotmega/mavlink.h"
 #include "support/mav_frames.h"
 

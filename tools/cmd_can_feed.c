@@ -8,7 +8,9 @@
 
 #include "cli.h"
 #include "feed_args.h"
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
+#include "occmap/host/occ_can_mcast.h"
+#include "occmap/host/occ_socketcan.h"
 
 #define CMD "can-feed"
 

@@ -11,6 +11,7 @@
 #include "occmap/occ_sectors.h"
 #include "occmap/occ_mavlink.h"
 #include "occmap/occ_port.h"
+#include "occmap/host/occ_link_posix.h"
 
 /* The options both commands take, with the same meaning and bounds. */
 typedef struct {

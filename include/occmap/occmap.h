@@ -10,8 +10,9 @@
  *   occ_io.h         OctoMap .bt/.ot and snapshot readers and writers, byte sinks
  *   occ_evict.h      eviction around the vehicle
  *
- * Front ends have their own headers (occ_sectors.h, occ_mavlink.h, occ_can.h). Host-only APIs
- * (files, scan readers, libccd) are under occmap/host/, which a firmware build does not use.
+ * Front ends have their own headers (occ_sectors.h, occ_mavlink.h, occ_dronecan.h); occ_port.h
+ * holds the platform hooks (clock, UART). Host-only APIs (files, scan readers, libccd, POSIX links,
+ * SocketCAN, CAN over multicast) are under occmap/host/, which a firmware build does not see.
  */
 #ifndef OCC_OCCMAP_H_INCLUDED
 #define OCC_OCCMAP_H_INCLUDED

@@ -8,7 +8,7 @@
 #ifndef OCC_BM_CAN_H_INCLUDED
 #define OCC_BM_CAN_H_INCLUDED
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 
 /* Queue one frame in the CAN peripheral (mailbox or software FIFO). Never blocks: OCC_OK,
  * OCC_ERR_NOMEM when full, OCC_ERR_IO without a driver. */

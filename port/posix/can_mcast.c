@@ -8,7 +8,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/host/occ_can_mcast.h"
 
 #include "fd_wait.h"
 

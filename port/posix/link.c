@@ -5,7 +5,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "occmap/occ_port.h"
+#include "occmap/host/occ_link_posix.h"
 
 occ_err_t occ_link_read(occ_link_t *l, uint8_t *buf, size_t cap, size_t *n)
 {

@@ -6,7 +6,7 @@
 #include <termios.h>
 #include <unistd.h>
 
-#include "occmap/occ_port.h"
+#include "occmap/host/occ_link_posix.h"
 
 static bool baud_code(uint32_t baud, speed_t *code)
 {

@@ -12,7 +12,7 @@
 #include <linux/can/error.h>
 #include <linux/can/raw.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/host/occ_socketcan.h"
 
 #include "fd_wait.h"
 

@@ -7,7 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "occmap/occ_port.h"
+#include "occmap/host/occ_link_posix.h"
 
 static void say(char *msg, size_t len, const char *what, const char *detail)
 {

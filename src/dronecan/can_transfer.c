@@ -1,7 +1,7 @@
 /* can_transfer.c - DroneCAN v0 transfer layer: ids, CRC, DSDL bit packing, frame split. */
 #include <string.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 
 uint32_t occ_dronecan_msg_id(uint8_t priority, uint16_t data_type_id, uint8_t src_node)
 {

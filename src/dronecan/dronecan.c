@@ -2,7 +2,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 
 #define NAME_MAX_BYTES 80u
 

@@ -1,5 +1,5 @@
 /* dronecan_map.c - the DroneCAN node fed from a map and a pose through the sector module. */
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 
 static bool within(uint64_t now_us, uint64_t stamp_us, uint32_t max_age_us)
 {

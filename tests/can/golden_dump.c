@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 
 typedef struct {
     occ_can_frame_t f[32];

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 #include "occmap/occ_sectors.h"
 
 static unsigned checks, failed;

@@ -9,7 +9,8 @@
 
 #include <linux/can.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
+#include "occmap/host/occ_socketcan.h"
 
 static int checks, failed;
 

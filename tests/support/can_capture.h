@@ -8,7 +8,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 
 /* ---- A capturing transmit hook with a settable queue limit ---------------------------------- */
 #define CAP_MAX 512

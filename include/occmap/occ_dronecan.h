@@ -1,10 +1,11 @@
 /*
- * occ_can.h - the CAN front end: a minimal DroneCAN (UAVCAN v0) node that tells an autopilot
+ * occ_dronecan.h - the CAN front end: a minimal DroneCAN (UAVCAN v0) node that tells an autopilot
  * where the obstacles are. This header is the manual.
  *
  * Layers (all portable C99, no heap, no OS; time is always passed in, microseconds):
  *  - occ_can_frame_t + occ_can_iface_t: one CAN frame and the transmit hook a port provides
- *    (port/posix/socketcan.c, port/posix/can_mcast.c, port/baremetal/can_hooks.c).
+ *    (port/baremetal/can_hooks.c; on a host port/posix/socketcan.c and can_mcast.c, declared in
+ *    occmap/host/occ_socketcan.h and occmap/host/occ_can_mcast.h).
  *  - Transfer layer (can_transfer.c): 29-bit ids, tail bytes, multi-frame split with the
  *    transfer CRC seeded by the data type signature, bit-stream packing, IEEE half floats.
  *  - Messages (dronecan.c): ardupilot.equipment.proximity_sensor.Proximity (21910),
@@ -19,8 +20,8 @@
  * the ports. Bit-exact with pydronecan 1.0.27 (tests/can_golden.py checks it byte for byte).
  * Not thread-safe: one node per thread, or serialize the calls.
  */
-#ifndef OCC_CAN_H_INCLUDED
-#define OCC_CAN_H_INCLUDED
+#ifndef OCC_DRONECAN_H_INCLUDED
+#define OCC_DRONECAN_H_INCLUDED
 
 #include <stddef.h>
 #include <stdint.h>
@@ -282,68 +283,6 @@ occ_err_t occ_dronecan_ingest(occ_dronecan_node_t *node, const occ_can_frame_t *
 occ_err_t occ_dronecan_poll_map(occ_dronecan_node_t *node, uint64_t now_us, const occ_map_t *map,
                                 uint64_t map_stamp_us, const occ_yaw_pose_t *pose,
                                 uint64_t pose_stamp_us, const occ_sectors_config_t *sectors_cfg);
-
-/* ---- Ports (host side: port/posix; not part of the firmware build) ---------------------------- */
-/* Receive filter: a frame passes when (frame id & mask) == (id & mask) and its EXT flag equals
- * `ext` (classic 11-bit vs 29-bit ids). */
-typedef struct {
-    uint32_t id, mask;
-    bool ext;
-} occ_can_filter_t;
-
-#define OCC_CAN_MAX_FILTERS 16u
-
-/* SocketCAN (port/posix/socketcan.c): one non-blocking CAN_RAW socket bound to one interface. */
-typedef struct {
-    int fd;                /* -1 when closed */
-    bool fd_frames;        /* CAN FD frames enabled on this socket */
-    uint32_t tx_full;      /* sends refused with EAGAIN / ENOBUFS */
-    uint32_t rx_errors;    /* error frames received */
-} occ_socketcan_t;
-
-/* Open `ifname` (e.g. "vcan0", "can0"), non-blocking, error frames enabled (bus-off, controller,
- * protocol, tx timeout, lost arbitration come back from occ_socketcan_recv() as
- * OCC_CAN_FLAG_ERR frames). `fd_frames` asks for CAN FD (fails with OCC_ERR_UNSUPPORTED when the
- * interface cannot). OCC_ERR_IO when the kernel has no CAN (errno in `msg`). */
-occ_err_t occ_socketcan_open(occ_socketcan_t *s, const char *ifname, bool fd_frames, char *msg,
-                             size_t msg_len);
-/* Replace the receive filters (n = 0: receive nothing but error reports; filters NULL with
- * n = 0 as well). n <= OCC_CAN_MAX_FILTERS. */
-occ_err_t occ_socketcan_set_filters(occ_socketcan_t *s, const occ_can_filter_t *filters, size_t n);
-/* Send without blocking: OCC_OK, OCC_ERR_NOMEM when the queue is full (counted in tx_full),
- * OCC_ERR_ARG for an FD frame on a classic socket or a bad length, OCC_ERR_IO otherwise. */
-occ_err_t occ_socketcan_send(occ_socketcan_t *s, const occ_can_frame_t *frame);
-/* Wait up to `timeout_ms` (0: poll, < 0: forever) for one frame. *got = false on timeout. */
-occ_err_t occ_socketcan_recv(occ_socketcan_t *s, occ_can_frame_t *frame, int timeout_ms,
-                             bool *got);
-void occ_socketcan_close(occ_socketcan_t *s);
-/* The transmit hook for the DroneCAN node (tx_space unknown). */
-occ_can_iface_t occ_socketcan_iface(occ_socketcan_t *s);
-
-/* CAN over UDP multicast (port/posix/can_mcast.c), the format of pydronecan's `mcast:` driver and
- * ArduPilot SITL: group 239.65.82.<bus>, port 57732, packet = u16 magic 0x2934, u16 CRC-16-CCITT
- * of the rest, u16 flags (1 = FD), u32 id (bit 31 = extended), data; little endian. */
-typedef struct {
-    int rx_fd, tx_fd;
-    uint16_t tx_port;          /* our sender's port: our own packets are dropped on receive */
-    uint32_t tx_full, rx_bad;  /* sends refused (EAGAIN), packets dropped (magic, CRC, size) */
-} occ_can_mcast_t;
-
-#define OCC_CAN_MCAST_PORT 57732u
-#define OCC_CAN_MCAST_MAGIC 0x2934u
-
-/* Join bus 0..255 on the loopback interface when `loopback_only`, else on the default one. */
-occ_err_t occ_can_mcast_open(occ_can_mcast_t *m, unsigned bus, bool loopback_only, char *msg,
-                             size_t msg_len);
-/* Encode / decode one packet (pure functions, used by the tests). encode returns the length
- * (10 + len) or 0 when `cap` is too small; decode returns OCC_ERR_FORMAT for a bad packet. */
-size_t occ_can_mcast_encode(const occ_can_frame_t *frame, uint8_t *out, size_t cap);
-occ_err_t occ_can_mcast_decode(const uint8_t *pkt, size_t len, occ_can_frame_t *frame);
-occ_err_t occ_can_mcast_send(occ_can_mcast_t *m, const occ_can_frame_t *frame);
-occ_err_t occ_can_mcast_recv(occ_can_mcast_t *m, occ_can_frame_t *frame, int timeout_ms,
-                             bool *got);
-void occ_can_mcast_close(occ_can_mcast_t *m);
-occ_can_iface_t occ_can_mcast_iface(occ_can_mcast_t *m);
 
 #ifdef __cplusplus
 }
