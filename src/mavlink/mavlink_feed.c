@@ -103,6 +103,40 @@ static void take_ack(occ_mav_feed_t *f, const occ_mav_frame_t *fr)
     }
 }
 
+static occ_quat_t quat_of(const float q[4])
+{
+    const occ_quat_t r = {q[0], q[1], q[2], q[3]};
+    return r;
+}
+
+/* A finite local NED position (false, nothing taken, otherwise). */
+static bool take_position(occ_mav_feed_t *f, float north, float east, float down,
+                          uint64_t now_us)
+{
+    if (!isfinite(north) || !isfinite(east) || !isfinite(down)) {
+        return false;
+    }
+    f->ned_m.x = north;
+    f->ned_m.y = east;
+    f->ned_m.z = down;
+    f->pos_us = now_us;
+    f->have_pos = true;
+    f->counters.positions_rx++;
+    return true;
+}
+
+/* An attitude NED <- FRD, kept unit; NaN, Inf or a zero quaternion is not taken. */
+static bool take_attitude(occ_mav_feed_t *f, occ_quat_t ned_from_frd, uint64_t now_us)
+{
+    if (occ_quat_normalize(ned_from_frd, &f->ned_from_frd) != OCC_OK) {
+        return false;
+    }
+    f->att_us = now_us;
+    f->have_att = true;
+    f->counters.attitudes_rx++;
+    return true;
+}
+
 static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
 {
     if (fr->sysid == f->cfg.sysid && fr->compid == f->cfg.compid) {
@@ -126,66 +160,35 @@ static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t no
     switch (fr->msgid) {
     case OCC_MAV_MSG_LOCAL_POSITION_NED: {
         occ_mav_local_position_ned_t m;
-        if (occ_mav_decode_local_position_ned(fr, &m) == OCC_OK && isfinite(m.x) &&
-            isfinite(m.y) && isfinite(m.z)) {
-            f->north = m.x;
-            f->east = m.y;
-            f->down = m.z;
-            f->pos_us = now_us;
-            f->have_pos = true;
-            f->counters.positions_rx++;
+        if (occ_mav_decode_local_position_ned(fr, &m) == OCC_OK &&
+            take_position(f, m.x, m.y, m.z, now_us)) {
             return;
         }
         break;
     }
     case OCC_MAV_MSG_ATTITUDE: {
         occ_mav_attitude_t m;
-        if (occ_mav_decode_attitude(fr, &m) == OCC_OK && isfinite(m.yaw)) {
-            f->yaw_ned = m.yaw;
-            f->roll = m.roll;
-            f->pitch = m.pitch;
-            f->att_us = now_us;
-            f->have_att = true;
-            f->counters.attitudes_rx++;
+        if (occ_mav_decode_attitude(fr, &m) == OCC_OK &&
+            take_attitude(f, occ_quat_from_euler(m.roll, m.pitch, m.yaw), now_us)) {
             return;
         }
         break;
     }
     case OCC_MAV_MSG_ATTITUDE_QUATERNION: {
         occ_mav_attitude_quaternion_t m;
-        if (occ_mav_decode_attitude_quaternion(fr, &m) == OCC_OK) {
-            const float yaw = occ_mav_quat_yaw(m.q, &f->roll, &f->pitch);
-            if (isfinite(yaw)) {
-                f->yaw_ned = yaw;
-                f->att_us = now_us;
-                f->have_att = true;
-                f->counters.attitudes_rx++;
-                return;
-            }
+        if (occ_mav_decode_attitude_quaternion(fr, &m) == OCC_OK &&
+            take_attitude(f, quat_of(m.q), now_us)) {
+            return;
         }
         break;
     }
     case OCC_MAV_MSG_ODOMETRY: {
         occ_mav_odometry_t m;
         if (occ_mav_decode_odometry(fr, &m) == OCC_OK && odometry_frame_ok(m.frame_id) &&
-            isfinite(m.x) && isfinite(m.y) && isfinite(m.z)) {
-            float roll, pitch;
-            const float yaw = occ_mav_quat_yaw(m.q, &roll, &pitch);
-            if (isfinite(yaw)) {
-                f->north = m.x;
-                f->east = m.y;
-                f->down = m.z;
-                f->yaw_ned = yaw;
-                f->roll = roll;
-                f->pitch = pitch;
-                f->pos_us = now_us;
-                f->att_us = now_us;
-                f->have_pos = true;
-                f->have_att = true;
-                f->counters.positions_rx++;
-                f->counters.attitudes_rx++;
-                return;
-            }
+            isfinite(m.x) && isfinite(m.y) && isfinite(m.z) &&
+            take_attitude(f, quat_of(m.q), now_us)) {
+            (void)take_position(f, m.x, m.y, m.z, now_us); /* finite: checked above */
+            return;
         }
         break;
     }
@@ -213,26 +216,23 @@ static bool fresh_at(const occ_mav_feed_t *f, bool have, uint64_t at_us, uint64_
     return have && now_us >= at_us && now_us - at_us <= f->cfg.pose_timeout_us;
 }
 
-bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_yaw_pose_t *pose)
+bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose)
 {
     if (f == NULL || !f->have_pos || !f->have_att) {
         return false;
     }
     const bool fresh = fresh_at(f, f->have_pos, f->pos_us, now_us) &&
                        fresh_at(f, f->have_att, f->att_us, now_us);
-    if (pose != NULL) {
-        if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
-            pose->x = f->north;
-            pose->y = f->east;
-            pose->z = f->down;
-            pose->yaw_rad = f->yaw_ned;
-        } else {
-            *pose = occ_yaw_pose_from_ned(f->north, f->east, f->down, f->yaw_ned);
-        }
-        pose->roll_rad = f->roll;
-        pose->pitch_rad = f->pitch;
+    if (pose == NULL) {
+        return fresh;
     }
-    return fresh;
+    if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
+        pose->p = f->ned_m;
+        pose->q = f->ned_from_frd;
+        return fresh;
+    }
+    /* Both parts were checked when taken: this cannot fail, but never reads as fresh if it does. */
+    return occ_pose_from_ned(f->ned_m, f->ned_from_frd, pose) == OCC_OK && fresh;
 }
 
 uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f)
@@ -323,7 +323,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         return 0;
     }
     f->next_obstacle_us = advance(f->next_obstacle_us, f->cfg.period_us, now_us);
-    occ_yaw_pose_t pose;
+    occ_pose_t pose;
     if (map == NULL || !occ_mav_feed_pose(f, now_us, &pose)) {
         f->counters.stale_skips++;
         return 0;

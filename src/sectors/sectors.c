@@ -31,27 +31,6 @@ typedef struct {
     bool dirty;
 } ctx_t;
 
-occ_yaw_pose_t occ_yaw_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad)
-{
-    occ_yaw_pose_t p;
-    float yaw = 0.5f * PI_F - yaw_ned_rad;
-    if (isfinite(yaw)) {
-        yaw = fmodf(yaw, TWO_PI_F);
-        if (yaw > PI_F) {
-            yaw -= TWO_PI_F;
-        } else if (yaw <= -PI_F) {
-            yaw += TWO_PI_F;
-        }
-    }
-    p.x = east_m;
-    p.y = north_m;
-    p.z = -down_m;
-    p.yaw_rad = yaw;
-    p.roll_rad = 0.0f;
-    p.pitch_rad = 0.0f;
-    return p;
-}
-
 occ_sectors_config_t occ_sectors_config_default(void)
 {
     occ_sectors_config_t c;
@@ -426,10 +405,9 @@ static void fill_unsafe(occ_sectors_t *out, const occ_sectors_config_t *cfg)
  * (from its voxel to the band's lower edge) is the ground it stands on or flies over; the band
  * then starts ground_clearance_m above that voxel's top face. Heights here are "up" metres
  * (z in an ENU map, -z in a NED one). Returns the band's lower edge. O(band / resolution). */
-static float ground_lift(const occ_map_t *map, const occ_yaw_pose_t *pose,
+static float ground_lift(const occ_map_t *map, const occ_vec3_t at,
                          const occ_sectors_config_t *cfg, float up_lo, float up_hi)
 {
-    const occ_vec3_t at = {pose->x, pose->y, pose->z};
     occ_key_t k;
     if (!cfg->ignore_ground || occ_map_key(map, at, &k) != OCC_OK) {
         return up_lo;
@@ -455,7 +433,7 @@ static float ground_lift(const occ_map_t *map, const occ_yaw_pose_t *pose,
     }
 }
 
-occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_yaw_pose_t *pose,
+occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *map_from_body,
                               const occ_sectors_config_t *cfg, occ_sectors_t *out)
 {
     if (out == NULL) {
@@ -464,25 +442,25 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_yaw_pose_t *pose,
     fill_unsafe(out, cfg); /* fail closed: every early return leaves the unsafe answer */
     out->nodes_read = 0;
     out->leaves_used = 0;
-    if (map == NULL || pose == NULL || occ_sectors_config_check(cfg) != OCC_OK ||
-        !isfinite(pose->x) || !isfinite(pose->y) || !isfinite(pose->z) ||
-        !isfinite(pose->yaw_rad)) {
+    if (map == NULL || occ_sectors_config_check(cfg) != OCC_OK ||
+        occ_pose_check(map_from_body) != OCC_OK) {
         return OCC_ERR_ARG;
     }
+    const occ_vec3_t at = map_from_body->p; /* the band is about the vehicle's z */
     const unsigned depth = map->cfg.depth_levels;
     const float res = map->cfg.resolution_m;
     const int32_t half = (int32_t)1 << (depth - 1u);
     const float vol_lo = -(float)half * res;
     const float vol_hi = (float)half * res;
-    if (pose->x < vol_lo || pose->x >= vol_hi || pose->y < vol_lo || pose->y >= vol_hi ||
-        pose->z < vol_lo || pose->z >= vol_hi) {
+    if (at.x < vol_lo || at.x >= vol_hi || at.y < vol_lo || at.y >= vol_hi ||
+        at.z < vol_lo || at.z >= vol_hi) {
         return OCC_ERR_RANGE;
     }
 
     ctx_t c;
-    c.px = pose->x;
-    c.py = pose->y;
-    c.yaw = fmodf(pose->yaw_rad, TWO_PI_F);
+    c.px = at.x;
+    c.py = at.y;
+    c.yaw = occ_pose_yaw(map_from_body); /* roll and pitch do not turn the sectors */
     c.offset = fmodf(cfg->angle_offset_deg * DEG2RAD_F, TWO_PI_F);
     c.inc = cfg->increment_deg * DEG2RAD_F;
     c.inv_inc = 1.0f / c.inc;
@@ -506,12 +484,12 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_yaw_pose_t *pose,
     }
 
     /* The band, its ground side lifted above the ground under the vehicle. */
-    float za = pose->z - (cfg->map_ned ? cfg->band_above_m : cfg->band_below_m);
-    float zb = pose->z + (cfg->map_ned ? cfg->band_below_m : cfg->band_above_m);
+    float za = at.z - (cfg->map_ned ? cfg->band_above_m : cfg->band_below_m);
+    float zb = at.z + (cfg->map_ned ? cfg->band_below_m : cfg->band_above_m);
     if (cfg->map_ned) {
-        zb = -ground_lift(map, pose, cfg, -zb, -za);
+        zb = -ground_lift(map, at, cfg, -zb, -za);
     } else {
-        za = ground_lift(map, pose, cfg, za, zb);
+        za = ground_lift(map, at, cfg, za, zb);
     }
     /* Space outside the map volume is unknown. */
     const float r = c.range;
