@@ -609,6 +609,8 @@ static unsigned order_children(const ctx_t *c, const keybox_t *box, const occ_no
  * it is farther than every sector it spans has already found. */
 static occ_err_t walk(const occ_map_t *map, ctx_t *c, occ_sectors_t *out, const keybox_t *box)
 {
+    const float res = c->res; /* locals: c's address escapes, its fields would be reloaded */
+    const int32_t half = c->half;
     unsigned sp = 1;
     unsigned pops = 0;
     occ_map_node_root(map, &out->stack[0].node);
@@ -621,9 +623,9 @@ static occ_err_t walk(const occ_map_t *map, ctx_t *c, occ_sectors_t *out, const 
         if (it.dmin > c->bound) {
             continue;
         }
-        const float size = c->res * (float)((uint32_t)1 << it.node.level);
-        const float x0 = (float)((int32_t)it.node.key.k[0] - c->half) * c->res;
-        const float y0 = (float)((int32_t)it.node.key.k[1] - c->half) * c->res;
+        const float size = res * (float)((uint32_t)1 << it.node.level);
+        const float x0 = (float)((int32_t)it.node.key.k[0] - half) * res;
+        const float y0 = (float)((int32_t)it.node.key.k[1] - half) * res;
         if (it.dmin > 0.0f && !sectors_open(c, out, x0 - c->px, y0 - c->py, size, it.dmin)) {
             continue;
         }
