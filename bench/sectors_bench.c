@@ -27,6 +27,17 @@ static int cmp_d(const void *a, const void *b)
     return x < y ? -1 : (x > y ? 1 : 0);
 }
 
+/* Pose n of the walk: level, heading 0.37 n rad (map ENU). */
+static occ_pose_t bench_pose(float x, float y, float z, int n)
+{
+    occ_pose_t p;
+    p.p.x = x;
+    p.p.y = y;
+    p.p.z = z;
+    p.q = occ_quat_from_euler(0.0f, 0.0f, (float)n * 0.37f);
+    return p;
+}
+
 #define MAXP 256
 static occ_sectors_t out;
 
@@ -36,7 +47,7 @@ static void run(const char *name, const occ_map_t *map, const occ_sectors_config
     static double nodes[MAXP];
     int n = 0;
     for (float x = -5.0f; x <= 26.0f && n < MAXP; x += 0.25f, n++) {
-        occ_yaw_pose_t p = {x, (n & 1) ? -0.1f : -0.5f, z, (float)n * 0.37f, 0.0f, 0.0f};
+        const occ_pose_t p = bench_pose(x, (n & 1) ? -0.1f : -0.5f, z, n);
         double best = 1e30;
         for (int r = 0; r < 7; r++) {
             const double a = now_us();
@@ -109,7 +120,7 @@ int main(int argc, char **argv)
     if (cg) {
         int n = 0;
         for (float x = -5.0f; x <= 26.0f; x += 0.25f, n++) {
-            occ_yaw_pose_t p = {x, (n & 1) ? -0.1f : -0.5f, 1.0f, (float)n * 0.37f, 0.0f, 0.0f};
+            const occ_pose_t p = bench_pose(x, (n & 1) ? -0.1f : -0.5f, 1.0f, n);
             (void)occ_sectors_compute(&map, &p, &def, &out);
         }
         printf("callgrind: %d updates\n", n);

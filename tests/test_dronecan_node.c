@@ -337,7 +337,10 @@ static void test_poll_map(void **state)
     sc.band_below_m = 0.04f;
     sc.band_above_m = 0.04f;
     /* Heading east (NED yaw 90): the wall is to the left, body yaw -90. */
-    const occ_yaw_pose_t pose = occ_yaw_pose_from_ned(0.0f, 0.0f, -0.05f, 1.57079633f);
+    occ_pose_t pose;
+    const occ_vec3_t up5cm = {0.0f, 0.0f, -0.05f};
+    assert_int_equal(occ_pose_from_ned(up5cm, occ_quat_from_euler(0.0f, 0.0f, 1.57079633f), &pose),
+                     OCC_OK);
     const uint64_t t0 = 10000000u;
     assert_int_equal(occ_dronecan_poll_map(&node, t0, &map, t0, &pose, t0, &sc), OCC_OK);
     const size_t n_prox = (cap.n - 1u) / 2u; /* + one NodeStatus */
@@ -371,7 +374,9 @@ static void test_poll_map(void **state)
     /* The vehicle off the map: the sector error comes back, the node still says NO_DATA and its
      * NodeStatus goes out on time. */
     cap.n = 0;
-    const occ_yaw_pose_t far = occ_yaw_pose_from_ned(1e7f, 0.0f, 0.0f, 0.0f);
+    occ_pose_t far;
+    const occ_vec3_t far_ned = {1e7f, 0.0f, 0.0f};
+    assert_int_equal(occ_pose_from_ned(far_ned, occ_quat_identity(), &far), OCC_OK);
     assert_int_equal(occ_dronecan_poll_map(&node, t0 + 1000000u, &map, t0 + 1000000u, &far,
                                            t0 + 1000000u, &sc), OCC_ERR_RANGE);
     assert_int_equal(cap.n, 3);

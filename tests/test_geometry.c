@@ -248,7 +248,7 @@ static void check_sectors(const where_t *w, occ_key_t k)
 {
     const float res = w->res;
     const float dx = w->p.x > 0.0f ? -2.5f * res : 2.5f * res;
-    const occ_yaw_pose_t pose = {w->p.x + dx, w->p.y, w->p.z, 0.0f, 0.0f, 0.0f};
+    const occ_pose_t pose = {{w->p.x + dx, w->p.y, w->p.z}, {1.0f, 0.0f, 0.0f, 0.0f}};
     const occ_sectors_config_t cfg = occ_sectors_config_default();
     CHECK(occ_sectors_compute(&map, &pose, &cfg, &sectors) == OCC_OK, w, "occ_sectors_compute");
     float best = OCC_SECTORS_FAR;
@@ -257,8 +257,8 @@ static void check_sectors(const where_t *w, occ_key_t k)
     }
     const occ_vec3_t c = occ_map_key_center(&map, k, 0u);
     const double half = 0.5 * (double)res;
-    const double gx = fmax(fabs((double)pose.x - (double)c.x) - half, 0.0);
-    const double gy = fmax(fabs((double)pose.y - (double)c.y) - half, 0.0);
+    const double gx = fmax(fabs((double)pose.p.x - (double)c.x) - half, 0.0);
+    const double gy = fmax(fabs((double)pose.p.y - (double)c.y) - half, 0.0);
     const double want = sqrt(gx * gx + gy * gy);
     CHECK(fabs((double)best - want) < 1e-3 * (double)res, w,
           "sectors: nearest obstacle is not p's voxel box");

@@ -156,7 +156,9 @@ static void test_feed(void **state)
     assert_int_equal(s.last.distances[40], 2001); /* observed free behind: max + 1 */
     /* The same numbers as occ_sectors_compute for the same pose. */
     static occ_sectors_t ref;
-    occ_yaw_pose_t pose = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, 0.0f);
+    occ_pose_t pose;
+    const occ_vec3_t origin = {0.0f, 0.0f, 0.0f};
+    assert_int_equal(occ_pose_from_ned(origin, occ_quat_identity(), &pose), OCC_OK); /* north */
     assert_int_equal(occ_sectors_compute(&map, &pose, &cfg.sectors, &ref), OCC_OK);
     assert_memory_equal(ref.distance_cm, s.last.distances, 72 * sizeof(uint16_t));
     /* Facing east (NED yaw +90 deg): the wall is on the left, body 270 deg = element 58. */
@@ -203,9 +205,9 @@ static void test_feed(void **state)
     assert_int_equal(s.obst, ob2 + 1);
     assert_int_equal(s.last.distances[58], 150);
     /* The ODOMETRY pose in the map frame: NED heading east = ENU yaw 0. */
-    occ_yaw_pose_t pz;
+    occ_pose_t pz;
     assert_true(occ_mav_feed_pose(&feed, t, &pz));
-    assert_true(fabsf(pz.yaw_rad) < 1e-5f);
+    assert_true(fabsf(occ_pose_yaw(&pz)) < 1e-5f);
     /* PX4 needs all 72 elements covered. */
     occ_mav_feed_config_t c2 = cfg;
     c2.autopilot = OCC_AUTOPILOT_PX4;

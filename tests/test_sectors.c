@@ -22,6 +22,29 @@ static occ_map_t map;
 static occ_sectors_t sect; /* large: static */
 static unsigned seed;
 
+/* The vehicle level at (x, y, z) with heading yaw (map frame): the pose the sectors take. */
+static occ_pose_t at_yaw(float x, float y, float z, float yaw)
+{
+    occ_pose_t p;
+    p.p.x = x;
+    p.p.y = y;
+    p.p.z = z;
+    p.q = occ_quat_from_euler(0.0f, 0.0f, yaw);
+    return p;
+}
+
+static void set_yaw(occ_pose_t *p, float yaw)
+{
+    p->q = occ_quat_from_euler(0.0f, 0.0f, yaw);
+}
+
+/* The heading of the body x axis, in double for the reference (ZYX yaw). */
+static double yaw_of(const occ_pose_t *p)
+{
+    const double w = p->q.w, x = p->q.x, y = p->q.y, z = p->q.z;
+    return atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -160,7 +183,7 @@ typedef struct {
 
 /* The ground rule of occ_sectors.h, in double: the first occupied voxel down the vehicle's column
  * (from its own voxel while the voxel reaches above za) lifts za to its top + clearance. */
-static double ref_band_lo(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg, double za,
+static double ref_band_lo(const occ_pose_t *p, const occ_sectors_config_t *cfg, double za,
                           double zb)
 {
     if (!cfg->ignore_ground) {
@@ -168,9 +191,9 @@ static double ref_band_lo(const occ_yaw_pose_t *p, const occ_sectors_config_t *c
     }
     const double res = map.cfg.resolution_m;
     const int64_t half = (int64_t)1 << (map.cfg.depth_levels - 1);
-    const int64_t kx = (int64_t)floor((double)p->x / res) + half;
-    const int64_t ky = (int64_t)floor((double)p->y / res) + half;
-    for (int64_t kz = (int64_t)floor((double)p->z / res) + half; kz >= 0; kz--) {
+    const int64_t kx = (int64_t)floor((double)p->p.x / res) + half;
+    const int64_t ky = (int64_t)floor((double)p->p.y / res) + half;
+    for (int64_t kz = (int64_t)floor((double)p->p.z / res) + half; kz >= 0; kz--) {
         const double top = (double)(kz - half + 1) * res;
         if (!(top > za)) {
             break;
@@ -186,12 +209,12 @@ static double ref_band_lo(const occ_yaw_pose_t *p, const occ_sectors_config_t *c
     return za;
 }
 
-static void reference(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg, ref_t *r)
+static void reference(const occ_pose_t *p, const occ_sectors_config_t *cfg, ref_t *r)
 {
     const double res = map.cfg.resolution_m;
     const int64_t half = (int64_t)1 << (map.cfg.depth_levels - 1);
     const double R = cfg->max_distance_cm * 0.01;
-    const double px = p->x, py = p->y, pz = p->z, yaw = p->yaw_rad;
+    const double px = p->p.x, py = p->p.y, pz = p->p.z, yaw = yaw_of(p);
     const double zb = pz + (double)cfg->band_above_m;
     const double za = ref_band_lo(p, cfg, pz - (double)cfg->band_below_m, zb);
     const double inc = (double)cfg->increment_deg * M_PI / 180.0;
@@ -240,7 +263,7 @@ static void reference(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg, 
 
 /* Compare with 1 cm of slack for float vs double; a kind may differ only on a (near) tie or at
  * the edge of the search radius. Returns the number of mismatching sectors. */
-static unsigned compare(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg, const char *what)
+static unsigned compare(const occ_pose_t *p, const occ_sectors_config_t *cfg, const char *what)
 {
     static ref_t r;
     reference(p, cfg, &r);
@@ -261,7 +284,7 @@ static unsigned compare(const occ_yaw_pose_t *p, const occ_sectors_config_t *cfg
             fprintf(stderr,
                     "%s seed %u: pose (%.3f %.3f %.3f yaw %.4f) n %u inc %.2f off %.2f: sector %u "
                     "got %d want %d (ref occ %.4f unk %.4f; got occ %.4f unk %.4f)\n",
-                    what, seed, (double)p->x, (double)p->y, (double)p->z, (double)p->yaw_rad,
+                    what, seed, (double)p->p.x, (double)p->p.y, (double)p->p.z, yaw_of(p),
                     cfg->n_sectors, (double)cfg->increment_deg, (double)cfg->angle_offset_deg, s,
                     a, b, r.d_occ[s], r.d_unk[s], (double)sect.d_occ_m[s],
                     (double)sect.d_unk_m[s]);
@@ -352,12 +375,11 @@ static void test_random_maps(void **state)
     for (int m = 0; m < 6; m++) {
         random_map();
         for (int i = 0; i < 8; i++) {
-            occ_yaw_pose_t p;
-            memset(&p, 0, sizeof p);
-            p.x = (float)(urand() * 5.0 - 2.5);
-            p.y = (float)(urand() * 5.0 - 2.5);
-            p.z = (float)(urand() * 1.0 - 0.5);
-            p.yaw_rad = (float)(urand() * 4.0 * M_PI - 2.0 * M_PI);
+            occ_pose_t p = occ_pose_identity();
+            p.p.x = (float)(urand() * 5.0 - 2.5);
+            p.p.y = (float)(urand() * 5.0 - 2.5);
+            p.p.z = (float)(urand() * 1.0 - 0.5);
+            set_yaw(&p, (float)(urand() * 4.0 * M_PI - 2.0 * M_PI));
             occ_sectors_config_t cfg;
             random_config(&cfg);
             bad += compare(&p, &cfg, "random");
@@ -376,10 +398,10 @@ static void test_yaw_wrap(void **state)
     static occ_sectors_t a;
     const float yaws[] = {(float)M_PI, (float)-M_PI, 0.0f, 3.0f, -3.1f, 6.2f};
     for (unsigned i = 0; i < sizeof yaws / sizeof yaws[0]; i++) {
-        occ_yaw_pose_t p = {0.33f, -0.71f, 0.05f, yaws[i], 0.0f, 0.0f};
+        occ_pose_t p = at_yaw(0.33f, -0.71f, 0.05f, yaws[i]);
         assert_int_equal(compare(&p, &cfg, "yaw"), 0);
         memcpy(&a, &sect, sizeof a);
-        p.yaw_rad = yaws[i] + 2.0f * (float)M_PI;
+        set_yaw(&p, yaws[i] + 2.0f * (float)M_PI);
         assert_int_equal(compare(&p, &cfg, "yaw+2pi"), 0);
         for (unsigned s = 0; s < cfg.n_sectors; s++) {
             assert_true(abs((int)a.distance_cm[s] - (int)sect.distance_cm[s]) <= 1);
@@ -406,7 +428,7 @@ static void test_behind_180(void **state)
     }
     occ_sectors_config_t cfg = occ_sectors_config_default();
     cfg.max_distance_cm = 250;
-    occ_yaw_pose_t p = {0.05f, 0.05f, 0.0f, 0.0f, 0.0f, 0.0f}; /* facing east: wall behind */
+    occ_pose_t p = at_yaw(0.05f, 0.05f, 0.0f, 0.0f); /* facing east: wall behind */
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     /* Nearest wall point (-0.9, 0.05): 0.95 m. */
     assert_int_equal(sect.distance_cm[36], 95);
@@ -414,15 +436,15 @@ static void test_behind_180(void **state)
     assert_int_equal(sect.distance_cm[18], 251);  /* right (south) */
     assert_int_equal(compare(&p, &cfg, "behind"), 0);
     /* Facing west (yaw pi): the wall is ahead, sector 0; yaw -pi the same. */
-    p.yaw_rad = (float)M_PI;
+    set_yaw(&p, (float)M_PI);
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sect.distance_cm[0], 95);
     assert_int_equal(sect.distance_cm[36], 251);
-    p.yaw_rad = -(float)M_PI;
+    set_yaw(&p, -(float)M_PI);
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sect.distance_cm[0], 95);
     /* Facing north (yaw pi/2): the wall is on the left, body 270 deg = sector 54. */
-    p.yaw_rad = (float)(M_PI / 2.0);
+    set_yaw(&p, (float)(M_PI / 2.0));
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sect.distance_cm[54], 95);
     assert_int_equal(compare(&p, &cfg, "left"), 0);
@@ -432,7 +454,7 @@ static void test_unknown_space(void **state)
 {
     (void)state;
     occ_sectors_config_t cfg = occ_sectors_config_default();
-    occ_yaw_pose_t p = {1.0f, 2.0f, 0.3f, 0.4f, 0.0f, 0.0f};
+    occ_pose_t p = at_yaw(1.0f, 2.0f, 0.3f, 0.4f);
     /* Empty map: the vehicle stands in unknown space. */
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     for (unsigned s = 0; s < 72; s++) {
@@ -449,7 +471,7 @@ static void test_unknown_space(void **state)
     key_at(0.05, 0.05, 0.05, &k);
     assert_int_equal(occ_map_forget_key(&map, k, 4), OCC_OK);
     assert_int_equal(occ_map_set_key(&map, k, 0, -1.0f), OCC_OK);
-    occ_yaw_pose_t q = {0.05f, 0.05f, 0.05f, 1.0f, 0.0f, 0.0f};
+    occ_pose_t q = at_yaw(0.05f, 0.05f, 0.05f, 1.0f);
     cfg.unknown_as_distance = false;
     assert_int_equal(compare(&q, &cfg, "bubble"), 0);
     cfg.unknown_as_distance = true;
@@ -471,23 +493,22 @@ static void test_map_edges(void **state)
     cfg.max_distance_cm = 300;
     cfg.unknown_as_distance = true;
     cfg.band_below_m = cfg.band_above_m = 0.3f;
-    occ_yaw_pose_t p = {1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    occ_pose_t p = at_yaw(1.0f, 0.0f, 0.0f, 0.0f);
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sect.distance_cm[0], 60);   /* volume edge 0.6 m ahead */
     assert_int_equal(sect.distance_cm[36], 260); /* 2.6 m behind */
     assert_int_equal(compare(&p, &cfg, "edge"), 0);
     for (int i = 0; i < 20; i++) {
-        occ_yaw_pose_t q;
-        memset(&q, 0, sizeof q);
-        q.x = (float)(urand() * 3.1 - 1.55);
-        q.y = (float)(urand() * 3.1 - 1.55);
-        q.z = (float)(urand() * 3.0 - 1.5);
-        q.yaw_rad = (float)(urand() * 7.0 - 3.5);
+        occ_pose_t q = occ_pose_identity();
+        q.p.x = (float)(urand() * 3.1 - 1.55);
+        q.p.y = (float)(urand() * 3.1 - 1.55);
+        q.p.z = (float)(urand() * 3.0 - 1.5);
+        set_yaw(&q, (float)(urand() * 7.0 - 3.5));
         occ_sectors_config_t c2;
         random_config(&c2);
         assert_int_equal(compare(&q, &c2, "edges-random"), 0);
     }
-    occ_yaw_pose_t out = {1.7f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    occ_pose_t out = at_yaw(1.7f, 0.0f, 0.0f, 0.0f);
     assert_int_equal(occ_sectors_compute(&map, &out, &cfg, &sect), OCC_ERR_RANGE);
     assert_int_equal(sect.n, 0);
     occ_map_clear(&map);
@@ -520,20 +541,20 @@ static void test_ned_mirror(void **state)
                              OCC_OK);
         }
         for (int i = 0; i < 6; i++) {
-            occ_yaw_pose_t p;
-            memset(&p, 0, sizeof p);
-            p.x = (float)(urand() * 5.0 - 2.5);
-            p.y = (float)(urand() * 5.0 - 2.5);
-            p.z = (float)(urand() * 1.0 - 0.5);
-            p.yaw_rad = (float)(urand() * 6.0 - 3.0);
+            occ_pose_t p = occ_pose_identity();
+            p.p.x = (float)(urand() * 5.0 - 2.5);
+            p.p.y = (float)(urand() * 5.0 - 2.5);
+            p.p.z = (float)(urand() * 1.0 - 0.5);
+            const float yaw = (float)(urand() * 6.0 - 3.0);
+            set_yaw(&p, yaw);
             occ_sectors_config_t sc;
             random_config(&sc);
             assert_int_equal(occ_sectors_compute(&map, &p, &sc, &a), OCC_OK);
-            occ_yaw_pose_t q = p;
-            q.x = p.y;
-            q.y = p.x;
-            q.z = -p.z;
-            q.yaw_rad = (float)(M_PI / 2.0) - p.yaw_rad;
+            occ_pose_t q = p;
+            q.p.x = p.p.y;
+            q.p.y = p.p.x;
+            q.p.z = -p.p.z;
+            set_yaw(&q, (float)(M_PI / 2.0) - yaw); /* NED <- FRD: heading from north */
             sc.map_ned = true;
             assert_int_equal(occ_sectors_compute(&ned, &q, &sc, &sect), OCC_OK);
             for (unsigned s = 0; s < sc.n_sectors; s++) {
@@ -590,22 +611,22 @@ static void test_floor_standing(void **state)
     floor_room();
     occ_sectors_config_t cfg = occ_sectors_config_default();
     cfg.max_distance_cm = 300; /* the free room reaches 3.15 m */
-    occ_yaw_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f}; /* 5 cm above the floor, facing east */
+    occ_pose_t p = at_yaw(0.05f, 0.05f, 0.05f, 0.0f); /* 5 cm above the floor, facing east */
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_int_equal(sectors_below(61), 0);
     assert_int_equal(sect.distance_cm[0], 195);   /* the wall ahead */
     assert_int_equal(sect.distance_cm[36], 301);  /* behind: free (floor ignored) */
     assert_int_equal(compare(&p, &cfg, "floor-standing"), 0);
     /* Flying over it at 0.3 m and at 1.2 m: the same. */
-    p.z = 0.3f;
+    p.p.z = 0.3f;
     assert_int_equal(compare(&p, &cfg, "floor-0.3"), 0);
     assert_int_equal(sectors_below(61), 0);
-    p.z = 1.2f;
+    p.p.z = 1.2f;
     assert_int_equal(compare(&p, &cfg, "floor-1.2"), 0);
     assert_int_equal(sectors_below(61), 0);
     /* The old band: the floor is an obstacle at 0 m in every sector (min_distance). */
     cfg.ignore_ground = false;
-    p.z = 0.05f;
+    p.p.z = 0.05f;
     assert_int_equal(compare(&p, &cfg, "floor-kept"), 0);
     assert_int_equal(sectors_below(21), 72);
     /* A box on the floor (z 0..0.3) taller than the clearance is an obstacle (west, 1.05 m). */
@@ -637,7 +658,7 @@ static void test_band_below_above(void **state)
     }
     occ_sectors_config_t cfg = occ_sectors_config_default();
     cfg.max_distance_cm = 300; /* the free room reaches 3.15 m */
-    occ_yaw_pose_t p = {0.05f, 0.05f, 0.6f, (float)(M_PI / 2.0), 0.0f, 0.0f}; /* facing north */
+    occ_pose_t p = at_yaw(0.05f, 0.05f, 0.6f, (float)(M_PI / 2.0)); /* facing north */
     cfg.band_below_m = 0.2f;
     cfg.band_above_m = 0.1f; /* [0.4, 0.7): neither */
     assert_int_equal(compare(&p, &cfg, "band-none"), 0);
@@ -670,7 +691,7 @@ static void test_fail_closed(void **state)
     (void)state;
     floor_room();
     occ_sectors_config_t cfg = occ_sectors_config_default();
-    occ_yaw_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f};
+    occ_pose_t p = at_yaw(0.05f, 0.05f, 0.05f, 0.0f);
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_OK);
     assert_true(sect.distance_cm[36] > cfg.min_distance_cm);
     assert_int_equal(occ_sectors_compute(NULL, &p, &cfg, &sect), OCC_ERR_ARG);
@@ -685,16 +706,16 @@ static void test_fail_closed(void **state)
     bad.min_distance_cm = 35;
     assert_int_equal(occ_sectors_compute(&map, &p, &bad, &sect), OCC_ERR_ARG);
     assert_unsafe(35);
-    p.yaw_rad = NAN;
+    set_yaw(&p, NAN);
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_ERR_ARG);
     assert_unsafe(cfg.min_distance_cm);
-    p.yaw_rad = 0.0f;
-    p.x = 1e7f;
+    set_yaw(&p, 0.0f);
+    p.p.x = 1e7f;
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_ERR_RANGE);
     assert_unsafe(cfg.min_distance_cm);
     bad = cfg;
     bad.ground_clearance_m = -0.1f;
-    p.x = 0.05f;
+    p.p.x = 0.05f;
     assert_int_equal(occ_sectors_compute(&map, &p, &bad, &sect), OCC_ERR_ARG);
     bad.ground_clearance_m = NAN;
     assert_int_equal(occ_sectors_config_check(&bad), OCC_ERR_ARG);
@@ -709,7 +730,7 @@ static void test_args(void **state)
 {
     (void)state;
     occ_sectors_config_t cfg = occ_sectors_config_default();
-    occ_yaw_pose_t p = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    occ_pose_t p = at_yaw(0.0f, 0.0f, 0.0f, 0.0f);
     assert_int_equal(occ_sectors_config_check(&cfg), OCC_OK);
     assert_int_equal(occ_sectors_compute(NULL, &p, &cfg, &sect), OCC_ERR_ARG);
     assert_int_equal(occ_sectors_compute(&map, NULL, &cfg, &sect), OCC_ERR_ARG);
@@ -743,30 +764,13 @@ static void test_args(void **state)
     c = cfg;
     c.angle_offset_deg = NAN;
     assert_int_equal(occ_sectors_config_check(&c), OCC_ERR_ARG);
-    p.yaw_rad = NAN;
+    set_yaw(&p, NAN);
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_ERR_ARG);
-    p.yaw_rad = 0.0f;
-    p.x = INFINITY;
+    set_yaw(&p, 0.0f);
+    p.p.x = INFINITY;
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_ERR_ARG);
-    p.x = 1e7f;
+    p.p.x = 1e7f;
     assert_int_equal(occ_sectors_compute(&map, &p, &cfg, &sect), OCC_ERR_RANGE);
-}
-
-static void test_pose_from_ned(void **state)
-{
-    (void)state;
-    /* North 2, east 3, down -1.5 (1.5 m up), heading east (90 deg): map yaw 0. */
-    occ_yaw_pose_t p = occ_yaw_pose_from_ned(2.0f, 3.0f, -1.5f, (float)(M_PI / 2.0));
-    assert_true(fabsf(p.x - 3.0f) < 1e-6f && fabsf(p.y - 2.0f) < 1e-6f);
-    assert_true(fabsf(p.z - 1.5f) < 1e-6f && fabsf(p.yaw_rad) < 1e-6f);
-    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, 0.0f); /* north: +y, map yaw +90 deg */
-    assert_true(fabsf(p.yaw_rad - (float)(M_PI / 2.0)) < 1e-6f);
-    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, (float)M_PI); /* south: -90 deg */
-    assert_true(fabsf(p.yaw_rad + (float)(M_PI / 2.0)) < 1e-6f);
-    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, -(float)(M_PI / 2.0)); /* west: 180 deg */
-    assert_true(fabsf(fabsf(p.yaw_rad) - (float)M_PI) < 1e-5f);
-    p = occ_yaw_pose_from_ned(0.0f, 0.0f, 0.0f, 20.0f);
-    assert_true(p.yaw_rad > -(float)M_PI - 1e-6f && p.yaw_rad <= (float)M_PI + 1e-6f);
 }
 
 int main(void)
@@ -777,7 +781,6 @@ int main(void)
     srand(seed);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_args, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_pose_from_ned, setup, teardown),
         cmocka_unit_test_setup_teardown(test_behind_180, setup, teardown),
         cmocka_unit_test_setup_teardown(test_unknown_space, setup, teardown),
         cmocka_unit_test_setup_teardown(test_yaw_wrap, setup, teardown),

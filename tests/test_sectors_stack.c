@@ -22,7 +22,7 @@ static void test_stack_full(void **state)
     mc.resolution_m = 0.1f;
     assert_int_equal(occ_map_init(&map, &mc, arena, sizeof arena), OCC_OK);
     occ_sectors_config_t cfg = occ_sectors_config_default();
-    const occ_yaw_pose_t p = {0.05f, 0.05f, 0.05f, 0.0f, 0.0f, 0.0f};
+    const occ_pose_t p = {{0.05f, 0.05f, 0.05f}, {1.0f, 0.0f, 0.0f, 0.0f}}; /* facing east */
     /* One uniform free root: one node read, the limit is never reached. */
     const occ_key_t root = {{0, 0, 0}};
     assert_int_equal(occ_map_set_key(&map, root, mc.depth_levels, -2.0f), OCC_OK);

@@ -97,8 +97,10 @@ static int sectors_config(const can_opts_t *o, const feed_args_t *fa, occ_sector
     return 0;
 }
 
-/* --pose (NED metres, yaw degrees from north) in the map's frame. */
-static occ_yaw_pose_t fixed_pose(const can_opts_t *o, const bool map_ned)
+/* --pose (NED metres, yaw degrees from north, level) in the map's frame: map(ENU) <- body(FLU),
+ * or with a NED map the NED <- FRD pose itself. A bad --pose leaves a zero quaternion, which
+ * the sectors refuse (fail closed). */
+static occ_pose_t fixed_pose(const can_opts_t *o, const bool map_ned)
 {
     const float deg = 3.14159265358979f / 180.0f;
     const float *const v = o->pose_v;
@@ -107,13 +109,14 @@ static occ_yaw_pose_t fixed_pose(const can_opts_t *o, const bool map_ned)
     if (!o->have_pose) {
         return pose;
     }
+    const occ_vec3_t ned = {v[0], v[1], v[2]};
+    const occ_quat_t heading = occ_quat_from_euler(0.0f, 0.0f, v[3] * deg);
     if (!map_ned) {
-        return occ_yaw_pose_from_ned(v[0], v[1], v[2], v[3] * deg);
+        (void)occ_pose_from_ned(ned, heading, &pose);
+        return pose;
     }
-    pose.x = v[0];
-    pose.y = v[1];
-    pose.z = v[2];
-    pose.yaw_rad = v[3] * deg;
+    pose.p = ned;
+    pose.q = heading;
     return pose;
 }
 

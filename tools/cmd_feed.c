@@ -232,11 +232,11 @@ static void log_autopilot(const occ_mav_feed_t *feed, bool *named, uint32_t *ref
 /* --verbose, once a second: the pose and the counters. */
 static void log_progress(const occ_mav_feed_t *feed, const uint64_t now, const uint64_t t0)
 {
-    occ_yaw_pose_t p;
+    occ_pose_t p = occ_pose_identity();
     const bool fresh = occ_mav_feed_pose(feed, now, &p);
     fprintf(stderr, "feed: t=%.1fs pose %s (%.2f %.2f %.2f yaw %.1f deg) tx %u obstacle %u hb"
             ", rx ok %u bad %u\n", (double)(now - t0) * 1e-6, fresh ? "fresh" : "stale",
-            (double)p.x, (double)p.y, (double)p.z, (double)p.yaw_rad * 57.29578,
+            (double)p.p.x, (double)p.p.y, (double)p.p.z, (double)occ_pose_yaw(&p) * 57.29578,
             feed->counters.obstacle_tx, feed->counters.heartbeat_tx,
             feed->parser.counters.frames_ok,
             feed->parser.counters.bad_crc + feed->parser.counters.bad_len);

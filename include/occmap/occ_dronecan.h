@@ -273,7 +273,9 @@ occ_err_t occ_dronecan_publish_status(occ_dronecan_node_t *node, uint64_t now_us
 occ_err_t occ_dronecan_ingest(occ_dronecan_node_t *node, const occ_can_frame_t *frame,
                               uint64_t now_us);
 
-/* Poll straight from a map (dronecan_map.c): `map` NULL = no map; the data is fresh when both
+/* Poll straight from a map (dronecan_map.c): `map` NULL = no map; `pose` is the vehicle's
+ * map_from_body as occ_sectors_compute() reads it (ENU <- FLU, or NED <- FRD with
+ * sectors_cfg->map_ned; NULL = no pose); the data is fresh when both
  * stamps are within cfg.stale_after_us of now_us (a stamp ahead of now_us counts as fresh).
  * When a Proximity publication is due and the data is fresh, sectors are computed with
  * occ_sectors_compute() into node->sectors (only then; node->sectors is ~5 KB of scratch, so
@@ -281,7 +283,7 @@ occ_err_t occ_dronecan_ingest(occ_dronecan_node_t *node, const occ_can_frame_t *
  * outside the map), the node still publishes - a NO_DATA reading and NodeStatus - and the
  * sector error is returned. Otherwise errors as occ_dronecan_poll. */
 occ_err_t occ_dronecan_poll_map(occ_dronecan_node_t *node, uint64_t now_us, const occ_map_t *map,
-                                uint64_t map_stamp_us, const occ_yaw_pose_t *pose,
+                                uint64_t map_stamp_us, const occ_pose_t *pose,
                                 uint64_t pose_stamp_us, const occ_sectors_config_t *sectors_cfg);
 
 #ifdef __cplusplus

@@ -233,7 +233,8 @@ occ_err_t occ_mav_decode_obstacle_distance(const occ_mav_frame_t *f, occ_mav_obs
 occ_err_t occ_mav_decode_command_long(const occ_mav_frame_t *f, occ_mav_command_long_t *out);
 occ_err_t occ_mav_decode_command_ack(const occ_mav_frame_t *f, occ_mav_command_ack_t *out);
 
-/* Yaw (rad, NED heading) of a w,x,y,z quaternion; roll and pitch (may be NULL). */
+/* Yaw (rad, NED heading) of a w,x,y,z quaternion; roll and pitch (may be NULL): the ZYX Euler
+ * angles of occ_quat_to_euler() (occ_pose.h), for a quaternion in a MAVLink float[4]. */
 float occ_mav_quat_yaw(const float q[4], float *roll, float *pitch);
 
 /* ---- The feed (src/feed/mavlink_feed.c) --------------------------------------------------------- */
@@ -284,7 +285,8 @@ typedef struct {
     uint8_t request_mask;            /* streams still to ask for in this round: 1 pos, 2 att */
     uint64_t pos_us, att_us;         /* receive times */
     uint64_t next_request_us;
-    float north, east, down, yaw_ned, roll, pitch;
+    occ_vec3_t ned_m;                /* last position, local NED metres */
+    occ_quat_t ned_from_frd;         /* last attitude, body FRD -> local NED (unit) */
     uint64_t next_obstacle_us, next_heartbeat_us;
     occ_sectors_t sectors;           /* last result + scratch */
 } occ_mav_feed_t;
@@ -313,8 +315,11 @@ void occ_mav_feed_rx(occ_mav_feed_t *f, const uint8_t *data, size_t n, uint64_t 
 size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_us, uint8_t *out,
                          size_t cap);
 
-/* The current pose in the map frame, true if fresh at now_us. */
-bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_yaw_pose_t *pose);
+/* The current pose in the map frame, true if fresh at now_us: map(ENU) <- body(FLU) by
+ * occ_pose_from_ned() for an ENU map, the autopilot's own NED position and NED <- FRD attitude
+ * for map_frame NED (what occ_sectors_compute() reads with cfg.map_ned). *pose is written
+ * whenever a position and an attitude have been received (may be NULL). */
+bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose);
 
 /* The next time poll() may have something to send (for a sleeping loop). */
 uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f);

@@ -36,15 +36,19 @@ typedef struct {
 occ_quat_t occ_quat_identity(void);
 occ_pose_t occ_pose_identity(void);
 
-/* Rotation about a unit axis by angle_rad (right hand). axis need not be unit: it is
- * normalised; a zero or non-finite axis or angle gives OCC_ERR_ARG and *out untouched. */
+/* Rotation about an axis by angle_rad (right hand). axis need not be unit: it is normalised.
+ * A zero or non-finite axis, a non-finite angle or a NULL out gives OCC_ERR_ARG and *out
+ * untouched (angle 0 is the identity). */
 occ_err_t occ_quat_from_axis_angle(occ_vec3_t axis, float angle_rad, occ_quat_t *out);
 
 /* Euler angles as autopilots send them (MAVLink ATTITUDE): the rotation is yaw about z, then
  * pitch about the new y, then roll about the new x (R = Rz(yaw) Ry(pitch) Rx(roll)). Always a
  * unit quaternion for finite input; NaN in, NaN out (occ_pose_check() refuses it). */
 occ_quat_t occ_quat_from_euler(float roll_rad, float pitch_rad, float yaw_rad);
-/* The inverse: roll, pitch in [-pi/2, pi/2], yaw in (-pi, pi]. Any output may be NULL. */
+/* The inverse: roll and yaw in (-pi, pi], pitch in [-pi/2, pi/2]. Any output may be NULL.
+ * Pitched straight up or down (cos pitch < 1e-3, within ~0.06 deg of +-90) roll and yaw turn
+ * about the same axis: roll is then 0 and yaw carries yaw - roll (pitch +90) or yaw + roll
+ * (pitch -90), so from_euler(to_euler(q)) is still q's rotation (within ~1e-3 rad). */
 void occ_quat_to_euler(occ_quat_t q, float *roll_rad, float *pitch_rad, float *yaw_rad);
 
 /* q / |q|. OCC_ERR_ARG (*out untouched) when q has NaN/Inf or |q| < 1e-6. */

@@ -1,19 +1,27 @@
 /*
- * occ_sectors.h - what the vehicle is told: the nearest obstacle per horizontal sector (src/feed/sectors.c).
+ * occ_sectors.h - what the vehicle is told: the nearest obstacle per horizontal sector (src/sectors/sectors.c).
  * Pure C99, no OS, no heap; uses the public map API only.
  *
- * Frames
- *  - The map frame is ENU: x east, y north, z up (OctoMap's data), unless cfg.map_ned is set:
- *    then the map is NED (x north, y east, z down; occmap feed --map-frame ned), the pose is
- *    given in it (x north, y east, z down, yaw_rad = NED heading, clockwise from +x), and the
- *    band's "above" side is -z.
- *  - An autopilot's NED pose converts as map x = NED y (east), map y = NED x (north),
- *    map z = -NED z, yaw_map = pi/2 - yaw_ned (occ_yaw_pose_from_ned).
- *  - Sectors are in the vehicle's heading frame, MAV_FRAME_BODY_FRD seen from above: body angle 0
- *    is forward, angles grow clockwise. Sector i is centred on body angle
- *    angle_offset_deg + i * increment_deg and covers [centre - inc/2, centre + inc/2).
- *    Roll and pitch are accepted but not used: sectors are horizontal slices (ArduPilot files
- *    OBSTACLE_DISTANCE in its 0-degree pitch layer, PX4 in its horizontal bins).
+ * Frames (the pose is the library's one pose type, occ_pose.h)
+ *  - ENU map (default): x east, y north, z up (OctoMap's data); the pose is map_from_body with
+ *    the body FLU (x forward, y left, z up). From an autopilot: occ_pose_from_ned(
+ *    LOCAL_POSITION_NED x y z, ATTITUDE_QUATERNION or occ_quat_from_euler(ATTITUDE roll, pitch,
+ *    yaw)).
+ *  - NED map (cfg.map_ned; occmap feed --map-frame ned): the map is x north, y east, z down and
+ *    the pose is read as map(NED) <- body(FRD): p = (north, east, down) as LOCAL_POSITION_NED
+ *    sends it, q the autopilot's attitude as it sends it (ATTITUDE_QUATERNION q1..q4, or
+ *    occ_quat_from_euler(ATTITUDE roll, pitch, yaw)); occ_pose_to_ned() of an ENU pose gives
+ *    the same. The band's "above" side is then -z.
+ *  - The heading is occ_pose_yaw(pose): the body x axis's direction seen from above (ENU:
+ *    0 = east, counter-clockwise; NED: 0 = north, clockwise). Sectors are in the vehicle's
+ *    heading frame, MAV_FRAME_BODY_FRD seen from above: body angle 0 is forward, angles grow
+ *    clockwise. Sector i is centred on body angle angle_offset_deg + i * increment_deg and
+ *    covers [centre - inc/2, centre + inc/2).
+ *  - Roll and pitch do not tilt anything: the band is about the vehicle's position on the map's
+ *    vertical axis and the sectors are horizontal slices (ArduPilot files OBSTACLE_DISTANCE in
+ *    its 0-degree pitch layer, PX4 in its horizontal bins), so a rolled or pitched vehicle gets
+ *    the sectors of the level vehicle with the same heading and position. (Pitched within
+ *    ~0.06 deg of +-90 the heading is the one occ_quat_to_euler() states.)
  *
  * What a sector reports (the exact geometric definition the tests check by brute force)
  *  - The vertical band is [z - band_below_m, z + band_above_m) ("below" is -z in an ENU map, +z
@@ -52,6 +60,7 @@
 #define OCC_OCC_SECTORS_H_INCLUDED
 
 #include "occmap/occ_core.h"
+#include "occmap/occ_pose.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -59,17 +68,6 @@ extern "C" {
 
 #define OCC_SECTORS_MAX 72u
 #define OCC_SECTORS_UNKNOWN UINT16_MAX
-
-typedef struct {
-    float x, y, z;                 /* metres, map frame (ENU) */
-    float yaw_rad;                 /* ENU map: 0 = +x (east), counter-clockwise positive;
-                                    * NED map (cfg.map_ned): 0 = +x (north), clockwise */
-    float roll_rad, pitch_rad;     /* optional, 0 when unknown; not used by the sectors */
-} occ_yaw_pose_t;
-
-/* Convert an autopilot pose (NED metres, yaw from north clockwise, radians) to the ENU map
- * frame; yaw_map is wrapped to (-pi, pi]. Roll and pitch are set to 0. O(1). */
-occ_yaw_pose_t occ_yaw_pose_from_ned(float north_m, float east_m, float down_m, float yaw_ned_rad);
 
 typedef struct {
     uint8_t n_sectors;             /* 1..72 */
@@ -120,7 +118,8 @@ occ_sectors_config_t occ_sectors_config_default(void);
 /* OCC_OK if `cfg` is usable, else OCC_ERR_ARG (ranges as documented on the fields). O(1). */
 occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg);
 
-/* Fill out->distance_cm[0..n_sectors-1] (and out->n, d_occ_m, d_unk_m) for the vehicle at `pose`.
+/* Fill out->distance_cm[0..n_sectors-1] (and out->n, d_occ_m, d_unk_m) for the vehicle at
+ * `map_from_body` (see "Frames": ENU <- FLU, or NED <- FRD with cfg.map_ned).
  * Walks the octree top-down with occ_map_read_key(), nearest node first, and skips a node when
  * it lies outside the search cylinder, holds only free space, or is farther than what every
  * sector it spans already found (d_occ_m / d_unk_m are exact where they decide the result).
@@ -130,11 +129,11 @@ occ_err_t occ_sectors_config_check(const occ_sectors_config_t *cfg);
  * Stack: < 512 bytes (the work space is in `out`). Never writes the map; reads no memory other
  * than map, pose, cfg and out.
  * The ground rule adds at most band_below_m / resolution + 1 voxel reads.
- * Errors: OCC_ERR_ARG (NULL, non-finite pose, bad cfg), OCC_ERR_RANGE (the vehicle outside the
+ * Errors: OCC_ERR_ARG (NULL, a pose occ_pose_check() refuses, bad cfg), OCC_ERR_RANGE (the vehicle outside the
  * map volume), OCC_ERR_NOMEM (the walk's stack in `out` is full: cannot happen with
  * OCC_SECTORS_STACK, checked anyway), or the error of occ_map_node_child() (a map written
  * during the call). On error `out` holds the unsafe answer (see "Fail closed" above). */
-occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_yaw_pose_t *pose,
+occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *map_from_body,
                               const occ_sectors_config_t *cfg, occ_sectors_t *out);
 
 #ifdef __cplusplus

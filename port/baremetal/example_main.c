@@ -135,7 +135,11 @@ int main(void)
     scfg.band_below_m = 0.04f;
     scfg.band_above_m = 0.04f;
     scfg.unknown_as_distance = true;
-    const occ_yaw_pose_t pose = occ_yaw_pose_from_ned(0.0f, 0.0f, -z0, 0.0f);
+    const occ_vec3_t start_ned = {0.0f, 0.0f, -z0}; /* level, facing north */
+    occ_pose_t pose;
+    if (occ_pose_from_ned(start_ned, occ_quat_identity(), &pose) != OCC_OK) {
+        return 1;
+    }
 
     /* The main loop: 3 simulated seconds at 1 kHz; the mailboxes drain every millisecond. */
     uint32_t errors = 0;

@@ -8,7 +8,7 @@ static bool within(uint64_t now_us, uint64_t stamp_us, uint32_t max_age_us)
 }
 
 occ_err_t occ_dronecan_poll_map(occ_dronecan_node_t *node, uint64_t now_us, const occ_map_t *map,
-                                uint64_t map_stamp_us, const occ_yaw_pose_t *pose,
+                                uint64_t map_stamp_us, const occ_pose_t *pose,
                                 uint64_t pose_stamp_us, const occ_sectors_config_t *sectors_cfg)
 {
     if (node == NULL || sectors_cfg == NULL) {

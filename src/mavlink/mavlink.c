@@ -452,14 +452,8 @@ occ_err_t occ_mav_decode_command_ack(const occ_mav_frame_t *f, occ_mav_command_a
 
 float occ_mav_quat_yaw(const float q[4], float *roll, float *pitch)
 {
-    const float w = q[0], x = q[1], y = q[2], z = q[3];
-    if (roll != NULL) {
-        *roll = atan2f(2.0f * (w * x + y * z), 1.0f - 2.0f * (x * x + y * y));
-    }
-    if (pitch != NULL) {
-        float s = 2.0f * (w * y - z * x);
-        s = s > 1.0f ? 1.0f : (s < -1.0f ? -1.0f : s);
-        *pitch = asinf(s);
-    }
-    return atan2f(2.0f * (w * z + x * y), 1.0f - 2.0f * (y * y + z * z));
+    const occ_quat_t qq = {q[0], q[1], q[2], q[3]};
+    float yaw = 0.0f;
+    occ_quat_to_euler(qq, roll, pitch, &yaw);
+    return yaw;
 }

@@ -103,25 +103,37 @@ static void take_ack(occ_mav_feed_t *f, const occ_mav_frame_t *fr)
     }
 }
 
-static void set_position(occ_mav_feed_t *f, float north, float east, float down, uint64_t now_us)
+static occ_quat_t quat_of(const float q[4])
 {
-    f->north = north;
-    f->east = east;
-    f->down = down;
+    const occ_quat_t r = {q[0], q[1], q[2], q[3]};
+    return r;
+}
+
+/* A finite local NED position (false, nothing taken, otherwise). */
+static bool set_position(occ_mav_feed_t *f, float north, float east, float down, uint64_t now_us)
+{
+    if (!isfinite(north) || !isfinite(east) || !isfinite(down)) {
+        return false;
+    }
+    f->ned_m.x = north;
+    f->ned_m.y = east;
+    f->ned_m.z = down;
     f->pos_us = now_us;
     f->have_pos = true;
     f->counters.positions_rx++;
+    return true;
 }
 
-static void set_attitude(occ_mav_feed_t *f, float yaw_ned, float roll, float pitch,
-                         uint64_t now_us)
+/* An attitude NED <- FRD, kept unit; NaN, Inf or a zero quaternion is not taken. */
+static bool set_attitude(occ_mav_feed_t *f, occ_quat_t ned_from_frd, uint64_t now_us)
 {
-    f->yaw_ned = yaw_ned;
-    f->roll = roll;
-    f->pitch = pitch;
+    if (occ_quat_normalize(ned_from_frd, &f->ned_from_frd) != OCC_OK) {
+        return false;
+    }
     f->att_us = now_us;
     f->have_att = true;
     f->counters.attitudes_rx++;
+    return true;
 }
 
 /* Each take_* below: true when the message was taken (it decoded, and what it says is finite
@@ -129,54 +141,33 @@ static void set_attitude(occ_mav_feed_t *f, float yaw_ned, float roll, float pit
 static bool take_position(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
 {
     occ_mav_local_position_ned_t m;
-    if (occ_mav_decode_local_position_ned(fr, &m) != OCC_OK || !isfinite(m.x) ||
-        !isfinite(m.y) || !isfinite(m.z)) {
-        return false;
-    }
-    set_position(f, m.x, m.y, m.z, now_us);
-    return true;
+    return occ_mav_decode_local_position_ned(fr, &m) == OCC_OK &&
+           set_position(f, m.x, m.y, m.z, now_us);
 }
 
 static bool take_attitude(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
 {
     occ_mav_attitude_t m;
-    if (occ_mav_decode_attitude(fr, &m) != OCC_OK || !isfinite(m.yaw)) {
-        return false;
-    }
-    set_attitude(f, m.yaw, m.roll, m.pitch, now_us);
-    return true;
+    return occ_mav_decode_attitude(fr, &m) == OCC_OK &&
+           set_attitude(f, occ_quat_from_euler(m.roll, m.pitch, m.yaw), now_us);
 }
 
 static bool take_quaternion(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
 {
     occ_mav_attitude_quaternion_t m;
-    if (occ_mav_decode_attitude_quaternion(fr, &m) != OCC_OK) {
-        return false;
-    }
-    /* roll and pitch are stored even when the yaw is rejected (as before the split). */
-    const float yaw = occ_mav_quat_yaw(m.q, &f->roll, &f->pitch);
-    if (!isfinite(yaw)) {
-        return false;
-    }
-    set_attitude(f, yaw, f->roll, f->pitch, now_us);
-    return true;
+    return occ_mav_decode_attitude_quaternion(fr, &m) == OCC_OK &&
+           set_attitude(f, quat_of(m.q), now_us);
 }
 
 static bool take_odometry(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
 {
     occ_mav_odometry_t m;
     if (occ_mav_decode_odometry(fr, &m) != OCC_OK || !odometry_frame_ok(m.frame_id) ||
-        !isfinite(m.x) || !isfinite(m.y) || !isfinite(m.z)) {
+        !isfinite(m.x) || !isfinite(m.y) || !isfinite(m.z) ||
+        !set_attitude(f, quat_of(m.q), now_us)) {
         return false;
     }
-    float roll, pitch;
-    const float yaw = occ_mav_quat_yaw(m.q, &roll, &pitch);
-    if (!isfinite(yaw)) {
-        return false;
-    }
-    set_position(f, m.x, m.y, m.z, now_us);
-    set_attitude(f, yaw, roll, pitch, now_us);
-    return true;
+    return set_position(f, m.x, m.y, m.z, now_us); /* finite: checked above */
 }
 
 static bool take_pose(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t now_us)
@@ -238,26 +229,23 @@ static bool fresh_at(const occ_mav_feed_t *f, bool have, uint64_t at_us, uint64_
     return have && now_us >= at_us && now_us - at_us <= f->cfg.pose_timeout_us;
 }
 
-bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_yaw_pose_t *pose)
+bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose)
 {
     if (f == NULL || !f->have_pos || !f->have_att) {
         return false;
     }
     const bool fresh = fresh_at(f, f->have_pos, f->pos_us, now_us) &&
                        fresh_at(f, f->have_att, f->att_us, now_us);
-    if (pose != NULL) {
-        if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
-            pose->x = f->north;
-            pose->y = f->east;
-            pose->z = f->down;
-            pose->yaw_rad = f->yaw_ned;
-        } else {
-            *pose = occ_yaw_pose_from_ned(f->north, f->east, f->down, f->yaw_ned);
-        }
-        pose->roll_rad = f->roll;
-        pose->pitch_rad = f->pitch;
+    if (pose == NULL) {
+        return fresh;
     }
-    return fresh;
+    if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
+        pose->p = f->ned_m;
+        pose->q = f->ned_from_frd;
+        return fresh;
+    }
+    /* Both parts were checked when taken: this cannot fail, but never reads as fresh if it does. */
+    return occ_pose_from_ned(f->ned_m, f->ned_from_frd, pose) == OCC_OK && fresh;
 }
 
 uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f)
@@ -348,7 +336,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         return 0;
     }
     f->next_obstacle_us = advance(f->next_obstacle_us, f->cfg.period_us, now_us);
-    occ_yaw_pose_t pose;
+    occ_pose_t pose;
     if (map == NULL || !occ_mav_feed_pose(f, now_us, &pose)) {
         f->counters.stale_skips++;
         return 0;

@@ -118,17 +118,34 @@ occ_quat_t occ_quat_from_euler(const float roll_rad, const float pitch_rad, cons
     return q;
 }
 
+/* cos(pitch) below which the pose counts as pitched straight up or down: roll and yaw then
+ * turn about (nearly) the same axis and only their difference (sum) is defined; roll is 0. */
+#define GIMBAL_COSP 1e-3f
+
 void occ_quat_to_euler(const occ_quat_t q, float *roll_rad, float *pitch_rad, float *yaw_rad)
 {
+    /* Body x in the parent frame is (cp cy, cp sy, -sp): pitch from atan2, not asin, keeps
+     * it exact near +-90 deg where sin is flat. */
+    const float r00 = 1.0f - 2.0f * (q.y * q.y + q.z * q.z);
+    const float r10 = 2.0f * (q.w * q.z + q.x * q.y);
     const float sinp = 2.0f * (q.w * q.y - q.z * q.x);
-    if (roll_rad != NULL) {
-        *roll_rad = atan2f(2.0f * (q.w * q.x + q.y * q.z), 1.0f - 2.0f * (q.x * q.x + q.y * q.y));
+    const float cosp = sqrtf(r00 * r00 + r10 * r10);
+    const bool gimbal = cosp < GIMBAL_COSP;
+    float yaw = gimbal ? 2.0f * atan2f(q.z, q.w) : atan2f(r10, r00);
+    if (yaw > PI_F) { /* 2 atan2 spans (-2 pi, 2 pi]; atan2 gives -pi for a -0 numerator */
+        yaw -= 2.0f * PI_F;
+    } else if (yaw <= -PI_F) {
+        yaw += 2.0f * PI_F;
     }
-    if (pitch_rad != NULL) { /* clamp: |sinp| creeps past 1 by rounding at +-90 deg */
-        *pitch_rad = sinp >= 1.0f ? 0.5f * PI_F : (sinp <= -1.0f ? -0.5f * PI_F : asinf(sinp));
+    if (roll_rad != NULL) {
+        *roll_rad = gimbal ? 0.0f
+                           : atan2f(2.0f * (q.w * q.x + q.y * q.z), 1.0f - 2.0f * (q.x * q.x + q.y * q.y));
+    }
+    if (pitch_rad != NULL) {
+        *pitch_rad = atan2f(sinp, cosp);
     }
     if (yaw_rad != NULL) {
-        *yaw_rad = atan2f(2.0f * (q.w * q.z + q.x * q.y), 1.0f - 2.0f * (q.y * q.y + q.z * q.z));
+        *yaw_rad = yaw;
     }
 }
 
@@ -211,6 +228,9 @@ occ_err_t occ_pose_to_ned(const occ_pose_t *const map_from_body, occ_vec3_t *con
     return OCC_OK;
 }
 
+/* Slerp as a turn from a: rel = conj(a) b on the shortest arc is a turn by 2 th about u; the
+ * result is a (cos s th, sin s th u). atan2 keeps th exact for nearly equal rotations, and the
+ * same formula extrapolates (s > 1) along the same axis at the same rate. */
 occ_pose_t occ_pose_interpolate(const occ_pose_t *const a, const occ_pose_t *const b,
                                 const float s)
 {
@@ -218,21 +238,20 @@ occ_pose_t occ_pose_interpolate(const occ_pose_t *const a, const occ_pose_t *con
     r.p.x = a->p.x + s * (b->p.x - a->p.x);
     r.p.y = a->p.y + s * (b->p.y - a->p.y);
     r.p.z = a->p.z + s * (b->p.z - a->p.z);
-    occ_quat_t qb = b->q;
-    float d = a->q.w * qb.w + a->q.x * qb.x + a->q.y * qb.y + a->q.z * qb.z;
-    if (d < 0.0f) { /* shortest arc: q and -q are the same rotation */
-        qb.w = -qb.w, qb.x = -qb.x, qb.y = -qb.y, qb.z = -qb.z;
-        d = -d;
+    occ_quat_t rel = quat_mul(quat_conj(a->q), b->q);
+    if (rel.w < 0.0f) { /* q and -q are the same rotation: take the short way */
+        rel.w = -rel.w, rel.x = -rel.x, rel.y = -rel.y, rel.z = -rel.z;
     }
-    float wa = 1.0f - s, wb = s;
-    if (d < 0.9995f) { /* slerp; nearly equal rotations take the (then exact enough) lerp */
-        const float th = acosf(d > 1.0f ? 1.0f : d);
-        const float inv_sin = 1.0f / sinf(th);
-        wa = sinf((1.0f - s) * th) * inv_sin;
-        wb = sinf(s * th) * inv_sin;
+    const float vn = sqrtf(rel.x * rel.x + rel.y * rel.y + rel.z * rel.z);
+    occ_quat_t turn = occ_quat_identity();
+    if (vn > 0.0f) {
+        const float th = atan2f(vn, rel.w) * s;
+        const float k = sinf(th) / vn;
+        turn.w = cosf(th);
+        turn.x = k * rel.x;
+        turn.y = k * rel.y;
+        turn.z = k * rel.z;
     }
-    const occ_quat_t q = {wa * a->q.w + wb * qb.w, wa * a->q.x + wb * qb.x,
-                          wa * a->q.y + wb * qb.y, wa * a->q.z + wb * qb.z};
-    r.q = quat_renorm(q);
+    r.q = quat_renorm(quat_mul(a->q, turn));
     return r;
 }

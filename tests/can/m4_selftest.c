@@ -152,7 +152,10 @@ static void test_sectors(void)
     occ_sectors_config_t sc = occ_sectors_config_default();
     sc.band_below_m = 0.04f;
     sc.band_above_m = 0.04f;
-    const occ_yaw_pose_t pose = occ_yaw_pose_from_ned(0.0f, 0.0f, -0.05f, 0.0f); /* facing north */
+    const occ_vec3_t up5cm = {0.0f, 0.0f, -0.05f};
+    occ_pose_t pose;
+    check(occ_pose_from_ned(up5cm, occ_quat_identity(), &pose) == OCC_OK, /* facing north */
+          "pose from NED");
     check(occ_sectors_compute(&map, &pose, &sc, &sectors) == OCC_OK && sectors.n == 72u,
           "sectors compute");
     check(sectors.distance_cm[0] >= 299u && sectors.distance_cm[0] <= 300u,
