@@ -70,10 +70,7 @@ static occ_range_beam_t beam(float dx, float dy, float dz, float d, float min_m,
 
 static occ_pose_t pose_at(float x, float y, float z)
 {
-    occ_pose_t p = occ_pose_identity();
-    p.p.x = x;
-    p.p.y = y;
-    p.p.z = z;
+    const occ_pose_t p = {{x, y, z}, {1.0f, 0.0f, 0.0f, 0.0f}};
     return p;
 }
 
@@ -589,18 +586,12 @@ int main(void)
     arena = malloc(ARENA_BYTES);
     arena2 = malloc(ARENA_BYTES);
     scratch = malloc(SCRATCH_BYTES);
+#define T(f) cmocka_unit_test_setup_teardown(f, setup, teardown)
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup_teardown(test_hit_hand, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_no_return_hand, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_skipped_counted, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_hits_equal_insert_cloud, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_no_return_equals_insert_cloud_max_range, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_mixed_brute_force, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_octomap_insert_ray, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_cone_rays, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_scratch_formula_and_work, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_bad_input, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_params_max_range_clips, setup, teardown),
+        T(test_hit_hand),         T(test_no_return_hand),         T(test_skipped_counted),
+        T(test_hits_equal_insert_cloud),  T(test_no_return_equals_insert_cloud_max_range),
+        T(test_mixed_brute_force),        T(test_octomap_insert_ray),     T(test_cone_rays),
+        T(test_scratch_formula_and_work), T(test_bad_input),     T(test_params_max_range_clips),
     };
     const int rc = cmocka_run_group_tests(tests, NULL, NULL);
     free(arena);
