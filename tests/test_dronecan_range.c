@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 #include "occmap/occ_ranges.h"
 #include "support/leak_check.h"
 

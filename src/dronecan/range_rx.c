@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "occmap/occ_can.h"
+#include "occmap/occ_dronecan.h"
 
 /* Bit offsets of the fields (DSDL v0, 120 bits). */
 #define BIT_TIMESTAMP 0u
