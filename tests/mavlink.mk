@@ -7,10 +7,11 @@ MAVGEN_DIR := $(BUILD)/gen/mavlink
 MAVGEN_STAMP := $(MAVGEN_DIR)/.stamp
 MAVGEN_DIALECT := ardupilotmega
 # MAVLINK_FLAGS only for the sources that include generated headers (directly or through
-# tests/support/mav_frames.h), in every build of them (rel, asan, host, cross, i386, lint):
-# a new includer is added to MAVLINK_INCLUDERS (without it, its compile fails on the include).
+# tests/support/mav_frames.h), in every build of them (rel, asan, host, cross, i386, lint). The
+# includers are found by their #include lines, so a new one needs no edit here.
 MAVLINK_FLAGS := -isystem $(MAVGEN_DIR)
-MAVLINK_INCLUDERS := src/mavlink/mavlink tests/test_mavlink tests/test_mavlink_feed
+MAVLINK_INCLUDERS := $(basename $(shell grep -lE '^\#include "((ardupilotmega|common|standard|minimal)/|support/mav_frames.h)' \
+  src/*/*.c tools/*.c port/*/*.c tests/*.c tests/mavlink/*.c 2>/dev/null))
 $(foreach f,$(MAVLINK_INCLUDERS),%/$(f).o %/$(f).analyzer.ok): EXTRA_CFLAGS += $(MAVLINK_FLAGS)
 
 $(MAVGEN_STAMP): | $(BUILD)/.deps-ok

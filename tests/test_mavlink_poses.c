@@ -81,11 +81,14 @@ static void quat_of(float roll, float pitch, float yaw, float q[4])
 
 static void expect_pose(float n, float e, float d, float roll, float pitch, float yaw)
 {
-    occ_yaw_pose_t p;
+    occ_pose_t p;
     memset(&p, 0, sizeof p);
-    assert_true(occ_mav_feed_pose(&feed, 1000000, &p));
-    assert_true(feq(p.x, n) && feq(p.y, e) && feq(p.z, d));
-    assert_true(feq(p.roll_rad, roll) && feq(p.pitch_rad, pitch) && feq(p.yaw_rad, yaw));
+    assert_true(occ_mav_feed_pose(&feed, 1000000, &p)); /* NED map: NED <- FRD as sent */
+    assert_true(feq(p.p.x, n) && feq(p.p.y, e) && feq(p.p.z, d));
+    float r = 0.0f, pt = 0.0f, y = 0.0f;
+    occ_quat_to_euler(p.q, &r, &pt, &y);
+    /* the attitude went through a quaternion: equal to float rounding */
+    assert_true(fabsf(r - roll) < 2e-6f && fabsf(pt - pitch) < 2e-6f && fabsf(y - yaw) < 2e-6f);
 }
 
 static void expect_counts(uint32_t pos, uint32_t att, uint32_t ignored)
@@ -113,9 +116,11 @@ static void test_position_and_attitude(void **state)
     attitude(0.3f, 0.3f, NAN, 1000000);
     expect_pose(1.0f, 2.0f, -3.0f, 0.1f, -0.2f, 0.5f);
     expect_counts(1, 1, 4);
-    /* Only yaw must be finite: roll and pitch are optional (0 when unknown, as sent). */
+    /* A NaN roll or pitch makes no rotation either: not taken (fail closed). */
     attitude(NAN, 0.0f, -1.0f, 1000000);
-    expect_counts(1, 2, 4);
+    attitude(0.0f, NAN, -1.0f, 1000000);
+    expect_pose(1.0f, 2.0f, -3.0f, 0.1f, -0.2f, 0.5f);
+    expect_counts(1, 1, 6);
 }
 
 /* ATTITUDE_QUATERNION: yaw, roll and pitch from the quaternion (occ_mav_quat_yaw). */
