@@ -1,0 +1,751 @@
+/* test_depth.c - occ_map_insert_depth(): an 8x8 time-of-flight frame worked out by hand, every
+ * bad input (error, map unchanged), the scratch formula, and the real TUM frames voxel for voxel
+ * against back-projection + occ_map_insert_cloud() and against OctoMap's insertPointCloud (the
+ * pioneer_slam2 frames with their association poses; tum_fr1_rpy with poses interpolated from
+ * its 100 Hz ground truth by occ_pose_history). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "occmap/occmap.h"
+#include "occmap/occ_depth.h"
+#include "occmap/host/occ_scan.h"
+#include "occmap/host/occ_tum.h"
+#include "support/iotest.h"
+#include "support/oracle_io.h"
+#include "support/leak_check.h"
+
+#define ARENA_BYTES ((size_t)48 << 20)
+#define SCRATCH_BYTES ((size_t)48 << 20)
+#define PIONEER_DIR "../shared/data/depth/tum_fr2_pioneer_slam2"
+#define RPY_DIR "../shared/data/depth/tum_fr1_rpy"
+
+static uint8_t *arena_a, *arena_b, *scratch;
+static occ_map_t map_a, map_b;
+
+static int setup(void **state)
+{
+    (void)state;
+    arena_a = malloc(ARENA_BYTES);
+    arena_b = malloc(ARENA_BYTES);
+    scratch = malloc(SCRATCH_BYTES);
+    return arena_a != NULL && arena_b != NULL && scratch != NULL ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    const int rc = leak_check(&map_a) | leak_check(&map_b);
+    free(arena_a);
+    free(arena_b);
+    free(scratch);
+    return rc;
+}
+
+static void init_maps(float res)
+{
+    occ_map_config_t c = iotest_octomap_cfg();
+    c.resolution_m = res;
+    assert_int_equal(occ_map_init(&map_a, &c, arena_a, ARENA_BYTES), OCC_OK);
+    assert_int_equal(occ_map_init(&map_b, &c, arena_b, ARENA_BYTES), OCC_OK);
+}
+
+/* ---- the 8x8 time-of-flight frame ---------------------------------------------------------- */
+/* VL53L5CX-like: 8x8 zones over a 45 degree square field of view: f = 4 / tan(22.5 deg),
+ * zone centres at pixel indices 0..7, principal point 3.5. Depth in mm (scale 0.001). */
+#define TOF_F 9.65685425f
+static const occ_pinhole_t TOF_K = {TOF_F, TOF_F, 3.5f, 3.5f};
+
+/* A wall 0.5 m ahead, zone (0,0) without reading, zone (7,0) at 20 mm (closer than min
+ * 0.05 m), zone (7,3) at 4 m (beyond max 2 m). */
+static void tof_frame(uint16_t mm[64])
+{
+    for (unsigned i = 0; i < 64u; i++) {
+        mm[i] = 500u;
+    }
+    mm[0] = 0u;
+    mm[7] = 20u;
+    mm[3 * 8 + 7] = 4000u;
+}
+
+static occ_depth_image_t tof_image(const uint16_t *mm)
+{
+    const occ_depth_image_t im = {mm, OCC_DEPTH_U16, 8u, 8u, 16u, 0.001f};
+    return im;
+}
+
+static occ_depth_params_t tof_params(void)
+{
+    const occ_depth_params_t p = {TOF_K, 0.05f, 2.0f, 1u};
+    return p;
+}
+
+/* Camera at the centre of voxel (0, 0, 0) at 0.1 m, optical axis = map z (identity pose). */
+static occ_pose_t tof_pose(void)
+{
+    occ_pose_t p = occ_pose_identity();
+    p.p = (occ_vec3_t){0.05f, 0.05f, 0.05f};
+    return p;
+}
+
+/* State of the voxel with index (i, j, k) (its centre at (i + 0.5) res ...): 0 unknown, 1 free,
+ * 2 occupied. */
+static int voxel_state(const occ_map_t *m, int i, int j, int k)
+{
+    const float r = m->cfg.resolution_m;
+    const occ_vec3_t c = {((float)i + 0.5f) * r, ((float)j + 0.5f) * r, ((float)k + 0.5f) * r};
+    occ_node_info_t info;
+    assert_int_equal(occ_map_read(m, c, 0u, &info), OCC_OK);
+    return !info.observed ? 0 : info.logodds >= 0.0f ? 2 : 1;
+}
+
+static int point_state(const occ_map_t *m, occ_vec3_t p)
+{
+    const float r = m->cfg.resolution_m;
+    return voxel_state(m, (int)floorf(p.x / r), (int)floorf(p.y / r), (int)floorf(p.z / r));
+}
+
+/* Hand computation (res 0.1): zone u ends at x = 0.05 + (u - 3.5) 0.5 / f = 0.05 + (u - 3.5)
+ * 0.05178, voxel index -2 -1 -1 0 0 1 1 2 for u = 0..7 (the same in y with v), z = 0.55:
+ * index 5. The 25 end columns minus (-2,-2) (only zone (0,0), no reading) and (2,-2) (only
+ * zone (7,0), too close) are hit: 23 voxels. The four central zones' rays stay in column
+ * (0,0): free from k = 0 to 4. Zone (7,3) runs along (0.34035, -0.04862, 0.93904) and stops
+ * at 2 m: 1.5 m along it is (0.5605, -0.0229, 1.4586), voxel (5,-1,14), free; 1.95 m along is
+ * (0.7137, -0.0448, 1.8811), voxel (7,-1,18), free; the clipped end (0.7307, -0.0472, 1.9281)
+ * lies in voxel (7,-1,19), which stays unknown (no hit; computeRayKeys excludes the end voxel),
+ * as does (9,-1,23), 2.5 m along. Behind the wall (k = 6) only that ray's voxel (2,0,6) is
+ * known. */
+static void check_tof_map(const occ_map_t *m)
+{
+    for (int i = -2; i <= 2; i++) {
+        for (int j = -2; j <= 2; j++) {
+            const bool lone = (i == -2 && j == -2) || (i == 2 && j == -2);
+            assert_int_equal(voxel_state(m, i, j, 5), lone ? 0 : 2);
+            /* behind the wall: unknown, but where zone (7,3)'s ray passes (z 0.6..0.7 at
+             * x 0.249..0.286, y 0.016..0.022) */
+            assert_int_equal(voxel_state(m, i, j, 6), i == 2 && j == 0 ? 1 : 0);
+        }
+    }
+    for (int k = 0; k <= 4; k++) {
+        assert_int_equal(voxel_state(m, 0, 0, k), 1);
+    }
+    assert_int_equal(voxel_state(m, 5, -1, 14), 1);
+    assert_int_equal(voxel_state(m, 7, -1, 18), 1);
+    assert_int_equal(voxel_state(m, 7, -1, 19), 0);
+    assert_int_equal(voxel_state(m, 9, -1, 23), 0);
+    assert_int_equal(voxel_state(m, -2, -2, 4), 0);
+}
+
+static void check_tof_counts(const occ_depth_result_t *r)
+{
+    assert_int_equal(r->pixels_sampled, 64);
+    assert_int_equal(r->pixels_no_reading, 1);
+    assert_int_equal(r->pixels_too_close, 1);
+    assert_int_equal(r->pixels_beyond_max, 1);
+    assert_int_equal(r->points, 62);
+    assert_int_equal(r->insert.points_integrated, 62);
+    assert_int_equal(r->insert.rays_clipped, 1);
+    assert_int_equal(r->insert.voxels_occupied, 23);
+}
+
+static void test_tof_8x8(void **state)
+{
+    (void)state;
+    init_maps(0.1f);
+    uint16_t mm[64];
+    tof_frame(mm);
+    const occ_depth_image_t im = tof_image(mm);
+    const occ_depth_params_t dp = tof_params();
+    const occ_pose_t pose = tof_pose();
+    const occ_insert_params_t ip = occ_insert_params_default();
+    occ_depth_result_t r;
+    assert_int_equal(occ_map_insert_depth(&map_a, &im, &dp, &pose, &ip, scratch, SCRATCH_BYTES,
+                                          &r),
+                     OCC_OK);
+    check_tof_counts(&r);
+    check_tof_map(&map_a);
+    assert_int_equal(point_state(&map_a, (occ_vec3_t){0.5605f, -0.0229f, 1.4586f}), 1);
+
+    /* The same scene as float metres: NaN = no reading, +Inf = no return (placed at 2 x max
+     * = 4 m, the U16 frame's 4000 mm): the same map. */
+    float m[64];
+    for (unsigned i = 0; i < 64u; i++) {
+        m[i] = (float)mm[i] * 0.001f;
+    }
+    m[0] = NAN;
+    m[3 * 8 + 7] = INFINITY;
+    const occ_depth_image_t imf = {m, OCC_DEPTH_F32, 8u, 8u, 32u, 0.0f};
+    occ_depth_result_t rf;
+    assert_int_equal(occ_map_insert_depth(&map_b, &imf, &dp, &pose, &ip, scratch, SCRATCH_BYTES,
+                                          &rf),
+                     OCC_OK);
+    check_tof_counts(&rf);
+    assert_true(iotest_map_digest(&map_a) == iotest_map_digest(&map_b));
+}
+
+/* ---- bad input: a clear error and the map unchanged ---------------------------------------- */
+typedef struct {
+    occ_depth_image_t im;
+    occ_depth_params_t dp;
+    occ_pose_t pose;
+    occ_insert_params_t ip;
+    size_t scratch_bytes;
+} call_t;
+
+static call_t tof_call(const uint16_t *mm)
+{
+    call_t c;
+    c.im = tof_image(mm);
+    c.dp = tof_params();
+    c.pose = tof_pose();
+    c.ip = occ_insert_params_default();
+    c.scratch_bytes = SCRATCH_BYTES;
+    return c;
+}
+
+static occ_err_t run_call(const call_t *c)
+{
+    occ_depth_result_t r;
+    return occ_map_insert_depth(&map_a, &c->im, &c->dp, &c->pose, &c->ip, scratch,
+                                c->scratch_bytes, &r);
+}
+
+/* One field broken per case; `what` names it in a failure. */
+static void expect_refused(const call_t *c, occ_err_t want, uint64_t digest, const char *what)
+{
+    const occ_err_t e = run_call(c);
+    if (e != want || iotest_map_digest(&map_a) != digest) {
+        printf("case '%s': %s, map %s\n", what, occ_err_str(e),
+               iotest_map_digest(&map_a) == digest ? "unchanged" : "CHANGED");
+    }
+    assert_int_equal(e, want);
+    assert_true(iotest_map_digest(&map_a) == digest);
+}
+
+static void bad_image_cases(const call_t *ok, uint64_t d)
+{
+    call_t c = *ok;
+    c.im.data = NULL;
+    expect_refused(&c, OCC_ERR_ARG, d, "data NULL");
+    const uint32_t sides[3] = {0u, OCC_DEPTH_MAX_SIDE + 1u, 0u};
+    for (unsigned i = 0; i < 2u; i++) {
+        c = *ok;
+        c.im.width = sides[i];
+        expect_refused(&c, OCC_ERR_ARG, d, "width");
+        c = *ok;
+        c.im.height = sides[i];
+        expect_refused(&c, OCC_ERR_ARG, d, "height");
+    }
+    c = *ok;
+    c.im.row_stride_bytes = 15u;
+    expect_refused(&c, OCC_ERR_ARG, d, "stride < width * 2");
+    c = *ok;
+    c.im.format = OCC_DEPTH_F32;
+    c.im.row_stride_bytes = 31u;
+    expect_refused(&c, OCC_ERR_ARG, d, "float stride < width * 4");
+    c = *ok;
+    c.im.format = (occ_depth_format_t)7;
+    expect_refused(&c, OCC_ERR_ARG, d, "format");
+    const float bad_scale[4] = {0.0f, -1.0f, NAN, INFINITY};
+    for (unsigned i = 0; i < 4u; i++) {
+        c = *ok;
+        c.im.depth_scale_m = bad_scale[i];
+        expect_refused(&c, OCC_ERR_ARG, d, "depth scale");
+    }
+}
+
+static void bad_params_cases(const call_t *ok, uint64_t d)
+{
+    const float bad_f[4] = {0.0f, -5.0f, NAN, INFINITY};
+    for (unsigned i = 0; i < 4u; i++) {
+        call_t c = *ok;
+        c.dp.intrinsics.fx = bad_f[i];
+        expect_refused(&c, OCC_ERR_ARG, d, "fx");
+        c = *ok;
+        c.dp.intrinsics.fy = bad_f[i];
+        expect_refused(&c, OCC_ERR_ARG, d, "fy");
+    }
+    call_t c = *ok;
+    c.dp.intrinsics.cx = NAN;
+    expect_refused(&c, OCC_ERR_ARG, d, "cx NaN");
+    c = *ok;
+    c.dp.intrinsics.cy = -INFINITY;
+    expect_refused(&c, OCC_ERR_ARG, d, "cy Inf");
+    const float ranges[6][2] = {{NAN, 2.0f}, {-0.1f, 2.0f}, {0.05f, NAN},
+                                {0.05f, INFINITY}, {2.0f, 2.0f}, {3.0f, 2.0f}};
+    for (unsigned i = 0; i < 6u; i++) {
+        c = *ok;
+        c.dp.min_range_m = ranges[i][0];
+        c.dp.max_range_m = ranges[i][1];
+        expect_refused(&c, OCC_ERR_ARG, d, "min / max range");
+    }
+    c = *ok;
+    c.dp.pixel_step = 0u;
+    expect_refused(&c, OCC_ERR_ARG, d, "step 0");
+}
+
+static void bad_pose_cases(const call_t *ok, uint64_t d)
+{
+    call_t c = *ok;
+    c.pose.p.y = NAN;
+    expect_refused(&c, OCC_ERR_ARG, d, "pose NaN");
+    c = *ok;
+    c.pose.q = (occ_quat_t){0.0f, 0.0f, 0.0f, 0.0f};
+    expect_refused(&c, OCC_ERR_ARG, d, "zero quaternion");
+    c = *ok;
+    c.pose.q = (occ_quat_t){1.01f, 0.0f, 0.0f, 0.0f};
+    expect_refused(&c, OCC_ERR_ARG, d, "quaternion not unit");
+    c = *ok;
+    c.pose.p.x = 1e7f;
+    expect_refused(&c, OCC_ERR_RANGE, d, "camera outside the map");
+    c = *ok;
+    c.ip.method = (occ_insert_method_t)99;
+    expect_refused(&c, OCC_ERR_ARG, d, "insert method");
+    c = *ok;
+    c.scratch_bytes = 3u + 12u * 61u; /* one point short */
+    expect_refused(&c, OCC_ERR_SCRATCH, d, "scratch for 61 of 62 points");
+    c = *ok;
+    c.scratch_bytes = 3u + 12u * 62u; /* the points, nothing for insert_cloud */
+    expect_refused(&c, OCC_ERR_SCRATCH, d, "no scratch left for insert_cloud");
+}
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    init_maps(0.1f);
+    uint16_t mm[64];
+    tof_frame(mm);
+    call_t ok = tof_call(mm);
+    ok.pose.p.z = 0.35f; /* a map that already holds something */
+    assert_int_equal(run_call(&ok), OCC_OK);
+    ok.pose.p.z = 0.05f;
+    const uint64_t d = iotest_map_digest(&map_a);
+    occ_depth_result_t r;
+    assert_int_equal(occ_map_insert_depth(NULL, &ok.im, &ok.dp, &ok.pose, &ok.ip, scratch,
+                                          SCRATCH_BYTES, &r),
+                     OCC_ERR_ARG);
+    assert_int_equal(occ_map_insert_depth(&map_a, NULL, &ok.dp, &ok.pose, &ok.ip, scratch,
+                                          SCRATCH_BYTES, &r),
+                     OCC_ERR_ARG);
+    assert_int_equal(occ_map_insert_depth(&map_a, &ok.im, NULL, &ok.pose, &ok.ip, scratch,
+                                          SCRATCH_BYTES, &r),
+                     OCC_ERR_ARG);
+    assert_int_equal(occ_map_insert_depth(&map_a, &ok.im, &ok.dp, NULL, &ok.ip, scratch,
+                                          SCRATCH_BYTES, &r),
+                     OCC_ERR_ARG);
+    assert_int_equal(occ_map_insert_depth(&map_a, &ok.im, &ok.dp, &ok.pose, NULL, scratch,
+                                          SCRATCH_BYTES, &r),
+                     OCC_ERR_ARG);
+    assert_int_equal(occ_map_insert_depth(&map_a, &ok.im, &ok.dp, &ok.pose, &ok.ip, NULL,
+                                          SCRATCH_BYTES, &r),
+                     OCC_ERR_SCRATCH);
+    assert_true(iotest_map_digest(&map_a) == d);
+    bad_image_cases(&ok, d);
+    bad_params_cases(&ok, d);
+    bad_pose_cases(&ok, d);
+    assert_int_equal(run_call(&ok), OCC_OK); /* and the good call still works */
+    assert_true(iotest_map_digest(&map_a) != d);
+}
+
+/* Maps whose pools cannot hold the frame, at every small arena size: OCC_ERR_NOMEM, the map
+ * unchanged and still valid. */
+static void test_pools_short(void **state)
+{
+    (void)state;
+    static uint8_t small[65536];
+    occ_map_config_t cfg = iotest_octomap_cfg();
+    cfg.resolution_m = 0.1f;
+    uint16_t mm[64];
+    tof_frame(mm);
+    const call_t c = tof_call(mm);
+    size_t refused = 0, fitted = 0;
+    for (size_t bytes = 1024u; bytes <= sizeof small; bytes += 1024u) {
+        occ_map_t m;
+        if (occ_map_init(&m, &cfg, small, bytes) != OCC_OK) {
+            continue;
+        }
+        const uint64_t d = iotest_map_digest(&m);
+        occ_depth_result_t r;
+        const occ_err_t e = occ_map_insert_depth(&m, &c.im, &c.dp, &c.pose, &c.ip, scratch,
+                                                 SCRATCH_BYTES, &r);
+        assert_true(e == OCC_OK || e == OCC_ERR_NOMEM);
+        if (e == OCC_ERR_NOMEM) {
+            refused++;
+            assert_true(iotest_map_digest(&m) == d);
+        } else {
+            fitted++;
+            check_tof_map(&m);
+        }
+        assert_int_equal(occ_map_check(&m), OCC_OK);
+    }
+    assert_true(refused > 0u && fitted > 0u);
+}
+
+/* The compile-time formula sizes a static buffer that is enough, and equals the function. */
+#define TOF_RAY_VOXELS 22u /* ceil(2 m / 0.1 m) + 2 */
+static uint8_t tof_scratch[OCC_DEPTH_SCRATCH_BYTES(8, 8, 1, TOF_RAY_VOXELS)];
+
+static void test_scratch_formula(void **state)
+{
+    (void)state;
+    init_maps(0.1f);
+    const occ_insert_params_t ip = occ_insert_params_default();
+    assert_int_equal(occ_depth_scratch_bytes(&map_a, 8u, 8u, 1u, 2.0f, &ip), sizeof tof_scratch);
+    assert_int_equal(OCC_DEPTH_PIXELS(640, 480, 8), 80u * 60u);
+    assert_int_equal(OCC_DEPTH_PIXELS(641, 479, 8), 81u * 60u);
+    assert_true(OCC_DEPTH_SCRATCH_FITS(640, 480, 1, 100));
+    assert_int_equal(occ_depth_scratch_bytes(&map_a, 0u, 8u, 1u, 2.0f, &ip), 0);
+    assert_int_equal(occ_depth_scratch_bytes(&map_a, 8u, 8u, 0u, 2.0f, &ip), 0);
+    assert_int_equal(occ_depth_scratch_bytes(&map_a, 8u, 8u, 1u, INFINITY, &ip), 0);
+    uint16_t mm[64];
+    tof_frame(mm);
+    call_t c = tof_call(mm);
+    const occ_insert_method_t methods[3] = {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE,
+                                            OCC_INSERT_SUPER_RAYS};
+    for (unsigned i = 0; i < 3u; i++) {
+        c.ip.method = methods[i];
+        occ_depth_result_t r;
+        /* off by one byte from the buffer's start: the alignment term is needed */
+        assert_int_equal(occ_map_insert_depth(&map_a, &c.im, &c.dp, &c.pose, &c.ip,
+                                              tof_scratch + 1, sizeof tof_scratch - 1u, &r),
+                         OCC_OK);
+        assert_true(r.scratch_points + r.insert.scratch_used <= sizeof tof_scratch);
+    }
+}
+
+/* ---- real frames ---------------------------------------------------------------------------- */
+typedef struct {
+    uint16_t *pix;
+    uint32_t w, h;
+    occ_pose_t pose; /* map_from_camera */
+    char path[512];
+} frame_t;
+
+static bool load_png(const char *path, frame_t *f)
+{
+    char msg[256] = "";
+    snprintf(f->path, sizeof f->path, "%s", path);
+    if (occ_depth_read_png_image(path, &f->pix, &f->w, &f->h, msg, sizeof msg) != OCC_OK) {
+        printf("SKIP: %s unreadable (%s; needs ../shared)\n", path, msg);
+        return false;
+    }
+    return true;
+}
+
+static occ_depth_image_t tum_image(const frame_t *f)
+{
+    const occ_depth_image_t im = {f->pix, OCC_DEPTH_U16, f->w, f->h, (size_t)f->w * 2u,
+                                  1.0f / 5000.0f};
+    return im;
+}
+
+static occ_depth_params_t cam_params(const occ_depth_camera_t *cam, float min_m, float max_m,
+                                     uint32_t step)
+{
+    const occ_depth_params_t p = {{cam->fx, cam->fy, cam->cx, cam->cy}, min_m, max_m, step};
+    return p;
+}
+
+/* The test's own back-projection of the valid pixels, the header's arithmetic: *n points. */
+static occ_vec3_t *back_project(const frame_t *f, const occ_depth_params_t *dp, size_t *n)
+{
+    occ_vec3_t *pts = malloc((size_t)f->w * f->h * sizeof *pts);
+    assert_non_null(pts);
+    const occ_pinhole_t *k = &dp->intrinsics;
+    *n = 0;
+    for (uint32_t v = 0; v < f->h; v += dp->pixel_step) {
+        for (uint32_t u = 0; u < f->w; u += dp->pixel_step) {
+            const uint16_t raw = f->pix[(size_t)v * f->w + u];
+            const float d = (float)raw * (1.0f / 5000.0f);
+            const occ_vec3_t c = {((float)u - k->cx) * d / k->fx, ((float)v - k->cy) * d / k->fy,
+                                  d};
+            if (raw != 0u && sqrtf(c.x * c.x + c.y * c.y + c.z * c.z) >= dp->min_range_m) {
+                pts[(*n)++] = occ_pose_apply(&f->pose, c);
+            }
+        }
+    }
+    return pts;
+}
+
+/* insert_depth into map_a, back-projection + insert_cloud into map_b: the same map (digest of
+ * every node and the pool counters) and the same insert counters. */
+static void same_as_cloud(const frame_t *f, const occ_depth_params_t *dp,
+                          const occ_insert_params_t *ip)
+{
+    const occ_depth_image_t im = tum_image(f);
+    occ_depth_result_t r;
+    assert_int_equal(occ_map_insert_depth(&map_a, &im, dp, &f->pose, ip, scratch, SCRATCH_BYTES,
+                                          &r),
+                     OCC_OK);
+    size_t n = 0;
+    occ_vec3_t *pts = back_project(f, dp, &n);
+    occ_insert_params_t p = *ip;
+    p.max_range_m = dp->max_range_m;
+    occ_insert_result_t rc;
+    assert_int_equal(occ_map_insert_cloud(&map_b, &f->pose.p, pts, n, &p, scratch, SCRATCH_BYTES,
+                                          &rc),
+                     OCC_OK);
+    free(pts);
+    assert_int_equal(r.points, n);
+    assert_int_equal(r.pixels_sampled, OCC_DEPTH_PIXELS(f->w, f->h, dp->pixel_step));
+    assert_int_equal(r.insert.voxels_updated, rc.voxels_updated);
+    assert_int_equal(r.insert.voxels_occupied, rc.voxels_occupied);
+    assert_int_equal(r.insert.rays_clipped, rc.rays_clipped);
+    printf("  %zu pixels: %zu no reading, %zu too close, %zu beyond max\n", r.pixels_sampled,
+           r.pixels_no_reading, r.pixels_too_close, r.pixels_beyond_max);
+    assert_true(r.pixels_beyond_max > 0u && r.pixels_too_close > 0u);
+    assert_true(iotest_map_digest(&map_a) == iotest_map_digest(&map_b));
+}
+
+/* The pioneer frames: poses and names from my_association.txt (occ_depth_read_tum_dir). */
+static size_t pioneer_frames(frame_t *out, size_t max)
+{
+    occ_scan_frame_t *fr = NULL;
+    size_t n = 0;
+    char msg[256] = "";
+    if (occ_depth_read_tum_dir(PIONEER_DIR, 64u, max, &fr, &n, msg, sizeof msg) != OCC_OK) {
+        printf("SKIP: %s not available (%s; needs ../shared)\n", PIONEER_DIR, msg);
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/depth/%s", PIONEER_DIR, fr[i].name);
+        assert_true(load_png(path, &out[i]));
+        out[i].pose.p = (occ_vec3_t){fr[i].pose_t[0], fr[i].pose_t[1], fr[i].pose_t[2]};
+        const occ_quat_t q = {fr[i].pose_q[0], fr[i].pose_q[1], fr[i].pose_q[2], fr[i].pose_q[3]};
+        assert_int_equal(occ_quat_normalize(q, &out[i].pose.q), OCC_OK);
+    }
+    occ_scan_frames_free(fr, n);
+    return n;
+}
+
+static void free_frames(frame_t *f, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        free(f[i].pix);
+    }
+}
+
+/* Our back-projection agrees with the host reader's (double precision, its own rotation
+ * matrix) to float rounding: the formula and the pose convention are right. */
+static void check_against_reader(const frame_t *f, const occ_depth_camera_t *cam)
+{
+    const occ_depth_params_t dp = cam_params(cam, 0.0f, 100.0f, 8u);
+    size_t n = 0;
+    occ_vec3_t *pts = back_project(f, &dp, &n);
+    const float t[3] = {f->pose.p.x, f->pose.p.y, f->pose.p.z};
+    const float q[4] = {f->pose.q.w, f->pose.q.x, f->pose.q.y, f->pose.q.z};
+    occ_scan_frame_t ref;
+    char msg[256];
+    assert_int_equal(occ_depth_read_png(f->path, cam, t, q, 8u, &ref, msg, sizeof msg), OCC_OK);
+    assert_int_equal(ref.n_points, n);
+    float worst = 0.0f;
+    for (size_t i = 0; i < n; i++) {
+        worst = fmaxf(worst, fabsf(pts[i].x - ref.points[i].x) + fabsf(pts[i].y - ref.points[i].y) +
+                                 fabsf(pts[i].z - ref.points[i].z));
+    }
+    assert_true(worst < 2e-5f);
+    free(pts);
+    free(ref.points);
+}
+
+static void test_pioneer_equals_cloud(void **state)
+{
+    (void)state;
+    frame_t f[6];
+    const size_t n = pioneer_frames(f, 6u);
+    if (n == 0u) {
+        skip();
+    }
+    assert_int_equal(n, 6);
+    const occ_depth_camera_t cam = occ_depth_camera_tum_fr2();
+    check_against_reader(&f[0], &cam);
+    const occ_insert_method_t methods[3] = {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE,
+                                            OCC_INSERT_SUPER_RAYS};
+    const occ_depth_params_t dp = cam_params(&cam, 1.5f, 4.0f, 4u);
+    for (unsigned m = 0; m < 3u; m++) {
+        init_maps(m == 2u ? 0.2f : 0.1f);
+        occ_insert_params_t ip = occ_insert_params_default();
+        ip.method = methods[m];
+        for (size_t i = 0; i < n; i += 5u) {
+            same_as_cloud(&f[i], &dp, &ip);
+        }
+    }
+    free_frames(f, n);
+}
+
+/* insert_depth frame after frame into map_a and OctoMap's insertPointCloud of the test's own
+ * back-projection (same max range; OctoMap has no min range: 0 here) into one tree: the same
+ * leaves, values within 1/1024 per frame (our log-odds are 16-bit fixed point, OctoMap's float;
+ * each update rounds to 1/1024). */
+static void same_as_octomap(const frame_t *f, size_t n, const occ_depth_params_t *dp,
+                            occ_insert_method_t method, float res)
+{
+    init_maps(res);
+    oracle_io_t *t = oracle_io_new(ORACLE_OCTREE, (double)res);
+    assert_non_null(t);
+    occ_insert_params_t ip = occ_insert_params_default();
+    ip.method = method;
+    for (size_t i = 0; i < n; i++) {
+        const occ_depth_image_t im = tum_image(&f[i]);
+        occ_depth_result_t r;
+        assert_int_equal(occ_map_insert_depth(&map_a, &im, dp, &f[i].pose, &ip, scratch,
+                                              SCRATCH_BYTES, &r),
+                         OCC_OK);
+        size_t np = 0;
+        occ_vec3_t *pts = back_project(&f[i], dp, &np);
+        const float o[3] = {f[i].pose.p.x, f[i].pose.p.y, f[i].pose.p.z};
+        oracle_io_insert_cloud(t, (const float *)(const void *)pts, np, o,
+                               (double)dp->max_range_m, method == OCC_INSERT_DISCRETE);
+        free(pts);
+    }
+    char why[256] = "";
+    const bool eq = iotest_equivalent(&map_a, t, (float)n / 1024.0f + 1e-4f, why, sizeof why);
+    if (!eq) {
+        printf("differs from OctoMap (method %d, res %.2f): %s\n", (int)method, (double)res, why);
+    }
+    assert_true(eq);
+    oracle_io_free(t);
+}
+
+static void test_pioneer_octomap(void **state)
+{
+    (void)state;
+    frame_t f[10];
+    const size_t n = pioneer_frames(f, 10u);
+    if (n == 0u) {
+        skip();
+    }
+    const occ_depth_camera_t cam = occ_depth_camera_tum_fr2();
+    const occ_depth_params_t dp = cam_params(&cam, 0.0f, 3.5f, 8u);
+    const frame_t some[3] = {f[0], f[4], f[9]};
+    same_as_octomap(some, 3u, &dp, OCC_INSERT_SIMPLE, 0.05f);
+    same_as_octomap(some, 3u, &dp, OCC_INSERT_DISCRETE, 0.1f);
+    free_frames(f, n);
+}
+
+/* ---- tum_fr1_rpy: poses interpolated from the 100 Hz ground truth -------------------------- */
+typedef struct {
+    occ_pose_sample_t *gt;
+    size_t n_gt;
+    occ_tum_depth_entry_t *list;
+    size_t n_list;
+    occ_pose_history_t h;
+} rpy_t;
+
+static bool load_rpy(rpy_t *r)
+{
+    char msg[256] = "";
+    if (occ_tum_read_groundtruth(RPY_DIR "/groundtruth.txt", &r->gt, &r->n_gt, msg, sizeof msg) !=
+            OCC_OK ||
+        occ_tum_read_depth_list(RPY_DIR "/depth.txt", &r->list, &r->n_list, msg, sizeof msg) !=
+            OCC_OK) {
+        printf("SKIP: %s not available (%s; needs ../shared)\n", RPY_DIR, msg);
+        return false;
+    }
+    const occ_pose_history_cfg_t cfg = {OCC_TUM_MAX_GAP_US, 0u};
+    assert_int_equal(occ_pose_history_init(&r->h, r->gt, r->n_gt, &cfg), OCC_OK);
+    assert_int_equal(occ_tum_history_fill(&r->h, r->gt, r->n_gt), OCC_OK);
+    return true;
+}
+
+/* The position by hand: the bracketing samples, linear in time (double). */
+static void check_interpolation(const rpy_t *r, uint64_t t_us, const occ_pose_t *got)
+{
+    size_t i = 0;
+    while (i + 1u < r->n_gt && r->gt[i + 1u].t_us < t_us) {
+        i++;
+    }
+    const occ_pose_sample_t *a = &r->gt[i], *b = &r->gt[i + 1u];
+    assert_true(a->t_us <= t_us && t_us <= b->t_us);
+    const double s = (double)(t_us - a->t_us) / (double)(b->t_us - a->t_us);
+    const double want_x = (double)a->pose.p.x + s * (double)(b->pose.p.x - a->pose.p.x);
+    const double want_z = (double)a->pose.p.z + s * (double)(b->pose.p.z - a->pose.p.z);
+    assert_true(fabs((double)got->p.x - want_x) < 1e-5 && fabs((double)got->p.z - want_z) < 1e-5);
+    /* slerp by hand (double): sin((1 - s) th) / sin th a + sin(s th) / sin th b, shortest arc */
+    const double qa[4] = {a->pose.q.w, a->pose.q.x, a->pose.q.y, a->pose.q.z};
+    double qb[4] = {b->pose.q.w, b->pose.q.x, b->pose.q.y, b->pose.q.z};
+    double dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
+    const double sign = dot < 0.0 ? -1.0 : 1.0;
+    dot *= sign;
+    const double th = acos(fmin(dot, 1.0));
+    const double wa = th > 1e-9 ? sin((1.0 - s) * th) / sin(th) : 1.0 - s;
+    const double wb = (th > 1e-9 ? sin(s * th) / sin(th) : s) * sign;
+    const double qg[4] = {got->q.w, got->q.x, got->q.y, got->q.z};
+    const double gs = qg[0] * (wa * qa[0] + wb * qb[0]) >= 0.0 ? 1.0 : -1.0; /* q = -q */
+    for (unsigned c = 0; c < 4u; c++) {
+        assert_true(fabs(gs * qg[c] - (wa * qa[c] + wb * qb[c])) < 1e-5);
+    }
+}
+
+static void test_rpy_interpolated(void **state)
+{
+    (void)state;
+    rpy_t r;
+    if (!load_rpy(&r)) {
+        skip();
+    }
+    assert_true(r.n_list >= 500u);
+    /* Of the 500 frames here exactly the four in the capture gap (130 ms without a pose, after
+     * the sample at .8129 s) have no pose: SOURCE.md's three plus .814094, 1.2 ms after the
+     * last sample, which would have to be interpolated across the gap. */
+    static const uint64_t gap[4] = {1305031244814094u, 1305031244841822u, 1305031244881801u,
+                                    1305031244914908u};
+    size_t refused = 0;
+    for (size_t i = 0; i < 500u; i++) {
+        occ_pose_t p;
+        occ_pose_refusal_t why;
+        if (occ_pose_history_at(&r.h, r.list[i].t_us, &p, &why) != OCC_OK) {
+            assert_int_equal(why, OCC_POSE_GAP);
+            assert_true(refused < 4u && r.list[i].t_us == gap[refused]);
+            refused++;
+        } else {
+            check_interpolation(&r, r.list[i].t_us, &p);
+        }
+    }
+    assert_int_equal(refused, 4);
+    /* Three frames across the sequence, posed by the history, into occmap and OctoMap. */
+    frame_t f[3];
+    const size_t idx[3] = {0u, 250u, 499u};
+    for (size_t i = 0; i < 3u; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s", RPY_DIR, r.list[idx[i]].file);
+        assert_true(load_png(path, &f[i]));
+        assert_int_equal(occ_pose_history_at(&r.h, r.list[idx[i]].t_us, &f[i].pose, NULL), OCC_OK);
+    }
+    const occ_depth_camera_t cam = occ_depth_camera_tum_fr1();
+    check_against_reader(&f[1], &cam);
+    const occ_depth_params_t dp = cam_params(&cam, 0.0f, 3.0f, 6u);
+    same_as_octomap(f, 3u, &dp, OCC_INSERT_SIMPLE, 0.05f);
+    const occ_depth_params_t dp_close = cam_params(&cam, 1.0f, 3.0f, 4u);
+    init_maps(0.1f);
+    occ_insert_params_t ip = occ_insert_params_default();
+    ip.method = OCC_INSERT_SUPER_RAYS;
+    for (size_t i = 0; i < 3u; i++) {
+        same_as_cloud(&f[i], &dp_close, &ip);
+    }
+    free_frames(f, 3u);
+    free(r.gt);
+    free(r.list);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_tof_8x8),
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_pools_short),
+        cmocka_unit_test(test_scratch_formula),
+        cmocka_unit_test(test_pioneer_equals_cloud),
+        cmocka_unit_test(test_pioneer_octomap),
+        cmocka_unit_test(test_rpy_interpolated),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
