@@ -390,14 +390,17 @@ static void test_pools_short(void **state)
 
 /* The compile-time formula sizes a static buffer that is enough, and equals the function. */
 #define TOF_RAY_VOXELS 22u /* ceil(2 m / 0.1 m) + 2 */
-static uint8_t tof_scratch[OCC_DEPTH_SCRATCH_BYTES(8, 8, 1, TOF_RAY_VOXELS)];
+static union {
+    uint8_t b[OCC_DEPTH_SCRATCH_BYTES(8, 8, 1, TOF_RAY_VOXELS)];
+    uint32_t align; /* b 4-aligned: b + 1 needs 3 bytes to align the points */
+} tof_scratch;
 
 static void test_scratch_formula(void **state)
 {
     (void)state;
     init_maps(0.1f);
     const occ_insert_params_t ip = occ_insert_params_default();
-    assert_int_equal(occ_depth_scratch_bytes(&map_a, 8u, 8u, 1u, 2.0f, &ip), sizeof tof_scratch);
+    assert_int_equal(occ_depth_scratch_bytes(&map_a, 8u, 8u, 1u, 2.0f, &ip), sizeof tof_scratch.b);
     assert_int_equal(OCC_DEPTH_PIXELS(640, 480, 8), 80u * 60u);
     assert_int_equal(OCC_DEPTH_PIXELS(641, 479, 8), 81u * 60u);
     assert_true(OCC_DEPTH_SCRATCH_FITS(640, 480, 1, 100));
@@ -414,9 +417,10 @@ static void test_scratch_formula(void **state)
         occ_depth_result_t r;
         /* off by one byte from the buffer's start: the alignment term is needed */
         assert_int_equal(occ_map_insert_depth(&map_a, &c.im, &c.dp, &c.pose, &c.ip,
-                                              tof_scratch + 1, sizeof tof_scratch - 1u, &r),
+                                              tof_scratch.b + 1, sizeof tof_scratch.b - 1u, &r),
                          OCC_OK);
-        assert_true(r.scratch_points + r.insert.scratch_used <= sizeof tof_scratch);
+        assert_int_equal(r.scratch_points, 3u + 12u * 62u);
+        assert_true(r.scratch_points + r.insert.scratch_used <= sizeof tof_scratch.b);
     }
 }
 
