@@ -21,3 +21,10 @@ depth-cli: $(BUILD)/occmap
 	  echo "PASS: depth-cli"
 TEST_STEPS += depth-cli
 .PHONY: depth-cli
+
+# The README's depth-camera snippet compiles under the core's warnings against libocc.a and
+# integrates a frame: a flat wall ahead of the camera, its pose from a two-sample history.
+depth-readme: $(BUILD)/libocc.a
+	bash tests/readme_depth.sh $(BUILD)
+TEST_STEPS += depth-readme
+.PHONY: depth-readme
