@@ -404,6 +404,10 @@ static void test_scratch_formula(void **state)
     assert_int_equal(OCC_DEPTH_PIXELS(640, 480, 8), 80u * 60u);
     assert_int_equal(OCC_DEPTH_PIXELS(641, 479, 8), 81u * 60u);
     assert_true(OCC_DEPTH_SCRATCH_FITS(640, 480, 1, 100));
+    /* the largest image saturates instead of wrapping (a 32-bit size_t) */
+    const size_t big = occ_depth_scratch_bytes(&map_a, OCC_DEPTH_MAX_SIDE, OCC_DEPTH_MAX_SIDE, 1u,
+                                               100.0f, &ip);
+    assert_true(big == SIZE_MAX || big / 12u >= (size_t)OCC_DEPTH_MAX_SIDE * OCC_DEPTH_MAX_SIDE);
     assert_int_equal(occ_depth_scratch_bytes(&map_a, 0u, 8u, 1u, 2.0f, &ip), 0);
     assert_int_equal(occ_depth_scratch_bytes(&map_a, 8u, 8u, 0u, 2.0f, &ip), 0);
     assert_int_equal(occ_depth_scratch_bytes(&map_a, 8u, 8u, 1u, INFINITY, &ip), 0);

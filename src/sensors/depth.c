@@ -53,7 +53,10 @@ size_t occ_depth_scratch_bytes(const occ_map_t *map, const uint32_t width, const
     }
     const size_t n = OCC_DEPTH_PIXELS(width, height, pixel_step);
     const size_t cloud = occ_insert_scratch_bytes(map, n, max_range_m, insert);
-    const size_t points = 3u + 12u * n; /* n <= 2^32: no overflow in a 64-bit size_t */
+    if (n > (SIZE_MAX - 3u) / 12u) {
+        return SIZE_MAX; /* a 32-bit size_t: no scratch that big */
+    }
+    const size_t points = 3u + 12u * n;
     return cloud > SIZE_MAX - points ? SIZE_MAX : cloud + points;
 }
 
