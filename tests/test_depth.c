@@ -188,6 +188,41 @@ static void test_tof_8x8(void **state)
                      OCC_OK);
     check_tof_counts(&rf);
     assert_true(iotest_map_digest(&map_a) == iotest_map_digest(&map_b));
+    /* A finite depth too far for float arithmetic is placed like +Inf: the same map again. */
+    m[3 * 8 + 7] = 1e30f;
+    occ_map_clear(&map_b);
+    assert_int_equal(occ_map_insert_depth(&map_b, &imf, &dp, &pose, &ip, scratch, SCRATCH_BYTES,
+                                          &rf),
+                     OCC_OK);
+    check_tof_counts(&rf);
+    assert_true(iotest_map_digest(&map_a) == iotest_map_digest(&map_b));
+    check_tof_map(&map_b);
+}
+
+/* Intrinsics so extreme that every ray overflows float: nothing integrated, no error, the map
+ * unchanged (never an Inf point handed on). */
+static void test_overflowing_rays(void **state)
+{
+    (void)state;
+    init_maps(0.1f);
+    float m[64];
+    for (unsigned i = 0; i < 64u; i++) {
+        m[i] = 0.5f;
+    }
+    const occ_depth_image_t imf = {m, OCC_DEPTH_F32, 8u, 8u, 32u, 0.0f};
+    occ_depth_params_t dp = tof_params();
+    dp.intrinsics.fx = 1e-38f;
+    dp.intrinsics.fy = 1e-38f;
+    const occ_pose_t pose = tof_pose();
+    const occ_insert_params_t ip = occ_insert_params_default();
+    const uint64_t d = iotest_map_digest(&map_a);
+    occ_depth_result_t r;
+    assert_int_equal(occ_map_insert_depth(&map_a, &imf, &dp, &pose, &ip, scratch, SCRATCH_BYTES,
+                                          &r),
+                     OCC_OK);
+    assert_int_equal(r.pixels_no_reading, 64);
+    assert_int_equal(r.points, 0);
+    assert_true(iotest_map_digest(&map_a) == d);
 }
 
 /* ---- bad input: a clear error and the map unchanged ---------------------------------------- */
@@ -748,6 +783,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_tof_8x8),
+        cmocka_unit_test(test_overflowing_rays),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_pools_short),
         cmocka_unit_test(test_scratch_formula),

@@ -15,11 +15,13 @@
  * map_from_camera->p. The range of a pixel is |c| (Euclidean, not d).
  *
  * Pixels, each one on the step grid (u = 0, step, 2 step, ... < width; the same in v):
- *  - no reading: raw 0 (U16); 0, NaN, negative or -Inf (F32): skipped, pixels_no_reading;
+ *  - no reading: raw 0 (U16); 0, NaN, negative or -Inf (F32); a pixel whose |c| overflows
+ *    float (absurd intrinsics): skipped, pixels_no_reading;
  *  - |c| < min_range_m: skipped, pixels_too_close (the sensor's blind zone: no free space);
  *  - |c| > max_range_m: cleared up to max range along the pixel's ray, no hit (OctoMap's
  *    max-range rule, insert_cloud's max_range_m), pixels_beyond_max; an F32 +Inf (REP 117 "no
- *    return within range") is such a pixel: it is placed at depth 2 max_range_m;
+ *    return within range") is such a pixel: it, and any depth beyond 1024 max_range_m (float
+ *    overflow), is placed at depth d = 2 max_range_m on its ray;
  *  - otherwise: free up to the end point, the end point's voxel hit (hits win in one call).
  * The beyond-max decision in the map is insert_cloud's (|p - origin| in the map frame); the
  * counter uses |c| and can differ from insert's rays_clipped by a pixel within float rounding

@@ -107,19 +107,25 @@ static bool back_project(const occ_depth_image_t *im, const occ_depth_params_t *
     const occ_pinhole_t *const k = &dp->intrinsics;
     const float min2 = dp->min_range_m * dp->min_range_m;
     const float max2 = dp->max_range_m * dp->max_range_m;
+    const float far = 1024.0f * dp->max_range_m;
     for (uint32_t v = 0; v < im->height; v += dp->pixel_step) {
         for (uint32_t u = 0; u < im->width; u += dp->pixel_step) {
             out->pixels_sampled++;
             float d = pixel_depth(im, u, v);
-            if (isinf(d) && d > 0.0f) {
-                d = 2.0f * dp->max_range_m; /* REP 117 "no return": clears to max range */
-            } else if (!(d > 0.0f)) { /* 0, NaN, negative, -Inf */
+            if (!(d > 0.0f)) { /* 0, NaN, negative, -Inf */
                 out->pixels_no_reading++;
                 continue;
+            }
+            if (d > far) {
+                d = 2.0f * dp->max_range_m; /* +Inf (REP 117 "no return") or absurdly far */
             }
             const occ_vec3_t c = {((float)u - k->cx) * d / k->fx, ((float)v - k->cy) * d / k->fy,
                                   d};
             const float r2 = c.x * c.x + c.y * c.y + c.z * c.z;
+            if (!isfinite(r2)) { /* the ray itself overflows float: nothing to integrate */
+                out->pixels_no_reading++;
+                continue;
+            }
             if (r2 < min2) {
                 out->pixels_too_close++;
                 continue;
