@@ -4,6 +4,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "build_depth.h"
 #include "cli.h"
 #include "evict_cli.h"
 #include "occmap/host/occ_file.h"
@@ -17,7 +18,9 @@ static void usage(void)
            "         [--arena-bytes N] [-o OUT.bt|.ot|.occ] [--json]\n"
            "  --scan FILE       plain 'x y z' points (OctoMap scan.dat), sensor at --origin (0,0,0)\n"
            "  --graph FILE      OctoMap binary ScanGraph: every node's scan with its pose\n"
-           "  --depth-dir DIR   TUM RGB-D directory (my_association.txt + depth/*.png)\n"
+           "  --depth-dir DIR   TUM RGB-D directory: my_association.txt + depth/*.png, or a\n"
+           "                    sequence: depth.txt + groundtruth.txt (poses interpolated;\n"
+           "                    frames without a pose are dropped and counted)\n"
            "  --res R           voxel edge in metres (default 0.1)\n"
            "  --method M        simple (default), discrete, fast (UFOMap, --n --d), superrays\n"
            "  --max-range M     clear only up to M metres, no hit beyond (default: unlimited)\n"
@@ -29,6 +32,7 @@ static void usage(void)
 typedef struct {
     occ_scan_frame_t *frames;
     size_t n;
+    build_depth_info_t depth; /* --depth-dir: layout, camera, frames dropped */
 } scans_t;
 
 static int load(const char *scan, const char *graph, const char *dir, const float origin[3],
@@ -49,8 +53,7 @@ static int load(const char *scan, const char *graph, const char *dir, const floa
     } else if (graph != NULL) {
         e = occ_scan_read_graph(graph, &out->frames, &out->n, msg, sizeof msg);
     } else {
-        e = occ_depth_read_tum_dir(dir, stride, max_frames, &out->frames, &out->n, msg,
-                                   sizeof msg);
+        return build_depth_load(dir, stride, max_frames, &out->frames, &out->n, &out->depth);
     }
     if (e != OCC_OK) {
         cli_error("build", "%s (%s)", msg[0] != '\0' ? msg : "cannot read input", occ_err_str(e));
@@ -315,6 +318,9 @@ static void print_result(const build_opts_t *o, const occ_map_t *map, const scan
                sum->rays_cast, sum->voxel_visits, sum->voxels_updated, sum->coarse_updated,
                b->need, b->scratch_peak, b->ms);
         evict_cli_print_json(stdout, &o->ev);
+        if (o->dir != NULL) {
+            build_depth_print_json(stdout, &in->depth);
+        }
         printf("}\n");
     } else {
         cli_print_stats_text(stdout, map, &st);
@@ -325,6 +331,9 @@ static void print_result(const build_opts_t *o, const occ_map_t *map, const scan
                sum->rays_cast, sum->voxel_visits, sum->voxels_updated, b->ms);
         printf("scratch           %zu bytes written at most, of %zu allocated (the bound)\n",
                b->scratch_peak, b->need);
+        if (o->dir != NULL) {
+            build_depth_print_text(stdout, &in->depth);
+        }
     }
 }
 
@@ -362,7 +371,8 @@ int cmd_build(int argc, char **argv)
     if (parsed >= 0) {
         return parsed;
     }
-    scans_t in = {NULL, 0};
+    scans_t in;
+    memset(&in, 0, sizeof in);
     if (load(o.scan, o.graph, o.dir, o.origin, (unsigned)o.stride, o.frames, &in) != 0) {
         return 1;
     }

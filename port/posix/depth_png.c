@@ -184,6 +184,34 @@ occ_err_t occ_depth_read_png(const char *path, const occ_depth_camera_t *cam, co
     return OCC_OK;
 }
 
+occ_err_t occ_depth_read_png_image(const char *path, uint16_t **pixels, uint32_t *width,
+                                   uint32_t *height, char *msg, size_t msg_len)
+{
+    if (path == NULL || pixels == NULL || width == NULL || height == NULL) {
+        return OCC_ERR_ARG;
+    }
+    *pixels = NULL;
+    png_job_t j;
+    memset(&j, 0, sizeof j);
+    j.f = fopen(path, "rb");
+    if (j.f == NULL) {
+        set_msg(msg, msg_len, path, -1, strerror(errno));
+        return OCC_ERR_IO;
+    }
+    const occ_err_t e = decode(&j, path, width, height, msg, msg_len);
+    if (j.png != NULL) {
+        png_destroy_read_struct(&j.png, j.info != NULL ? &j.info : NULL, NULL);
+    }
+    (void)fclose(j.f);
+    free(j.rows);
+    if (e != OCC_OK) {
+        free(j.pix);
+        return e;
+    }
+    *pixels = j.pix;
+    return OCC_OK;
+}
+
 occ_err_t occ_depth_read_tum_dir(const char *dir, unsigned stride, size_t max_frames,
                                  occ_scan_frame_t **frames, size_t *n_frames, char *msg,
                                  size_t msg_len)

@@ -275,3 +275,15 @@ extern "C" bool oracle_io_equivalent(const oracle_io_t *a, const oracle_io_t *b,
     }
     return w.empty();
 }
+
+extern "C" void oracle_io_insert_cloud(oracle_io_t *t, const float *xyz, size_t n,
+                                       const float origin[3], double max_range_m, bool discretize)
+{
+    octomap::Pointcloud pc;
+    pc.reserve(n);
+    for (size_t i = 0; i < n; i++) {
+        pc.push_back(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    }
+    const octomap::point3d o(origin[0], origin[1], origin[2]);
+    visit(t, [&](auto *p) { p->insertPointCloud(pc, o, max_range_m, false, discretize); return 0; });
+}

@@ -47,6 +47,10 @@ bool oracle_io_insert_graph(oracle_io_t *t, const char *path, unsigned max_scans
                             double max_range_m);
 
 /* Visit every leaf; returns the count. */
+/* insertPointCloud(points in the map frame, origin, max_range (<= 0: none), lazy_eval false,
+ * discretize) on an ORACLE_OCTREE (the depth tests' reference). */
+void oracle_io_insert_cloud(oracle_io_t *t, const float *xyz, size_t n, const float origin[3],
+                            double max_range_m, bool discretize);
 typedef void (*oracle_io_leaf_fn)(void *ctx, const uint32_t key[3], unsigned level,
                                   float logodds);
 size_t oracle_io_for_each_leaf(const oracle_io_t *t, oracle_io_leaf_fn fn, void *ctx);

@@ -61,6 +61,11 @@ occ_err_t occ_depth_read_png(const char *path, const occ_depth_camera_t *cam, co
                              const float q[4], unsigned stride, occ_scan_frame_t *frame,
                              char *msg, size_t msg_len);
 
+/* The raw pixels of a 16-bit grayscale PNG (host byte order, row stride width * 2): *pixels
+ * (malloc'd, free() it), *width, *height. Errors as occ_depth_read_png(). */
+occ_err_t occ_depth_read_png_image(const char *path, uint16_t **pixels, uint32_t *width,
+                                   uint32_t *height, char *msg, size_t msg_len);
+
 /* A TUM RGB-D directory: DIR/my_association.txt (lines "rgb_file depth_file tx ty tz qx qy qz
  * qw", '#' comments) and the depth PNGs it names; lines whose depth file is absent are skipped
  * (the shared data holds 10 of its frames). At most max_frames frames (0: all), in file order.
