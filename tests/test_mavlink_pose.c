@@ -38,9 +38,7 @@ static void position(float north, float east, float down)
 {
     mavlink_local_position_ned_t lp;
     memset(&lp, 0, sizeof lp);
-    lp.x = north;
-    lp.y = east;
-    lp.z = down;
+    lp.x = north, lp.y = east, lp.z = down; /* local NED, metres */
     rx(MAVLINK_MSG_ID_LOCAL_POSITION_NED, &lp, sizeof lp);
 }
 

@@ -70,7 +70,8 @@ occ_vec3_t occ_pose_rotate(const occ_pose_t *a_from_b, occ_vec3_t d_b);
 
 /* Heading of the pose's x axis about frame a's z axis, (-pi, pi]: in the ENU map 0 = east,
  * counter-clockwise positive; for a NED pose (occ_pose_to_ned) 0 = north, clockwise. Roll and
- * pitch do not change it (it is the yaw of the ZYX Euler angles). */
+ * pitch do not change it (it is the yaw of the ZYX Euler angles; pitched straight up or down,
+ * where the x axis has no heading, it is the yaw occ_quat_to_euler() gives). */
 float occ_pose_yaw(const occ_pose_t *pose);
 
 /* ---- autopilot (NED / FRD) ---------------------------------------------------------------- */
@@ -143,7 +144,9 @@ occ_err_t occ_pose_history_span(const occ_pose_history_t *h, uint64_t *oldest_us
                                 uint64_t *newest_us);
 
 /* Interpolation of two poses at fraction s (0 = a, 1 = b; outside [0, 1] extrapolates):
- * position a.p + s (b.p - a.p), rotation slerp along the shortest arc. */
+ * position a.p + s (b.p - a.p), rotation slerp along the shortest arc (q and -q are the same
+ * rotation); outside [0, 1] the turn from a to b continues about the same axis at the same
+ * rate. a and b unit (occ_pose_check); the result is unit. O(1). */
 occ_pose_t occ_pose_interpolate(const occ_pose_t *a, const occ_pose_t *b, float s);
 
 #ifdef __cplusplus

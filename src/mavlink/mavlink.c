@@ -449,11 +449,3 @@ occ_err_t occ_mav_decode_command_ack(const occ_mav_frame_t *f, occ_mav_command_a
     out->target_component = s.target_component;
     return OCC_OK;
 }
-
-float occ_mav_quat_yaw(const float q[4], float *roll, float *pitch)
-{
-    const occ_quat_t qq = {q[0], q[1], q[2], q[3]};
-    float yaw = 0.0f;
-    occ_quat_to_euler(qq, roll, pitch, &yaw);
-    return yaw;
-}

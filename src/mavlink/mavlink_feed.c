@@ -109,6 +109,14 @@ static occ_quat_t quat_of(const float q[4])
     return r;
 }
 
+/* Here, not in the codec (mavlink.c builds alone for the fuzzer): it is the pose module's. */
+float occ_mav_quat_yaw(const float q[4], float *roll, float *pitch)
+{
+    float yaw = 0.0f;
+    occ_quat_to_euler(quat_of(q), roll, pitch, &yaw);
+    return yaw;
+}
+
 /* A finite local NED position (false, nothing taken, otherwise). */
 static bool set_position(occ_mav_feed_t *f, float north, float east, float down, uint64_t now_us)
 {
