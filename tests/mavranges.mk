@@ -1,0 +1,6 @@
+# mavranges.mk - MAVLink range messages (DISTANCE_SENSOR, OBSTACLE_DISTANCE, _3D) as beams: the
+# frames pymavlink builds for test_mavlink_ranges.c.
+$(MAV_REF)/ranges_frames.bin: tools/mav_ranges_golden.py $(BUILD)/.deps-ok
+	@mkdir -p $(dir $@)
+	$(PY) tools/mav_ranges_golden.py $@ $(MAV_REF)/ranges_frames.txt
+TEST_BUILD_EXTRA += $(MAV_REF)/ranges_frames.bin
