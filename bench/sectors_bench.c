@@ -36,7 +36,7 @@ static void run(const char *name, const occ_map_t *map, const occ_sectors_config
     static double nodes[MAXP];
     int n = 0;
     for (float x = -5.0f; x <= 26.0f && n < MAXP; x += 0.25f, n++) {
-        occ_pose_t p = {x, (n & 1) ? -0.1f : -0.5f, z, (float)n * 0.37f, 0.0f, 0.0f};
+        occ_yaw_pose_t p = {x, (n & 1) ? -0.1f : -0.5f, z, (float)n * 0.37f, 0.0f, 0.0f};
         double best = 1e30;
         for (int r = 0; r < 7; r++) {
             const double a = now_us();
@@ -109,7 +109,7 @@ int main(int argc, char **argv)
     if (cg) {
         int n = 0;
         for (float x = -5.0f; x <= 26.0f; x += 0.25f, n++) {
-            occ_pose_t p = {x, (n & 1) ? -0.1f : -0.5f, 1.0f, (float)n * 0.37f, 0.0f, 0.0f};
+            occ_yaw_pose_t p = {x, (n & 1) ? -0.1f : -0.5f, 1.0f, (float)n * 0.37f, 0.0f, 0.0f};
             (void)occ_sectors_compute(&map, &p, &def, &out);
         }
         printf("callgrind: %d updates\n", n);

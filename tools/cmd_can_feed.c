@@ -96,17 +96,17 @@ static int sectors_config(const can_opts_t *o, const feed_args_t *fa, occ_sector
 }
 
 /* --pose (NED metres, yaw degrees from north) in the map's frame. */
-static occ_pose_t fixed_pose(const can_opts_t *o, const bool map_ned)
+static occ_yaw_pose_t fixed_pose(const can_opts_t *o, const bool map_ned)
 {
     const float deg = 3.14159265358979f / 180.0f;
     const float *const v = o->pose_v;
-    occ_pose_t pose;
+    occ_yaw_pose_t pose;
     memset(&pose, 0, sizeof pose);
     if (!o->have_pose) {
         return pose;
     }
     if (!map_ned) {
-        return occ_pose_from_ned(v[0], v[1], v[2], v[3] * deg);
+        return occ_yaw_pose_from_ned(v[0], v[1], v[2], v[3] * deg);
     }
     pose.x = v[0];
     pose.y = v[1];
@@ -213,7 +213,7 @@ static int node_open(occ_dronecan_node_t *node, const can_opts_t *o, const feed_
 typedef struct {
     const occ_map_t *map;
     occ_sectors_config_t sectors;
-    occ_pose_t pose;           /* fixed, or the last live one */
+    occ_yaw_pose_t pose;           /* fixed, or the last live one */
     occ_link_t *mav_link;      /* NULL with --pose */
     occ_mav_feed_t *mav;       /* the live pose's parser (with mav_link) */
     bus_t *bus;

@@ -232,7 +232,7 @@ static void log_autopilot(const occ_mav_feed_t *feed, bool *named, uint32_t *ref
 /* --verbose, once a second: the pose and the counters. */
 static void log_progress(const occ_mav_feed_t *feed, const uint64_t now, const uint64_t t0)
 {
-    occ_pose_t p;
+    occ_yaw_pose_t p;
     const bool fresh = occ_mav_feed_pose(feed, now, &p);
     fprintf(stderr, "feed: t=%.1fs pose %s (%.2f %.2f %.2f yaw %.1f deg) tx %u obstacle %u hb"
             ", rx ok %u bad %u\n", (double)(now - t0) * 1e-6, fresh ? "fresh" : "stale",

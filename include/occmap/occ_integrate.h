@@ -130,6 +130,8 @@ typedef struct {
     size_t points_integrated; /* points that produced a ray or a hit */
     size_t points_skipped;    /* bad points: NaN / Inf, or (within max range) outside the map */
     size_t rays_clipped;      /* rays longer than max range: cleared up to max range, no hit */
+    size_t rays_no_hit;       /* occ_map_insert_rays: no-hit points within max range (cleared
+                               * up to the point, end voxel not marked) */
     size_t rays_cast;         /* traversals run (DISCRETE: distinct end voxels; super rays) */
     size_t voxel_visits;      /* keys produced by traversals, before de-duplication */
     size_t voxels_updated;    /* distinct voxels updated (= voxels_free + voxels_occupied) */
@@ -180,6 +182,23 @@ occ_err_t occ_map_insert_cloud(occ_map_t *map, const occ_vec3_t *origin,
                                const occ_vec3_t *points, size_t n_points,
                                const occ_insert_params_t *params, void *scratch,
                                size_t scratch_bytes, occ_insert_result_t *out);
+
+/* occ_map_insert_cloud() with a per-point hit flag: hit[i] == false makes point i the end of
+ * a ray that only clears - the voxels up to the point (to max range if it lies beyond) are
+ * updated as free and the point's own voxel is not marked, exactly what insert_cloud does for a
+ * point beyond max range (OctoMap insertRay() with a max range the end exceeds). hit == NULL:
+ * every point is a hit (this is then occ_map_insert_cloud()). Rangefinders (occ_ranges.h) use
+ * it for "no return within the sensor's own max range", which a single max_range_m cannot say.
+ * A no-hit point is traced the way the method traces rays: SIMPLE and SUPER_RAYS exactly to
+ * the point; DISCRETE and FAST_DISCRETE take it apart from the discretised end voxels, to the
+ * point itself (FAST_DISCRETE: with its coarse march). Counted in out->rays_no_hit (within max
+ * range) or rays_clipped (beyond it) and in points_integrated. The sets, scratch (the same
+ * bounds), errors, all-or-nothing rule and work are occ_map_insert_cloud()'s; `hit` is read,
+ * never kept. */
+occ_err_t occ_map_insert_rays(occ_map_t *map, const occ_vec3_t *origin, const occ_vec3_t *points,
+                              const bool *hit, size_t n_points,
+                              const occ_insert_params_t *params, void *scratch,
+                              size_t scratch_bytes, occ_insert_result_t *out);
 
 /* ---- Exact ray keys ----------------------------------------------------------------------- */
 /* The voxels OctoMap's computeRayKeys(origin, end) visits, in its order: the origin's voxel

@@ -135,7 +135,7 @@ int main(void)
     scfg.band_below_m = 0.04f;
     scfg.band_above_m = 0.04f;
     scfg.unknown_as_distance = true;
-    const occ_pose_t pose = occ_pose_from_ned(0.0f, 0.0f, -z0, 0.0f);
+    const occ_yaw_pose_t pose = occ_yaw_pose_from_ned(0.0f, 0.0f, -z0, 0.0f);
 
     /* The main loop: 3 simulated seconds at 1 kHz; the mailboxes drain every millisecond. */
     uint32_t errors = 0;

@@ -157,15 +157,19 @@ static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3]
     x->n += w;
 }
 
-int occi_ictx_point(occ_ictx_t *const x, const float p[3])
+int occi_ictx_point(occ_ictx_t *const x, const float p[3], const bool hit)
 {
     if (!occ_finite(p[0]) || !occ_finite(p[1]) || !occ_finite(p[2])) {
         return 1;
     }
     uint32_t ke[3];
-    if (x->max_range > 0.0f && occi_raygeo_dist(x->o, p) > x->max_range_r) {
-        float e[3];
-        occi_raygeo_clip(x->o, p, x->max_range, e);
+    const bool clip = x->max_range > 0.0f && occi_raygeo_dist(x->o, p) > x->max_range_r;
+    if (clip || !hit) {
+        /* OctoMap's max-range rule, or a caller's no-hit ray: clear up to e, mark nothing. */
+        float e[3] = {p[0], p[1], p[2]};
+        if (clip) {
+            occi_raygeo_clip(x->o, p, x->max_range, e);
+        }
         if (!occi_raygeo_key(&x->g, e, ke)) {
             return 1;
         }
@@ -173,7 +177,11 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3])
             return -1;
         }
         ictx_ray(x, e, ke);
-        x->r->rays_clipped++;
+        if (clip) {
+            x->r->rays_clipped++;
+        } else {
+            x->r->rays_no_hit++;
+        }
         return 0;
     }
     if (!occi_raygeo_key(&x->g, p, ke)) {
@@ -192,6 +200,28 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3])
     return 0;
 }
 
+int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                     const bool no_hit_only)
+{
+    for (size_t i = 0; i < n; i++) {
+        const bool hit = occ_ictx_hit(x, i);
+        if (no_hit_only && hit) {
+            continue;
+        }
+        const float q[3] = {points[i].x, points[i].y, points[i].z};
+        const int rc = occi_ictx_point(x, q, hit);
+        if (rc < 0) {
+            return rc;
+        }
+        if (rc == 0) {
+            x->r->points_integrated++;
+        } else {
+            x->r->points_skipped++;
+        }
+    }
+    return 0;
+}
+
 /* ---- DISCRETE: one ray per distinct end voxel, to its centre ------------------------------- */
 /* End voxels are de-duplicated by their index in the scan's box (no Morton order is needed:
  * rays are independent), which sorts in 2-3 radix passes instead of 5. */
@@ -202,6 +232,9 @@ static size_t discretize(occ_ictx_t *const x, const occ_vec3_t *const points, co
     const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
+        if (!occ_ictx_hit(x, i)) {
+            continue; /* a no-hit ray: cast to its own point after the end voxels */
+        }
         const float p[3] = {points[i].x, points[i].y, points[i].z};
         uint32_t k[3];
         if (occi_raygeo_key(&x->g, p, k)) { /* also rejects NaN / Inf */
@@ -219,6 +252,7 @@ static size_t discretize(occ_ictx_t *const x, const occ_vec3_t *const points, co
         }
     }
     x->r->points_integrated = m;
+    x->n_ends = m;
     /* a and b are still empty: use them as the sort's buffers. Keys outside the box carry
      * bit 63 (ignored by the sort); they are rare and may repeat, which only repeats a ray. */
     occ_ictx_note(x, m, 0);
@@ -247,7 +281,7 @@ static int run_discrete(occ_ictx_t *const x, const occ_code_t *const ends, const
         }
         const float c[3] = {occi_raygeo_center(&x->g, k.k[0]), occi_raygeo_center(&x->g, k.k[1]),
                             occi_raygeo_center(&x->g, k.k[2])};
-        const int rc = occi_ictx_point(x, c);
+        const int rc = occi_ictx_point(x, c, true);
         if (rc < 0) {
             return rc;
         }
@@ -260,27 +294,17 @@ static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const para
                       const occ_vec3_t *const points, const size_t n_points,
                       occ_code_t *const ends)
 {
-    occ_insert_result_t *const r = x->r;
-    int rc = 0;
     switch (params->method) {
     case OCC_INSERT_SIMPLE:
-        for (size_t i = 0; i < n_points && rc >= 0; i++) {
-            const float q[3] = {points[i].x, points[i].y, points[i].z};
-            rc = occi_ictx_point(x, q);
-            if (rc == 0) {
-                r->points_integrated++;
-            } else if (rc > 0) {
-                r->points_skipped++;
-            }
-        }
-        return rc < 0 ? rc : 0;
+        return occi_ictx_points(x, points, n_points, false);
     case OCC_INSERT_DISCRETE:
     case OCC_INSERT_FAST_DISCRETE: {
         if (x->cap < n_points) {
             return -1; /* the end-voxel sort borrows a[] */
         }
         const size_t u = discretize(x, points, n_points, ends);
-        return run_discrete(x, ends, u);
+        const int rc = run_discrete(x, ends, u);
+        return rc < 0 || x->hit == NULL ? rc : occi_ictx_points(x, points, n_points, true);
     }
     case OCC_INSERT_SUPER_RAYS:
         return occi_superray_run(x, points, n_points, params->super_k) ? 0 : -1;
@@ -523,7 +547,7 @@ static size_t touched_bytes(const occ_ictx_t *const x, const occ_insert_params_t
         b += 8u * (dense_bricks + x->bs->n_touched);
     }
     if (params->method == OCC_INSERT_DISCRETE || params->method == OCC_INSERT_FAST_DISCRETE) {
-        b += 8u * x->r->points_integrated;
+        b += 8u * x->n_ends;
     }
     if (x->cbs != NULL) {
         b += 8u * (cbricks + x->cbs->n_touched);
@@ -531,15 +555,12 @@ static size_t touched_bytes(const occ_ictx_t *const x, const occ_insert_params_t
     return b + 8u * (x->a_hwm + x->b_hwm);
 }
 
-occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const origin,
-                               const occ_vec3_t *const points, const size_t n_points,
-                               const occ_insert_params_t *const params, void *const scratch,
-                               const size_t scratch_bytes, occ_insert_result_t *const out)
+/* ---- entry: the call's steps ---------------------------------------------------------------- */
+static occ_err_t check_args(const occ_map_t *const map, const occ_vec3_t *const origin,
+                            const occ_vec3_t *const points, const size_t n_points,
+                            const occ_insert_params_t *const params, const void *const scratch,
+                            const size_t scratch_bytes)
 {
-    occ_insert_result_t local;
-    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
-    occ_insert_result_t *const r = out != NULL ? out : &local;
-    memset(r, 0, sizeof *r);
     if (map == NULL || origin == NULL || params == NULL || (points == NULL && n_points > 0u) ||
         (scratch == NULL && scratch_bytes > 0u)) {
         return OCC_ERR_ARG;
@@ -549,115 +570,188 @@ occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const ori
         params->fast_d >= map->cfg.depth_levels || isnan(params->max_range_m)) {
         return OCC_ERR_ARG;
     }
-    if (!occ_finite3(*origin)) {
-        return OCC_ERR_ARG;
-    }
-    occ_ictx_t x;
-    memset(&x, 0, sizeof x);
-    x.map = map;
-    x.r = r;
-    occi_raygeo_init(&x.g, map);
-    x.o[0] = origin->x;
-    x.o[1] = origin->y;
-    x.o[2] = origin->z;
-    if (!occi_raygeo_key(&x.g, x.o, x.ko)) {
+    return occ_finite3(*origin) ? OCC_OK : OCC_ERR_ARG;
+}
+
+/* The context for one call: geometry, origin and its key, max range. */
+static occ_err_t ictx_begin(occ_ictx_t *const x, occ_map_t *const map,
+                            const occ_vec3_t *const origin, const occ_insert_params_t *const params,
+                            occ_insert_result_t *const r)
+{
+    memset(x, 0, sizeof *x);
+    x->map = map;
+    x->r = r;
+    occi_raygeo_init(&x->g, map);
+    x->o[0] = origin->x;
+    x->o[1] = origin->y;
+    x->o[2] = origin->z;
+    if (!occi_raygeo_key(&x->g, x->o, x->ko)) {
         return OCC_ERR_RANGE;
     }
-    x.max_range = params->max_range_m > 0.0f ? params->max_range_m : -1.0f;
-    x.max_range_r = (occ_rr_t)x.max_range;
+    x->max_range = params->max_range_m > 0.0f ? params->max_range_m : -1.0f;
+    x->max_range_r = (occ_rr_t)x->max_range;
+    return OCC_OK;
+}
 
-    /* Carve the scratch: filter | histograms | end voxels (n) | the rest. */
+/* The scratch after the fixed carve: filter | histograms | end voxels (ends_n) | rest. */
+typedef struct {
+    occ_code_t *ends;
+    uint8_t *rest;
+    size_t rest_bytes;
+} carve_t;
+
+static bool carve_scratch(occ_ictx_t *const x, void *const scratch, const size_t scratch_bytes,
+                          const size_t ends_n, carve_t *const c)
+{
     uint8_t *const p = scratch != NULL ? align8(scratch) : NULL;
     const size_t pad = p != NULL ? (size_t)(p - (uint8_t *)scratch) : 0u;
     const size_t usable = occ_sat_sub(scratch_bytes, pad) < SCRATCH_MAX
                               ? occ_sat_sub(scratch_bytes, pad)
                               : SCRATCH_MAX;
-    const size_t ends_bytes = uses_ends(params->method) ? occ_sat_mul(n_points, 8u) : 0u;
+    const size_t ends_bytes = occ_sat_mul(ends_n, 8u);
     if (p == NULL || usable < occ_sat_add(FIXED_RT, ends_bytes)) {
+        return false;
+    }
+    x->filt = (occ_code_t *)(void *)p;
+    x->hist = (uint32_t *)(void *)(p + FILTER_N * 8u);
+    c->ends = (occ_code_t *)(void *)(p + FIXED_RT);
+    c->rest = p + FIXED_RT + ends_bytes;
+    c->rest_bytes = usable - FIXED_RT - ends_bytes;
+    return true;
+}
+
+/* FAST_DISCRETE, d > 0: the coarse nodes' set over the same box at level d (2048 bricks per
+ * axis are 2^33: the product saturates, it never wraps), carved from the rest. Returns its
+ * bricks, or 0 when it does not fit. */
+static size_t setup_coarse(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                           occ_bitset_t *const cbs, carve_t *const c)
+{
+    x->cd = params->fast_d;
+    x->cn = params->fast_n;
+    size_t cbricks = 1;
+    for (unsigned a = 0; a < 3u; a++) {
+        cbs->b0[a] = ((x->box_lo[a] >> x->cd) >> 2) & ~7u;
+        cbs->nb[a] = ((((x->box_hi[a] >> x->cd) >> 2) - cbs->b0[a]) | 7u) + 1u;
+        cbricks = occ_sat_mul(cbricks, cbs->nb[a]);
+    }
+    cbs->stride_y = cbs->nb[0] >> 3;
+    cbs->stride_z = (size_t)(cbs->nb[0] >> 3) * (cbs->nb[1] >> 3);
+    if (cbricks > c->rest_bytes / 32u) {
+        return 0;
+    }
+    cbs->words = (uint64_t *)(void *)c->rest;
+    cbs->touched = cbs->words + cbricks;
+    c->rest += 16u * cbricks;
+    c->rest_bytes -= 16u * cbricks;
+    x->cbs = cbs;
+    return cbricks;
+}
+
+/* Lay out one pass: the dense set and the hits after it, or the sorted path's code arrays. */
+static void layout_pass(occ_ictx_t *const x, const carve_t *const c, const bool dense,
+                        occ_bitset_t *const bs, const size_t bricks, const size_t hits_cap)
+{
+    x->n = 0;
+    x->a_hwm = 0;
+    x->b_hwm = 0;
+    if (dense) {
+        bs->words = (uint64_t *)(void *)c->rest;
+        bs->touched = bs->words + bricks;
+        bs->n_touched = 0;
+        bs->n_set = 0;
+        bs->overflow = false;
+        memset(bs->words, 0, bricks * 8u);
+        x->bs = bs;
+        x->a = bs->touched + bricks;
+        x->cap = hits_cap;
+        x->b = x->a + hits_cap;
+        x->b_cap = (size_t)((c->rest + c->rest_bytes) - (uint8_t *)(void *)x->b) / 8u;
+    } else {
+        memset(x->filt, 0xFF, FILTER_N * 8u); /* bit 63 set: never a code */
+        x->bs = NULL;
+        x->cap = c->rest_bytes / 16u;
+        x->a = (occ_code_t *)(void *)c->rest;
+        x->b = x->a + x->cap;
+    }
+}
+
+/* Trace the scan: in the dense set when the box fits the scratch, else as sorted codes (also
+ * when a visit fell outside the box, which the padding should rule out). Returns run_method's
+ * code; *dense says which path holds the result. */
+static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                      const occ_vec3_t *const points, const size_t n_points, const carve_t *c,
+                      occ_bitset_t *const bs, const size_t bricks, const size_t cbricks,
+                      bool *const dense)
+{
+    const size_t hits_cap = occ_sat_add(n_points, 1u);
+    /* FAST_DISCRETE with n = 0 casts no voxel rays: only hits, no dense set needed. */
+    const bool no_fine = x->cbs != NULL && x->cn == 0u;
+    *dense = !no_fine && bricks > 0u && bricks <= c->rest_bytes / 64u &&
+             hits_cap <= (c->rest_bytes / 2u - 16u * bricks) / 16u;
+    int rc = 0;
+    for (unsigned attempt = 0; attempt < 2u; attempt++) {
+        if (x->cbs != NULL) {
+            memset(x->cbs->words, 0, cbricks * 8u);
+            x->cbs->n_touched = 0;
+            x->cbs->n_set = 0;
+            x->cbs->overflow = false;
+        }
+        layout_pass(x, c, *dense, bs, bricks, hits_cap);
+        rc = run_method(x, params, points, n_points, c->ends);
+        if (rc < 0 || !*dense || !bs->overflow) {
+            break;
+        }
+        memset(x->r, 0, sizeof *x->r); /* cannot happen with the padded box; stay exact anyway */
+        *dense = false;
+    }
+    return rc;
+}
+
+occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const origin,
+                              const occ_vec3_t *const points, const bool *const hit,
+                              const size_t n_points, const occ_insert_params_t *const params,
+                              void *const scratch, const size_t scratch_bytes,
+                              occ_insert_result_t *const out)
+{
+    occ_insert_result_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
+    occ_insert_result_t *const r = out != NULL ? out : &local;
+    memset(r, 0, sizeof *r);
+    occ_err_t e = check_args(map, origin, points, n_points, params, scratch, scratch_bytes);
+    occ_ictx_t x;
+    if (e != OCC_OK || (e = ictx_begin(&x, map, origin, params, r)) != OCC_OK) {
+        return e;
+    }
+    x.hit = hit;
+    carve_t c;
+    if (!carve_scratch(&x, scratch, scratch_bytes, uses_ends(params->method) ? n_points : 0u,
+                       &c)) {
         return OCC_ERR_SCRATCH;
     }
-    x.filt = (occ_code_t *)(void *)p;
-    x.hist = (uint32_t *)(void *)(p + FILTER_N * 8u);
-    occ_code_t *const ends = (occ_code_t *)(void *)(p + FIXED_RT);
-    uint8_t *rest = p + FIXED_RT + ends_bytes;
-    size_t rest_bytes = usable - FIXED_RT - ends_bytes;
-
-    /* Dense set when the scan's box is small enough for the scratch, else sorted codes. */
     occ_bitset_t bs, cbs;
     memset(&bs, 0, sizeof bs);
     memset(&cbs, 0, sizeof cbs);
     const size_t bricks = box_bricks(&x, points, n_points, &bs);
     size_t cbricks = 0;
-    if (params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u) {
-        /* The coarse nodes' set, over the same box at level d (2048 bricks per axis are 2^33:
-         * the product saturates, it never wraps). */
-        x.cd = params->fast_d;
-        x.cn = params->fast_n;
-        cbricks = 1;
-        for (unsigned a = 0; a < 3u; a++) {
-            cbs.b0[a] = ((x.box_lo[a] >> x.cd) >> 2) & ~7u;
-            cbs.nb[a] = ((((x.box_hi[a] >> x.cd) >> 2) - cbs.b0[a]) | 7u) + 1u;
-            cbricks = occ_sat_mul(cbricks, cbs.nb[a]);
-        }
-        cbs.stride_y = cbs.nb[0] >> 3;
-        cbs.stride_z = (size_t)(cbs.nb[0] >> 3) * (cbs.nb[1] >> 3);
-        if (cbricks > rest_bytes / 32u) {
-            return OCC_ERR_SCRATCH;
-        }
-        cbs.words = (uint64_t *)(void *)rest;
-        cbs.touched = cbs.words + cbricks;
-        rest += 16u * cbricks;
-        rest_bytes -= 16u * cbricks;
-        x.cbs = &cbs;
+    if (params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u &&
+        (cbricks = setup_coarse(&x, params, &cbs, &c)) == 0u) {
+        return OCC_ERR_SCRATCH;
     }
-    const size_t hits_cap = occ_sat_add(n_points, 1u);
-    /* FAST_DISCRETE with n = 0 casts no voxel rays: only hits, no dense set needed. */
-    const bool no_fine = x.cbs != NULL && x.cn == 0u;
-    bool dense = !no_fine && bricks > 0u && bricks <= rest_bytes / 64u &&
-                 hits_cap <= (rest_bytes / 2u - 16u * bricks) / 16u;
-    int rc = 0;
-    for (unsigned attempt = 0; attempt < 2u; attempt++) {
-        x.n = 0;
-        x.a_hwm = 0;
-        x.b_hwm = 0;
-        if (x.cbs != NULL) {
-            memset(cbs.words, 0, cbricks * 8u);
-            cbs.n_touched = 0;
-            cbs.n_set = 0;
-            cbs.overflow = false;
-        }
-        if (dense) {
-            bs.words = (uint64_t *)(void *)rest;
-            bs.touched = bs.words + bricks;
-            bs.n_touched = 0;
-            bs.n_set = 0;
-            bs.overflow = false;
-            memset(bs.words, 0, bricks * 8u);
-            x.bs = &bs;
-            x.a = bs.touched + bricks;
-            x.cap = hits_cap;
-            x.b = x.a + hits_cap;
-            x.b_cap = (size_t)((rest + rest_bytes) - (uint8_t *)(void *)x.b) / 8u;
-        } else {
-            memset(x.filt, 0xFF, FILTER_N * 8u); /* bit 63 set: never a code */
-            x.bs = NULL;
-            x.cap = rest_bytes / 16u;
-            x.a = (occ_code_t *)(void *)rest;
-            x.b = x.a + x.cap;
-        }
-        rc = run_method(&x, params, points, n_points, ends);
-        if (rc >= 0 && dense && bs.overflow) {
-            memset(r, 0, sizeof *r); /* cannot happen with the padded box; stay exact anyway */
-            dense = false;
-            continue;
-        }
-        break;
-    }
+    bool dense = false;
+    const int rc = trace_scan(&x, params, points, n_points, &c, &bs, bricks, cbricks, &dense);
     occ_ictx_note(&x, x.n, 0);
-    const occ_err_t e = rc < 0 || (x.cbs != NULL && cbs.overflow)
-                            ? OCC_ERR_SCRATCH
-                            : collapse_and_apply(&x, params, origin, dense, &bs, &cbs);
+    e = rc < 0 || (x.cbs != NULL && cbs.overflow)
+            ? OCC_ERR_SCRATCH
+            : collapse_and_apply(&x, params, origin, dense, &bs, &cbs);
     r->scratch_used = touched_bytes(&x, params, dense ? bricks : 0u, cbricks);
     return e;
 }
 
+occ_err_t occ_map_insert_cloud(occ_map_t *const map, const occ_vec3_t *const origin,
+                               const occ_vec3_t *const points, const size_t n_points,
+                               const occ_insert_params_t *const params, void *const scratch,
+                               const size_t scratch_bytes, occ_insert_result_t *const out)
+{
+    return occ_map_insert_rays(map, origin, points, NULL, n_points, params, scratch,
+                               scratch_bytes, out);
+}

@@ -159,8 +159,16 @@ typedef struct {
     uint8_t cd, cn;        /* FAST_DISCRETE: coarse level d and n */
     uint32_t box_lo[3], box_hi[3]; /* keys of the scan's box (padded) */
     size_t a_hwm, b_hwm;   /* codes ever written at a[] and at b[] (scratch_used) */
+    size_t n_ends;         /* DISCRETE: end voxels written (scratch_used) */
+    const bool *hit;       /* per point, false: no hit (occ_map_insert_rays); NULL: all hit */
     occ_insert_result_t *r;
 } occ_ictx_t;
+
+/* Does point i mark its end voxel (false: its ray only clears)? */
+static inline bool occ_ictx_hit(const occ_ictx_t *x, size_t i)
+{
+    return x->hit == NULL || x->hit[i];
+}
 
 /* Note that codes a[0..na) and b[0..nb) have been written. */
 static inline void occ_ictx_note(occ_ictx_t *x, size_t na, size_t nb)
@@ -180,9 +188,13 @@ static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
 /* FAST_DISCRETE's ray (fastdiscrete.c): coarse marching, then fine DDA near the end. */
 void occi_fast_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
 
-/* One point as OctoMap's computeUpdate() treats it: max range, keys, ray, hit.
+/* One point as OctoMap's computeUpdate() treats it: max range, keys, ray, and the hit unless
+ * `hit` is false (then the ray to p clears and p's voxel is not marked, as for a clipped ray).
  * Returns 0 (integrated), 1 (bad point, skipped) or -1 (no scratch). */
-int occi_ictx_point(occ_ictx_t *x, const float p[3]);
+int occi_ictx_point(occ_ictx_t *x, const float p[3], bool hit);
+/* occi_ictx_point() on points[0..n) (only the no-hit ones if no_hit_only), each counted as
+ * integrated or skipped. Returns 0, or -1 when scratch ran out. */
+int occi_ictx_points(occ_ictx_t *x, const occ_vec3_t *points, size_t n, bool no_hit_only);
 
 /* SUPER_RAYS (superray.c): integrate the valid points whose end voxel codes are ends[0..n)
  * (sorted, bit 63 clear) - equal result to occi_ictx_point() on each. `work` has work_cap codes.

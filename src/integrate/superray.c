@@ -277,23 +277,6 @@ static bool run_voxel(occ_ictx_t *const x, const occ_vec3_t *const points,
     return true;
 }
 
-static bool run_single(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        const float q[3] = {points[i].x, points[i].y, points[i].z};
-        const int rc = occi_ictx_point(x, q);
-        if (rc < 0) {
-            return false;
-        }
-        if (rc == 0) {
-            x->r->points_integrated++;
-        } else {
-            x->r->points_skipped++;
-        }
-    }
-    return true;
-}
-
 bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
                        const uint16_t k_min)
 {
@@ -303,7 +286,7 @@ bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, cons
                                     SR_MAX_GROUP * (sizeof(sr_ray_t) + 8u) +
                                         3u * SR_MAX_EDGES * sizeof(occ_rr_t) + SR_STAMPS * 4u + 64u);
     if (x->bs == NULL || x->b_cap < need / 8u + 1u || n >= UINT32_MAX) {
-        return run_single(x, points, n);
+        return occi_ictx_points(x, points, n, false) == 0;
     }
     occ_ictx_note(x, 0, need / 8u + 1u);
     uint64_t *const keys = x->b;
@@ -328,9 +311,11 @@ bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, cons
         }
         const float q[3] = {points[i].x, points[i].y, points[i].z};
         uint32_t k[3];
-        if ((x->max_range > 0.0f && occi_raygeo_dist(x->o, q) > x->max_range_r) ||
+        if (!occ_ictx_hit(x, i) ||
+            (x->max_range > 0.0f && occi_raygeo_dist(x->o, q) > x->max_range_r) ||
             !occi_raygeo_key(&x->g, q, k)) {
-            const int rc = occi_ictx_point(x, q); /* clipped ray, or a bad point */
+            /* no-hit or clipped ray, or a bad point: cast singly */
+            const int rc = occi_ictx_point(x, q, occ_ictx_hit(x, i));
             if (rc < 0) {
                 return false;
             }
