@@ -14,6 +14,9 @@
  *    NOT_CONNECTED reading when there is no map), NodeStatus at 1 Hz, GetNodeInfo answered.
  *  - occ_dronecan_poll_map() (dronecan_map.c): the same fed straight from a map and a pose through
  *    the sector module (occ_sectors.h).
+ *  - Range sensors in (range_rx.c): uavcan.equipment.range_sensor.Measurement (1050) received
+ *    (multi-frame reassembly, CRC) and turned into a range beam (occ_ranges.h) with the mount
+ *    configured for its sensor_id.
  *
  * Only classic CAN (8-byte) frames are emitted by the node; the frame type carries FD frames for
  * the ports. Bit-exact with pydronecan 1.0.27 (tests/can_golden.py checks it byte for byte).
@@ -27,6 +30,8 @@
 #include <stdbool.h>
 
 #include "occmap/occ_core.h"
+#include "occmap/occ_pose.h"
+#include "occmap/occ_ranges.h"
 #include "occmap/occ_sectors.h"
 
 #ifdef __cplusplus
@@ -282,6 +287,112 @@ occ_err_t occ_dronecan_ingest(occ_dronecan_node_t *node, const occ_can_frame_t *
 occ_err_t occ_dronecan_poll_map(occ_dronecan_node_t *node, uint64_t now_us, const occ_map_t *map,
                                 uint64_t map_stamp_us, const occ_yaw_pose_t *pose,
                                 uint64_t pose_stamp_us, const occ_sectors_config_t *sectors_cfg);
+
+/* ---- Range sensors in (range_rx.c) ---------------------------------------------------------- */
+#define OCC_DRONECAN_RANGE_ID 1050u
+#define OCC_DRONECAN_RANGE_SIG 0x68FFFE70FC771952ull
+#define OCC_DRONECAN_RANGE_BYTES 15u  /* the message's payload: 120 bits */
+/* Transfers reassembled at once (one per source node), and how long one may take. */
+#define OCC_DRONECAN_RANGE_RX_SLOTS 4u
+#define OCC_DRONECAN_RANGE_RX_TIMEOUT_US 2000000u
+
+/* reading_type of the message. */
+#define OCC_DRONECAN_RANGE_UNDEFINED 0u
+#define OCC_DRONECAN_RANGE_VALID 1u
+#define OCC_DRONECAN_RANGE_TOO_CLOSE 2u
+#define OCC_DRONECAN_RANGE_TOO_FAR 3u
+
+/* The message's fields, decoded. */
+typedef struct {
+    uint64_t timestamp_us;      /* uavcan.Timestamp, 56 bits (0: unknown), the sender's clock */
+    uint8_t sensor_id;
+    int8_t orientation_rpy[3];  /* CoarseOrientation fixed-axis roll, pitch, yaw in units of
+                                 * pi/15 rad (12 deg), -16..15; decoded, not used (the mount
+                                 * table is what places the beam, as ArduPilot's RNGFNDn_ORIENT) */
+    bool orientation_defined;
+    float field_of_view_rad;    /* full angle (float16) */
+    uint8_t sensor_type;        /* 0 undefined, 1 sonar, 2 lidar, 3 radar */
+    uint8_t reading_type;       /* OCC_DRONECAN_RANGE_* */
+    float range_m;              /* float16 */
+} occ_dronecan_range_t;
+
+/* Decode a Measurement payload (exactly OCC_DRONECAN_RANGE_BYTES; more or less is
+ * OCC_ERR_FORMAT, NULL OCC_ERR_ARG; *out untouched on error). O(1). */
+occ_err_t occ_dronecan_decode_range(const uint8_t *payload, size_t len, occ_dronecan_range_t *out);
+
+/* Where a sensor sits: the caller's table, one entry per sensor_id. The message carries
+ * neither the mount nor the valid interval, so both are configured (ArduPilot RNGFNDn_ORIENT,
+ * _POS, _MIN_CM, _MAX_CM). */
+typedef struct {
+    uint8_t sensor_id;
+    occ_pose_t body_from_sensor; /* body (FLU, occ_pose.h) <- sensor; the beam is the sensor's +x */
+    float min_m, max_m;          /* the sensor's valid interval, 0 <= min < max */
+} occ_dronecan_range_mount_t;
+
+/* The beam a message gives, in the sensor frame (dir +x), and its mount from the table:
+ *  - VALID: distance = range (the beam rules of occ_ranges.h then apply: < min skipped,
+ *    >= max no return, NaN / Inf skipped);
+ *  - TOO_FAR: no return, distance = max_m (cleared up to max, no hit);
+ *  - TOO_CLOSE, UNDEFINED (and the unused codes 4..7): valid = false (skipped, counted).
+ * A field of view fov > 0 makes a cone of half-angle fov / 2; a fov that is NaN, negative or
+ * wider than 2 * OCC_RANGES_CONE_MAX_RAD makes the beam invalid (fail closed: no guessed cone).
+ * OCC_ERR_ARG for NULL, OCC_ERR_UNSUPPORTED when no mount has the message's sensor_id (*beam
+ * and *mount untouched). O(n_mounts). */
+occ_err_t occ_dronecan_range_beam(const occ_dronecan_range_t *msg,
+                                  const occ_dronecan_range_mount_t *mounts, size_t n_mounts,
+                                  occ_range_beam_t *beam,
+                                  const occ_dronecan_range_mount_t **mount);
+
+/* A received reading: who sent it, the message, its beam and its mount. */
+typedef struct {
+    uint8_t src_node;
+    occ_dronecan_range_t msg;
+    occ_range_beam_t beam;
+    const occ_dronecan_range_mount_t *mount;  /* into the receiver's table */
+} occ_dronecan_range_reading_t;
+
+/* One transfer being reassembled (private to range_rx.c). */
+typedef struct {
+    bool busy_;
+    uint8_t src_, tid_, toggle_, len_;
+    uint64_t start_us_;
+    uint8_t buf_[OCC_DRONECAN_RANGE_BYTES + 2u]; /* CRC + payload */
+} occ_dronecan_range_slot_t;
+
+/* Receiver of Measurement transfers. Size public for static allocation; callers read only the
+ * counters. */
+typedef struct {
+    /* read-only for callers: counters since init */
+    uint32_t frames;          /* Measurement frames seen */
+    uint32_t readings;        /* transfers completed, decoded and mapped to a mount */
+    uint32_t crc_errors;      /* multi-frame transfers whose CRC did not match (dropped) */
+    uint32_t sequence_errors; /* frames out of sequence: toggle, transfer id, no start, timeout,
+                               * too long (the transfer is dropped) */
+    uint32_t unknown_sensor;  /* readings from a sensor_id without a mount (dropped) */
+    uint32_t bad_payload;     /* completed transfers of the wrong length (dropped) */
+    /* private: layout may change, do not touch */
+    occ_dronecan_range_slot_t slot_[OCC_DRONECAN_RANGE_RX_SLOTS];
+    const occ_dronecan_range_mount_t *mounts_;
+    size_t n_mounts_;
+} occ_dronecan_range_rx_t;
+
+/* Start a receiver over the caller's mount table (kept by reference: it must outlive rx and
+ * not change). OCC_ERR_ARG for NULL (mounts may be NULL with n_mounts 0), a bad pose
+ * (occ_pose_check), a bad interval or a sensor_id listed twice. O(n_mounts^2). */
+occ_err_t occ_dronecan_range_rx_init(occ_dronecan_range_rx_t *rx,
+                                     const occ_dronecan_range_mount_t *mounts, size_t n_mounts);
+
+/* Hand one received frame (any frame of the bus: others are ignored) to the receiver. When it
+ * completes a Measurement transfer (single frame, or multi-frame with matching toggles, transfer
+ * id and CRC, within OCC_DRONECAN_RANGE_RX_TIMEOUT_US of its first frame) whose sensor has a
+ * mount, *got = true and *out holds the reading; otherwise *got = false (the reason counted).
+ * Up to OCC_DRONECAN_RANGE_RX_SLOTS sources interleave; a start frame from one more source
+ * takes the oldest slot. OCC_ERR_ARG for NULL. O(frame length). The integration is the
+ * caller's: map_from_sensor = compose(map_from_body at msg.timestamp_us or the arrival time,
+ * out->mount->body_from_sensor), then occ_map_insert_ranges() with &out->beam. */
+occ_err_t occ_dronecan_range_rx_frame(occ_dronecan_range_rx_t *rx, const occ_can_frame_t *frame,
+                                      uint64_t now_us, occ_dronecan_range_reading_t *out,
+                                      bool *got);
 
 /* ---- Ports (host side: port/posix; not part of the firmware build) ---------------------------- */
 /* Receive filter: a frame passes when (frame id & mask) == (id & mask) and its EXT flag equals

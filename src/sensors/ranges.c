@@ -179,6 +179,7 @@ occ_err_t occ_map_insert_ranges(occ_map_t *const map, const occ_pose_t *const ma
                                 const size_t scratch_bytes, occ_ranges_result_t *const out)
 {
     occ_ranges_result_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_ranges_result_t *const r = out != NULL ? out : &local;
     memset(r, 0, sizeof *r);
     size_t rays = 0;
