@@ -26,3 +26,8 @@ test-build-tlog: $(BUILD)/occmap
 	    $(MAV_REF)/build_tlog.json $(MAV_REF)/build_tlog_info.json
 TEST_STEPS += test-build-tlog
 .PHONY: test-build-tlog
+# A small log pymavlink packs (OBSTACLE_DISTANCE, our own echo, a reading before any pose).
+$(MAV_REF)/synth.tlog: tools/mav_tlog_synth.py $(BUILD)/.deps-ok
+	@mkdir -p $(dir $@)
+	$(PY) tools/mav_tlog_synth.py $@
+TEST_BUILD_EXTRA += $(MAV_REF)/synth.tlog

@@ -2,7 +2,8 @@
  * readings) through the tlog reader, the translator, the log's poses and
  * occ_map_insert_ranges(), against what pymavlink alone says about each reading
  * (tools/mav_tlog_sonar_ref.py -> build/mavlink/sonar_ref.txt): every beam where pymavlink puts
- * it, the occupied voxels on the surface the readings imply, free space above it, none below. */
+ * it, the occupied voxels on the surface the readings imply, free space above it, none below;
+ * and a small log pymavlink packed (OBSTACLE_DISTANCE, our own echo, a reading without a pose). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -19,6 +20,7 @@
 
 #define TLOG "../shared/data/mavlink/ardusub_2023-04-18_11-03-34.tlog"
 #define SONAR_REF "build/mavlink/sonar_ref.txt"
+#define SYNTH "build/mavlink/synth.tlog"
 #define RES 0.5f
 #define ARENA_BYTES ((size_t)96 << 20)
 #define MAX_READINGS 2000
@@ -331,10 +333,71 @@ static void test_ardusub_floor(void **state)
     free(arena);
 }
 
+/* A small log pymavlink packed (tools/mav_tlog_synth.py): OBSTACLE_DISTANCE in the body frame
+ * from a proximity sensor, our own echo refused, a reading before the first pose refused, a
+ * down sonar. The vehicle: ENU (1.05, 2.05, 3.05), heading east, level. */
+static void test_synthetic_log(void **state)
+{
+    (void)state;
+    FILE *probe = fopen(SYNTH, "rb");
+    if (probe == NULL) {
+        printf("SKIP: %s missing (made by `make test-build`, tools/mav_tlog_synth.py)\n", SYNTH);
+        skip();
+    }
+    fclose(probe);
+    static uint8_t arena[16u << 20];
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.resolution_m = 0.1f;
+    occ_map_t map;
+    assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+    const occ_tlog_ranges_config_t tc = occ_tlog_ranges_config_default();
+    const occ_insert_params_t rp = occ_insert_params_default();
+    occ_tlog_ranges_stats_t st;
+    assert_int_equal(occ_tlog_integrate_ranges(&map, SYNTH, &tc, &rp, NULL, NULL, &st, NULL, 0),
+                     OCC_OK);
+    assert_int_equal(st.poses, 21);
+    assert_int_equal(st.position_source, 32); /* LOCAL_POSITION_NED */
+    assert_false(st.no_horizontal_fix);
+    assert_int_equal(st.range_msgs, 3);       /* the own echo never becomes beams */
+    assert_int_equal(st.no_pose, 1);          /* the reading before the first pose */
+    assert_int_equal(st.integrated, 2);
+    assert_int_equal(st.tr.own_refused, 1);
+    assert_int_equal(st.tr.unknown_elements, 70);
+    assert_true(st.sum.beams_hit == 2u && st.sum.beams_no_return == 1u);
+    static const struct {
+        float x, y, z;
+        occ_state_t want;
+        const char *why;
+    } probes[] = {
+        {5.05f, 2.05f, 3.05f, OCC_STATE_OCCUPIED, "forward (east) element, 4 m"},
+        {3.05f, 2.05f, 3.05f, OCC_STATE_FREE, "short of it"},
+        {2.05f, 2.05f, 3.05f, OCC_STATE_FREE, "where our own echo (1 m) would have hit"},
+        {1.05f, -7.45f, 3.05f, OCC_STATE_FREE, "right (south) element, max + 1: free to 10 m"},
+        {1.05f, -8.35f, 3.05f, OCC_STATE_UNKNOWN, "... and not beyond"},
+        {1.05f, 2.05f, 0.55f, OCC_STATE_OCCUPIED, "down sonar, 2.5 m"},
+        {1.05f, 2.05f, 1.55f, OCC_STATE_FREE, "above its hit"},
+        {1.05f, 2.05f, 0.05f, OCC_STATE_UNKNOWN, "below it"},
+    };
+    for (size_t i = 0; i < sizeof probes / sizeof probes[0]; i++) {
+        const occ_vec3_t p = {probes[i].x, probes[i].y, probes[i].z};
+        if (occ_map_state_at(&map, p) != probes[i].want) {
+            fail_msg("(%.2f %.2f %.2f) %s: state %d, want %d", (double)p.x, (double)p.y,
+                     (double)p.z, probes[i].why, occ_map_state_at(&map, p), probes[i].want);
+        }
+    }
+    assert_int_equal(occ_map_check(&map), OCC_OK);
+    char msg[64];
+    assert_int_equal(occ_tlog_integrate_ranges(&map, "build/none.tlog", &tc, &rp, NULL, NULL, &st,
+                                               msg, sizeof msg), OCC_ERR_IO);
+    assert_int_equal(occ_tlog_integrate_ranges(NULL, SYNTH, &tc, &rp, NULL, NULL, &st, NULL, 0),
+                     OCC_ERR_ARG);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ardusub_floor),
+        cmocka_unit_test(test_synthetic_log),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
