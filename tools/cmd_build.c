@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include "build_depth.h"
+#include "build_tlog.h"
 #include "cli.h"
 #include "evict_cli.h"
 #include "occmap/host/occ_file.h"
@@ -12,7 +13,8 @@
 
 static void usage(void)
 {
-    printf("usage: occmap build (--scan FILE | --graph FILE | --depth-dir DIR) [--res R]\n"
+    printf("usage: occmap build (--scan FILE | --graph FILE | --depth-dir DIR | --tlog FILE)\n"
+           "         [--res R]"
            "         [--method simple|discrete|fast|superrays] [--n N] [--d D] [--k K]\n"
            "         [--max-range M] [--origin x,y,z] [--stride S] [--frames F]\n"
            "         [--arena-bytes N] [-o OUT.bt|.ot|.occ] [--json]\n"
@@ -21,6 +23,8 @@ static void usage(void)
            "  --depth-dir DIR   TUM RGB-D directory: my_association.txt + depth/*.png, or a\n"
            "                    sequence: depth.txt + groundtruth.txt (poses interpolated;\n"
            "                    frames without a pose are dropped and counted)\n"
+           "  --tlog FILE       MAVLink telemetry log: DISTANCE_SENSOR / OBSTACLE_DISTANCE\n"
+           "                    readings with the log's poses (README: --tlog)\n"
            "  --res R           voxel edge in metres (default 0.1)\n"
            "  --method M        simple (default), discrete, fast (UFOMap, --n --d), superrays\n"
            "  --max-range M     clear only up to M metres, no hit beyond (default: unlimited)\n"
@@ -90,6 +94,7 @@ static double now_ms(void)
 /* What the command line asks for. */
 typedef struct {
     const char *scan, *graph, *dir, *out_path; /* one input; -o */
+    const char *tlog;                          /* --tlog: build_tlog.c */
     float res, max_range, origin[3];
     bool json;
     uint32_t stride, frames, n, d, k;
@@ -132,6 +137,8 @@ static int value_option(build_opts_t *o, const char *a, const char *v)
         o->graph = v;
     } else if (strcmp(a, "--depth-dir") == 0) {
         o->dir = v;
+    } else if (strcmp(a, "--tlog") == 0) {
+        o->tlog = v;
     } else if (strcmp(a, "-o") == 0) {
         o->out_path = v;
     } else if (strcmp(a, "--res") == 0) {
@@ -171,8 +178,8 @@ static int check_opts(const build_opts_t *o)
     if (evict_cli_finish(&o->ev) != 0) {
         return 2;
     }
-    if ((o->scan != NULL) + (o->graph != NULL) + (o->dir != NULL) != 1) {
-        cli_error("build", "give exactly one of --scan, --graph, --depth-dir");
+    if ((o->scan != NULL) + (o->graph != NULL) + (o->dir != NULL) + (o->tlog != NULL) != 1) {
+        cli_error("build", "give exactly one of --scan, --graph, --depth-dir, --tlog");
         return 2;
     }
     if (o->n > 255u || o->d > 20u) {
@@ -370,6 +377,14 @@ int cmd_build(int argc, char **argv)
     const int parsed = parse_args(&o, argc, argv);
     if (parsed >= 0) {
         return parsed;
+    }
+    if (o.tlog != NULL) {
+        occ_map_t map;
+        void *arena = NULL;
+        int rc = make_map(&o, &map, &arena);
+        rc = rc == 0 ? build_tlog(&map, o.tlog, o.json, o.out_path) : rc;
+        free(arena);
+        return rc;
     }
     scans_t in;
     memset(&in, 0, sizeof in);

@@ -1,6 +1,7 @@
 /* mavlink.c - MAVLink frame parser, encoders and pose decoders (see occ_mavlink.h).
  * Message definitions come from the mavgen-generated headers (build/gen/mavlink, -isystem). */
 #include "occmap/occ_mavlink.h"
+#include "mavlink_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -275,8 +276,7 @@ size_t occ_mav_encode_command_ack(occ_mav_sender_t *tx, const occ_mav_command_ac
 
 /* ---- decoding -------------------------------------------------------------------------------- */
 
-/* Copy a payload into a generated struct, zero-filling what MAVLink 2 trimmed. */
-static bool load(const occ_mav_frame_t *f, uint32_t msgid, void *dst, size_t size)
+bool occi_mav_load(const occ_mav_frame_t *f, uint32_t msgid, void *dst, size_t size)
 {
     if (f == NULL || f->payload == NULL || f->msgid != msgid) {
         return false;
@@ -289,7 +289,7 @@ static bool load(const occ_mav_frame_t *f, uint32_t msgid, void *dst, size_t siz
 occ_err_t occ_mav_decode_local_position_ned(const occ_mav_frame_t *f, occ_mav_local_position_ned_t *out)
 {
     mavlink_local_position_ned_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_LOCAL_POSITION_NED, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_LOCAL_POSITION_NED, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->time_boot_ms = s.time_boot_ms;
@@ -305,7 +305,7 @@ occ_err_t occ_mav_decode_local_position_ned(const occ_mav_frame_t *f, occ_mav_lo
 occ_err_t occ_mav_decode_attitude(const occ_mav_frame_t *f, occ_mav_attitude_t *out)
 {
     mavlink_attitude_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_ATTITUDE, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_ATTITUDE, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->time_boot_ms = s.time_boot_ms;
@@ -322,7 +322,7 @@ occ_err_t occ_mav_decode_attitude_quaternion(const occ_mav_frame_t *f,
                                              occ_mav_attitude_quaternion_t *out)
 {
     mavlink_attitude_quaternion_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_ATTITUDE_QUATERNION, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_ATTITUDE_QUATERNION, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->time_boot_ms = s.time_boot_ms;
@@ -339,7 +339,7 @@ occ_err_t occ_mav_decode_attitude_quaternion(const occ_mav_frame_t *f,
 occ_err_t occ_mav_decode_odometry(const occ_mav_frame_t *f, occ_mav_odometry_t *out)
 {
     mavlink_odometry_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_ODOMETRY, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_ODOMETRY, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->time_usec = s.time_usec;
@@ -360,7 +360,7 @@ occ_err_t occ_mav_decode_odometry(const occ_mav_frame_t *f, occ_mav_odometry_t *
 occ_err_t occ_mav_decode_distance_sensor(const occ_mav_frame_t *f, occ_mav_distance_sensor_t *out)
 {
     mavlink_distance_sensor_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_DISTANCE_SENSOR, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_DISTANCE_SENSOR, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->time_boot_ms = s.time_boot_ms;
@@ -383,7 +383,7 @@ occ_err_t occ_mav_decode_distance_sensor(const occ_mav_frame_t *f, occ_mav_dista
 occ_err_t occ_mav_decode_heartbeat(const occ_mav_frame_t *f, occ_mav_heartbeat_t *out)
 {
     mavlink_heartbeat_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_HEARTBEAT, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_HEARTBEAT, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->custom_mode = s.custom_mode;
@@ -398,7 +398,7 @@ occ_err_t occ_mav_decode_heartbeat(const occ_mav_frame_t *f, occ_mav_heartbeat_t
 occ_err_t occ_mav_decode_obstacle_distance(const occ_mav_frame_t *f, occ_mav_obstacle_distance_t *out)
 {
     mavlink_obstacle_distance_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_OBSTACLE_DISTANCE, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_OBSTACLE_DISTANCE, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->time_usec = s.time_usec;
@@ -418,7 +418,7 @@ occ_err_t occ_mav_decode_obstacle_distance(const occ_mav_frame_t *f, occ_mav_obs
 occ_err_t occ_mav_decode_command_long(const occ_mav_frame_t *f, occ_mav_command_long_t *out)
 {
     mavlink_command_long_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_COMMAND_LONG, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_COMMAND_LONG, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->target_system = s.target_system;
@@ -438,7 +438,7 @@ occ_err_t occ_mav_decode_command_long(const occ_mav_frame_t *f, occ_mav_command_
 occ_err_t occ_mav_decode_command_ack(const occ_mav_frame_t *f, occ_mav_command_ack_t *out)
 {
     mavlink_command_ack_t s;
-    if (out == NULL || !load(f, MAVLINK_MSG_ID_COMMAND_ACK, &s, sizeof s)) {
+    if (out == NULL || !occi_mav_load(f, MAVLINK_MSG_ID_COMMAND_ACK, &s, sizeof s)) {
         return OCC_ERR_ARG;
     }
     out->command = s.command;
