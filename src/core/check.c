@@ -36,7 +36,7 @@ static bool tally_complete(const tally_t *const t, const uint32_t hwm)
 static bool check_free_lists(const occ_map_t *const m, tally_t *const inner, tally_t *const leaf)
 {
     uint32_t n = 0u;
-    for (uint32_t i = m->inner.free_head; i != OCC_NONE; i = occ_inner_at(m, i)->child[0]) {
+    for (uint32_t i = m->inner.priv.free_head; i != OCC_NONE; i = occ_inner_at(m, i)->child[0]) {
         if (i >= m->inner.hwm || n++ > m->inner.hwm ||
             occ_inner_at(m, i)->flags[7] != OCC_INNER_FREE_MARK) {
             return false; /* foreign index, cycle, or a used block on the list */
@@ -47,7 +47,7 @@ static bool check_free_lists(const occ_map_t *const m, tally_t *const inner, tal
         return false;
     }
     n = 0u;
-    uint32_t i = m->leaf.free_head;
+    uint32_t i = m->leaf.priv.free_head;
     while (i != OCC_NONE) {
         if (i >= m->leaf.hwm || n++ > m->leaf.hwm) {
             return false;
@@ -111,8 +111,8 @@ occ_err_t occ_map_check(const occ_map_t *const m)
     }
     /* Root. */
     const unsigned depth = m->cfg.depth_levels;
-    if (m->root_child == OCC_NONE) {
-        return m->root_flags == occ_value_flags(m, m->root_value) &&
+    if (m->priv.root_child == OCC_NONE) {
+        return m->priv.root_flags == occ_value_flags(m, m->priv.root_value) &&
                        tally_complete(&inner, m->inner.hwm) && tally_complete(&leaf, m->leaf.hwm)
                    ? OCC_OK
                    : OCC_ERR_CORRUPT;
@@ -123,19 +123,19 @@ occ_err_t occ_map_check(const occ_map_t *const m)
         return OCC_ERR_CORRUPT;
     }
     const uint32_t root_hwm = depth == 1u ? m->leaf.hwm : m->inner.hwm;
-    if (m->root_child >= root_hwm ||
-        !check_block(m, m->root_child, depth, m->root_value, m->root_flags)) {
+    if (m->priv.root_child >= root_hwm ||
+        !check_block(m, m->priv.root_child, depth, m->priv.root_value, m->priv.root_flags)) {
         return OCC_ERR_CORRUPT;
     }
     if (depth == 1u) {
-        tally_add(&leaf, m->root_child);
+        tally_add(&leaf, m->priv.root_child);
     } else {
-        tally_add(&inner, m->root_child);
+        tally_add(&inner, m->priv.root_child);
         /* Iterative DFS over inner blocks: frame = block whose nodes sit at lvl, next slot. */
         uint32_t blk[OCC_MAX_DEPTH + 1];
         uint8_t lvl[OCC_MAX_DEPTH + 1], next[OCC_MAX_DEPTH + 1];
         unsigned sp = 0;
-        blk[0] = m->root_child;
+        blk[0] = m->priv.root_child;
         lvl[0] = (uint8_t)(depth - 1u);
         next[0] = 0u;
         for (;;) {

@@ -218,10 +218,10 @@ static bool begin_pass(ctx_t *const x)
 {
     occ_evict_cursor_t *const cur = x->cur;
     cur->sp = 0u;
-    if (x->m->root_child == OCC_NONE) {
+    if (x->m->priv.root_child == OCC_NONE) {
         return false;
     }
-    push(cur, x->m->root_child, 0u);
+    push(cur, x->m->priv.root_child, 0u);
     return true;
 }
 
@@ -450,7 +450,7 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
     x.m = map;
     x.c = *center;
     x.p = policy;
-    x.cur = &out->cursor;
+    x.cur = &out->priv;
     x.need_inner = n_inner;
     x.need_leaf = n_leaf;
     x.budget = budget;
@@ -465,7 +465,7 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
                                    policy->keep_half_m.z);
     x.eps = map->cfg.resolution_m * 1.0e-3f + 8.0f * FLT_EPSILON * (far_c + reach);
     const uint32_t inner_before = map->inner.used, leaf_before = map->leaf.used;
-    occ_evict_cursor_t *const cur = &out->cursor;
+    occ_evict_cursor_t *const cur = &out->priv;
     run_end_t end = RUN_TARGET;
     bool sweep_on = cur->phase == PHASE_RESUME && cur->depth == map->cfg.depth_levels;
     if (!target_ok(&x)) {

@@ -56,9 +56,9 @@ occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg)
     f->cfg = *cfg;
     f->cfg.sectors.map_ned = cfg->map_frame == OCC_MAP_FRAME_NED;
     occ_mav_parser_init(&f->parser);
-    f->tx.sysid = cfg->sysid;
-    f->tx.compid = cfg->compid;
-    f->tx.seq = 0;
+    f->priv.tx.sysid = cfg->sysid;
+    f->priv.tx.compid = cfg->compid;
+    f->priv.tx.seq = 0;
     f->have_autopilot = cfg->autopilot_sysid != 0u;
     f->ap_sysid = cfg->autopilot_sysid;
     f->ap_compid = cfg->autopilot_compid;
@@ -128,11 +128,11 @@ static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t no
         occ_mav_local_position_ned_t m;
         if (occ_mav_decode_local_position_ned(fr, &m) == OCC_OK && isfinite(m.x) &&
             isfinite(m.y) && isfinite(m.z)) {
-            f->north = m.x;
-            f->east = m.y;
-            f->down = m.z;
-            f->pos_us = now_us;
-            f->have_pos = true;
+            f->priv.north = m.x;
+            f->priv.east = m.y;
+            f->priv.down = m.z;
+            f->priv.pos_us = now_us;
+            f->priv.have_pos = true;
             f->counters.positions_rx++;
             return;
         }
@@ -141,11 +141,11 @@ static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t no
     case OCC_MAV_MSG_ATTITUDE: {
         occ_mav_attitude_t m;
         if (occ_mav_decode_attitude(fr, &m) == OCC_OK && isfinite(m.yaw)) {
-            f->yaw_ned = m.yaw;
-            f->roll = m.roll;
-            f->pitch = m.pitch;
-            f->att_us = now_us;
-            f->have_att = true;
+            f->priv.yaw_ned = m.yaw;
+            f->priv.roll = m.roll;
+            f->priv.pitch = m.pitch;
+            f->priv.att_us = now_us;
+            f->priv.have_att = true;
             f->counters.attitudes_rx++;
             return;
         }
@@ -154,11 +154,11 @@ static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t no
     case OCC_MAV_MSG_ATTITUDE_QUATERNION: {
         occ_mav_attitude_quaternion_t m;
         if (occ_mav_decode_attitude_quaternion(fr, &m) == OCC_OK) {
-            const float yaw = occ_mav_quat_yaw(m.q, &f->roll, &f->pitch);
+            const float yaw = occ_mav_quat_yaw(m.q, &f->priv.roll, &f->priv.pitch);
             if (isfinite(yaw)) {
-                f->yaw_ned = yaw;
-                f->att_us = now_us;
-                f->have_att = true;
+                f->priv.yaw_ned = yaw;
+                f->priv.att_us = now_us;
+                f->priv.have_att = true;
                 f->counters.attitudes_rx++;
                 return;
             }
@@ -172,16 +172,16 @@ static void take_frame(occ_mav_feed_t *f, const occ_mav_frame_t *fr, uint64_t no
             float roll, pitch;
             const float yaw = occ_mav_quat_yaw(m.q, &roll, &pitch);
             if (isfinite(yaw)) {
-                f->north = m.x;
-                f->east = m.y;
-                f->down = m.z;
-                f->yaw_ned = yaw;
-                f->roll = roll;
-                f->pitch = pitch;
-                f->pos_us = now_us;
-                f->att_us = now_us;
-                f->have_pos = true;
-                f->have_att = true;
+                f->priv.north = m.x;
+                f->priv.east = m.y;
+                f->priv.down = m.z;
+                f->priv.yaw_ned = yaw;
+                f->priv.roll = roll;
+                f->priv.pitch = pitch;
+                f->priv.pos_us = now_us;
+                f->priv.att_us = now_us;
+                f->priv.have_pos = true;
+                f->priv.have_att = true;
                 f->counters.positions_rx++;
                 f->counters.attitudes_rx++;
                 return;
@@ -215,35 +215,35 @@ static bool fresh_at(const occ_mav_feed_t *f, bool have, uint64_t at_us, uint64_
 
 bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose)
 {
-    if (f == NULL || !f->have_pos || !f->have_att) {
+    if (f == NULL || !f->priv.have_pos || !f->priv.have_att) {
         return false;
     }
-    const bool fresh = fresh_at(f, f->have_pos, f->pos_us, now_us) &&
-                       fresh_at(f, f->have_att, f->att_us, now_us);
+    const bool fresh = fresh_at(f, f->priv.have_pos, f->priv.pos_us, now_us) &&
+                       fresh_at(f, f->priv.have_att, f->priv.att_us, now_us);
     if (pose != NULL) {
         if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
-            pose->x = f->north;
-            pose->y = f->east;
-            pose->z = f->down;
-            pose->yaw_rad = f->yaw_ned;
+            pose->x = f->priv.north;
+            pose->y = f->priv.east;
+            pose->z = f->priv.down;
+            pose->yaw_rad = f->priv.yaw_ned;
         } else {
-            *pose = occ_pose_from_ned(f->north, f->east, f->down, f->yaw_ned);
+            *pose = occ_pose_from_ned(f->priv.north, f->priv.east, f->priv.down, f->priv.yaw_ned);
         }
-        pose->roll_rad = f->roll;
-        pose->pitch_rad = f->pitch;
+        pose->roll_rad = f->priv.roll;
+        pose->pitch_rad = f->priv.pitch;
     }
     return fresh;
 }
 
 uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f)
 {
-    if (f == NULL || !f->started) {
+    if (f == NULL || !f->priv.started) {
         return 0;
     }
-    uint64_t due = f->next_obstacle_us < f->next_heartbeat_us ? f->next_obstacle_us
-                                                               : f->next_heartbeat_us;
-    if (f->have_autopilot && f->cfg.pose_interval_us > 0u && f->next_request_us < due) {
-        due = f->next_request_us;
+    uint64_t due = f->priv.next_obstacle_us < f->priv.next_heartbeat_us ? f->priv.next_obstacle_us
+                                                               : f->priv.next_heartbeat_us;
+    if (f->have_autopilot && f->cfg.pose_interval_us > 0u && f->priv.next_request_us < due) {
+        due = f->priv.next_request_us;
     }
     return due;
 }
@@ -265,16 +265,16 @@ static size_t poll_request(occ_mav_feed_t *f, uint64_t now_us, uint8_t *out, siz
     if (!f->have_autopilot || f->cfg.pose_interval_us == 0u) {
         return 0;
     }
-    if (f->request_mask == 0u && now_us >= f->next_request_us) {
-        f->next_request_us = now_us + f->cfg.request_period_us;
-        f->request_mask = (uint8_t)((fresh_at(f, f->have_pos, f->pos_us, now_us) ? 0u : 1u) |
-                                    (fresh_at(f, f->have_att, f->att_us, now_us) ? 0u : 2u));
+    if (f->priv.request_mask == 0u && now_us >= f->priv.next_request_us) {
+        f->priv.next_request_us = now_us + f->cfg.request_period_us;
+        f->priv.request_mask = (uint8_t)((fresh_at(f, f->priv.have_pos, f->priv.pos_us, now_us) ? 0u : 1u) |
+                                    (fresh_at(f, f->priv.have_att, f->priv.att_us, now_us) ? 0u : 2u));
     }
-    if (f->request_mask == 0u) {
+    if (f->priv.request_mask == 0u) {
         return 0;
     }
-    const bool pos = (f->request_mask & 1u) != 0u;
-    f->request_mask = (uint8_t)(f->request_mask & (pos ? ~1u : ~2u));
+    const bool pos = (f->priv.request_mask & 1u) != 0u;
+    f->priv.request_mask = (uint8_t)(f->priv.request_mask & (pos ? ~1u : ~2u));
     occ_mav_command_long_t c;
     memset(&c, 0, sizeof c);
     c.target_system = f->ap_sysid;
@@ -282,7 +282,7 @@ static size_t poll_request(occ_mav_feed_t *f, uint64_t now_us, uint8_t *out, siz
     c.command = OCC_MAV_CMD_SET_MESSAGE_INTERVAL;
     c.param[0] = (float)(pos ? OCC_MAV_MSG_LOCAL_POSITION_NED : OCC_MAV_MSG_ATTITUDE);
     c.param[1] = (float)f->cfg.pose_interval_us;
-    const size_t n = occ_mav_encode_command_long(&f->tx, &c, out, cap);
+    const size_t n = occ_mav_encode_command_long(&f->priv.tx, &c, out, cap);
     if (n > 0u) {
         f->counters.requests_tx++;
     }
@@ -295,13 +295,13 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     if (f == NULL || out == NULL || cap < OCC_MAV_FRAME_MAX) {
         return 0;
     }
-    if (!f->started) {
-        f->started = true;
-        f->next_heartbeat_us = now_us;
-        f->next_obstacle_us = now_us;
+    if (!f->priv.started) {
+        f->priv.started = true;
+        f->priv.next_heartbeat_us = now_us;
+        f->priv.next_obstacle_us = now_us;
     }
-    if (now_us >= f->next_heartbeat_us) {
-        f->next_heartbeat_us = advance(f->next_heartbeat_us, f->cfg.heartbeat_period_us, now_us);
+    if (now_us >= f->priv.next_heartbeat_us) {
+        f->priv.next_heartbeat_us = advance(f->priv.next_heartbeat_us, f->cfg.heartbeat_period_us, now_us);
         occ_mav_heartbeat_t hb;
         hb.custom_mode = 0;
         hb.type = MAV_TYPE_ONBOARD_CONTROLLER_;
@@ -309,7 +309,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         hb.base_mode = 0;
         hb.system_status = MAV_STATE_ACTIVE_;
         hb.mavlink_version = 3;
-        const size_t n = occ_mav_encode_heartbeat(&f->tx, &hb, out, cap);
+        const size_t n = occ_mav_encode_heartbeat(&f->priv.tx, &hb, out, cap);
         if (n > 0u) {
             f->counters.heartbeat_tx++;
         }
@@ -319,17 +319,17 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     if (nr > 0u) {
         return nr;
     }
-    if (now_us < f->next_obstacle_us) {
+    if (now_us < f->priv.next_obstacle_us) {
         return 0;
     }
-    f->next_obstacle_us = advance(f->next_obstacle_us, f->cfg.period_us, now_us);
+    f->priv.next_obstacle_us = advance(f->priv.next_obstacle_us, f->cfg.period_us, now_us);
     occ_pose_t pose;
     if (map == NULL || !occ_mav_feed_pose(f, now_us, &pose)) {
         f->counters.stale_skips++;
         return 0;
     }
     const occ_sectors_config_t *const sc = &f->cfg.sectors;
-    if (occ_sectors_compute(map, &pose, sc, &f->sectors) != OCC_OK) {
+    if (occ_sectors_compute(map, &pose, sc, &f->priv.sectors) != OCC_OK) {
         f->counters.sector_errors++;
         return 0;
     }
@@ -337,7 +337,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     m.time_usec = now_us;
     m.sensor_type = f->cfg.sensor_type;
     for (unsigned i = 0; i < 72u; i++) {
-        m.distances[i] = i < f->sectors.n ? f->sectors.distance_cm[i] : UINT16_MAX;
+        m.distances[i] = i < f->priv.sectors.n ? f->priv.sectors.distance_cm[i] : UINT16_MAX;
     }
     const float inc = sc->increment_deg;
     m.increment = 0;
@@ -349,7 +349,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     m.increment_f = inc;
     m.angle_offset = sc->angle_offset_deg;
     m.frame = OCC_MAV_FRAME_BODY_FRD;
-    const size_t n = occ_mav_encode_obstacle_distance(&f->tx, &m, out, cap);
+    const size_t n = occ_mav_encode_obstacle_distance(&f->priv.tx, &m, out, cap);
     if (n > 0u) {
         f->counters.obstacle_tx++;
     }

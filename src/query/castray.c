@@ -70,12 +70,12 @@ static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3], 
     c->key[1] = key[1];
     c->key[2] = key[2];
     const unsigned d = m->cfg.depth_levels;
-    if (m->root_child == OCC_NONE || (m->root_flags & stop) == 0u) {
+    if (m->priv.root_child == OCC_NONE || (m->priv.root_flags & stop) == 0u) {
         c->lu = d;
-        c->val = m->root_value;
+        c->val = m->priv.root_value;
         return;
     }
-    c->blk[d] = m->root_child;
+    c->blk[d] = m->priv.root_child;
     descend(c, d);
 }
 
@@ -263,8 +263,8 @@ occ_err_t occ_cast_ray(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t direc
     /* A voxel entered at ray parameter t has its centre within t + 0.87 res of the origin, so
      * OctoMap's exact centre-distance test can only fail once t passes this (with margin). */
     const real_t safe_t = (real_t)max_range_m - res * (real_t)1.01 - (real_t)1e-5 * (real_t)max_range_m;
-    const occ_value_t occ_min = map->q_occ_min;
-    const occ_value_t free_max = map->q_free_max;
+    const occ_value_t occ_min = map->priv.q_occ_min;
+    const occ_value_t free_max = map->priv.q_free_max;
     /* The last key a step may leave from, per axis (never reached for a zero step). */
     const uint32_t lim[3] = {d.step[0] > 0 ? kmax : 0u, d.step[1] > 0 ? kmax : 0u,
                              d.step[2] > 0 ? kmax : 0u};
@@ -376,8 +376,8 @@ occ_err_t occ_line_of_sight(const occ_map_t *map, occ_vec3_t a, occ_vec3_t b,
                              (real_t)dv.z * (real_t)dv.z);
     dda_t d;
     dda_init(&d, &c, res, tmv, o, dir);
-    const occ_value_t occ_min = map->q_occ_min;
-    const occ_value_t free_max = map->q_free_max;
+    const occ_value_t occ_min = map->priv.q_occ_min;
+    const occ_value_t free_max = map->priv.q_free_max;
     const bool unknown_blocks = policy == OCC_UNKNOWN_UNSAFE;
     bool entered = true;
     for (;;) {
