@@ -219,17 +219,17 @@ static void test_pool_alloc_leaf_foreign_link(void **state)
     /* The free list's head links to a block never carved: popping the head must not hand that
      * index on as the next block. */
     const uint32_t bad = map.leaf.hwm + 5u;
-    memcpy(occ_leaf_at(&map, map.leaf.free_head)->value, &bad, sizeof bad);
+    memcpy(occ_leaf_at(&map, map.leaf.priv.free_head)->value, &bad, sizeof bad);
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
     expect_assert_on(occi_pool_alloc_leaf(&map),
-                     "m->leaf.free_head == OCC_NONE || m->leaf.free_head < m->leaf.hwm");
+                     "m->leaf.priv.free_head == OCC_NONE || m->leaf.priv.free_head < m->leaf.hwm");
 }
 
 static void test_pool_alloc_inner_without_free_mark(void **state)
 {
     (void)state;
     /* The inner free list's head does not carry the free mark: a used block is on the list. */
-    occ_inner_at(&map, map.inner.free_head)->flags[7] = 0u;
+    occ_inner_at(&map, map.inner.priv.free_head)->flags[7] = 0u;
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
     expect_assert_on(occi_pool_alloc_inner(&map),
                      "occ_inner_at(m, idx)->flags[7] == OCC_INNER_FREE_MARK");
@@ -239,7 +239,7 @@ static void test_pool_alloc_counters_broken(void **state)
 {
     (void)state;
     /* The free list dropped: used + free_count no longer equals the blocks carved. */
-    map.leaf.free_head = OCC_NONE;
+    map.leaf.priv.free_head = OCC_NONE;
     map.leaf.free_count = 0u;
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
     expect_assert_on(occi_pool_alloc_leaf(&map), "p->used + p->free_count == p->hwm");
@@ -250,8 +250,8 @@ static void test_release_stack_bound(void **state)
     (void)state;
     /* A block that is its own child, on a map whose depth claims more levels than a walk stack
      * holds: releasing it would push frame after frame past OCC_MAX_DEPTH. */
-    occ_inner_block_t *const root_block = occ_inner_at(&map, map.root_child);
-    root_block->child[0] = map.root_child;
+    occ_inner_block_t *const root_block = occ_inner_at(&map, map.priv.root_child);
+    root_block->child[0] = map.priv.root_child;
     map.cfg.depth_levels = 30u;
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
     expect_assert_on(occi_tree_release_children(&map, occ_root(&map), 30u),

@@ -126,25 +126,25 @@ static void test_free_list_cycles(void **state)
 {
     (void)state;
     /* Inner: the last free block points back to the head. */
-    uint32_t i = map.inner.free_head, last = i;
+    uint32_t i = map.inner.priv.free_head, last = i;
     while (i != OCC_NONE) {
         last = i;
         i = occ_inner_at(&map, i)->child[0];
     }
-    occ_inner_at(&map, last)->child[0] = map.inner.free_head;
+    occ_inner_at(&map, last)->child[0] = map.inner.priv.free_head;
     expect_corrupt("inner free-list cycle (tail -> head)");
-    occ_inner_at(&map, map.inner.free_head)->child[0] = map.inner.free_head;
+    occ_inner_at(&map, map.inner.priv.free_head)->child[0] = map.inner.priv.free_head;
     expect_corrupt("inner free-list self loop");
     /* Leaf: the same. */
-    i = map.leaf.free_head;
+    i = map.leaf.priv.free_head;
     last = i;
     while (i != OCC_NONE) {
         last = i;
         i = leaf_next(i);
     }
-    memcpy(occ_leaf_at(&map, last)->value, &map.leaf.free_head, sizeof(uint32_t));
+    memcpy(occ_leaf_at(&map, last)->value, &map.leaf.priv.free_head, sizeof(uint32_t));
     expect_corrupt("leaf free-list cycle (tail -> head)");
-    const uint32_t h = map.leaf.free_head;
+    const uint32_t h = map.leaf.priv.free_head;
     memcpy(occ_leaf_at(&map, h)->value, &h, sizeof h);
     expect_corrupt("leaf free-list self loop");
 }
@@ -152,17 +152,17 @@ static void test_free_list_cycles(void **state)
 static void test_free_list_foreign(void **state)
 {
     (void)state;
-    map.inner.free_head = map.inner.hwm + 3u;
+    map.inner.priv.free_head = map.inner.hwm + 3u;
     expect_corrupt("inner free head beyond the high-water mark");
-    map.leaf.free_head = map.leaf.hwm;
+    map.leaf.priv.free_head = map.leaf.hwm;
     expect_corrupt("leaf free head at the high-water mark");
-    occ_inner_at(&map, map.inner.free_head)->child[0] = 0x7FFFFFFFu;
+    occ_inner_at(&map, map.inner.priv.free_head)->child[0] = 0x7FFFFFFFu;
     expect_corrupt("inner free-list link to a foreign index");
     const uint32_t bad = map.leaf.hwm + 1u;
-    memcpy(occ_leaf_at(&map, map.leaf.free_head)->value, &bad, sizeof bad);
+    memcpy(occ_leaf_at(&map, map.leaf.priv.free_head)->value, &bad, sizeof bad);
     expect_corrupt("leaf free-list link to a foreign index");
     /* The inner free mark cleared on a free block (looks used). */
-    occ_inner_at(&map, map.inner.free_head)->flags[7] = 0u;
+    occ_inner_at(&map, map.inner.priv.free_head)->flags[7] = 0u;
     expect_corrupt("inner free block without its free mark");
 }
 
@@ -217,7 +217,7 @@ static void test_leaked_block(void **state)
     expect_corrupt("leaked leaf block (from the free list)");
     (void)occi_pool_alloc_inner(&map);
     expect_corrupt("leaked inner block (from the free list)");
-    map.leaf.free_head = OCC_NONE;
+    map.leaf.priv.free_head = OCC_NONE;
     map.leaf.free_count = 0u;
     map.leaf.hwm++; /* one more block carved (by hand: the allocator asserts on these counters) */
     map.leaf.used = map.leaf.hwm - 0u; /* consistent counters, unreachable blocks */
@@ -238,7 +238,7 @@ static void test_wrong_values(void **state)
     n = node_at(mk(0, 0, 0), 2u);
     (*n.value)--;
     expect_corrupt("level-2 max one step too low");
-    map.root_value = (occ_value_t)(map.root_value - 100);
+    map.priv.root_value = (occ_value_t)(map.priv.root_value - 100);
     expect_corrupt("root max wrong");
     /* A voxel raised above its parent's max. */
     n = node_at(mk(0, 0, 0), 1u);
@@ -264,7 +264,7 @@ static void test_wrong_indicators(void **state)
         n = node_at(mk(8, 8, 8), 2u); /* pruned: flags follow from the value */
         *n.flags ^= bits[b];
         expect_corrupt("pruned node indicator flipped");
-        map.root_flags ^= bits[b];
+        map.priv.root_flags ^= bits[b];
         expect_corrupt("root indicator flipped");
     }
 }
@@ -303,11 +303,11 @@ static void test_child_index_out_of_range(void **state)
     n = node_at(mk(0, 0, 0), 2u);
     *n.child = map.inner.hwm + 5u;
     expect_corrupt("inner child index beyond inner hwm");
-    map.root_child = map.inner.hwm;
+    map.priv.root_child = map.inner.hwm;
     expect_corrupt("root child index == inner hwm");
     /* A child index that names a block on the free list. */
     n = node_at(mk(0, 0, 0), 2u);
-    *n.child = map.inner.free_head;
+    *n.child = map.inner.priv.free_head;
     expect_corrupt("child index of a free inner block");
 }
 

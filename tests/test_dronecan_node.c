@@ -84,7 +84,7 @@ static void test_queue_full_counted(void **state)
     assert_int_equal(node.stats.tx_transfers, 1);
     assert_int_equal(node.stats.tx_frames, 3);
     /* The partial transfer used id 1; the next one that starts is id 2. */
-    assert_int_equal(node.tid_proximity, 2);
+    assert_int_equal(node.priv.tid_proximity, 2);
 
     /* With tx_space: all or nothing, and the transfer id is not spent. */
     memset(&cap, 0, sizeof cap);
@@ -93,7 +93,7 @@ static void test_queue_full_counted(void **state)
     make_node(100);
     assert_int_equal(occ_dronecan_publish_proximity(&node, &m), OCC_ERR_NOMEM);
     assert_int_equal(cap.n, 0);
-    assert_int_equal(node.tid_proximity, 0);
+    assert_int_equal(node.priv.tid_proximity, 0);
     assert_int_equal(node.stats.tx_full, 1);
     /* A single-frame NodeStatus still fits. */
     assert_int_equal(occ_dronecan_publish_status(&node, 0), OCC_OK);

@@ -9,11 +9,7 @@
  *  - Slices: budgets are respected, a sliced run ends in the same place as a one-shot run.
  *  - Exhaustion: nothing evictable is left outside the protected region.
  *  - occ_map_observe_need() against the blocks occ_map_observe_codes() really takes.
- *  - Automatic mode (need -> evict_for -> observe, in Morton chunks) along a straight path in
- *    arenas from a tenth of the map to all of it: no failure, invariants hold, and the map near
- *    the last position equals an unbounded map's.
- *  - The same on the real TUM depth frames at 0.05 m (../shared/data/depth), rays by
- *    occ_ray_keys with OctoMap's per-scan semantics (a voxel hit in the scan is a hit).
+ * Automatic mode and the real depth frames: test_evict_auto.c.
  * Random seed: printed, overridable with OCC_SEED.
  */
 #include <stdarg.h>
@@ -34,66 +30,11 @@
 #include "occmap/occ_integrate.h"
 #include "occmap/host/occ_scan.h"
 #include "core/tree_internal.h"
+#include "support/evict_fixture.h"
 #include "support/leak_check.h"
 
 #define VOL 64u                     /* shadow volume edge, voxels */
 #define VOL_N (VOL * VOL * VOL)
-#define TUM_DIR "../shared/data/depth/tum_fr2_pioneer_slam2"
-
-static uint64_t rng_state;
-static unsigned seed;
-
-static uint32_t rnd(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (uint32_t)(rng_state >> 11);
-}
-
-static float rndf(void)
-{
-    return (float)(rnd() & 0xFFFFFFu) / (float)0x1000000u;
-}
-
-static int setup_seed(void **state)
-{
-    (void)state;
-    const char *const env = getenv("OCC_SEED");
-    seed = env != NULL ? (unsigned)strtoul(env, NULL, 0) : (unsigned)time(NULL);
-    printf("test_evict: seed %u (set OCC_SEED to repeat)\n", seed);
-    rng_state = 0x9E3779B97F4A7C15ull ^ seed;
-    return 0;
-}
-
-static occ_map_config_t cfg_res(const float res)
-{
-    occ_map_config_t c = occ_map_config_default();
-    c.resolution_m = res;
-    return c;
-}
-
-static int cmp_code(const void *a, const void *b)
-{
-    const occ_code_t x = *(const occ_code_t *)a & ~OCC_CODE_HIT_BIT;
-    const occ_code_t y = *(const occ_code_t *)b & ~OCC_CODE_HIT_BIT;
-    return x < y ? -1 : x > y;
-}
-
-/* Sort and de-duplicate; a code hit anywhere stays a hit (OctoMap's per-scan rule). */
-static size_t sort_unique(occ_code_t *c, size_t n)
-{
-    qsort(c, n, sizeof *c, cmp_code);
-    size_t u = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (u > 0u && ((c[u - 1u] ^ c[i]) & ~OCC_CODE_HIT_BIT) == 0u) {
-            c[u - 1u] |= c[i] & OCC_CODE_HIT_BIT;
-        } else {
-            c[u++] = c[i];
-        }
-    }
-    return u;
-}
 
 /* ---- geometry shared by the checks ---------------------------------------------------------- */
 
@@ -145,11 +86,11 @@ static void random_content(occ_map_t *m, const uint32_t base, const unsigned n_c
 {
     static occ_code_t codes[4096];
     for (unsigned c = 0; c < n_cubes; c++) {
-        const uint32_t e = 1u + rnd() % 6u;
-        const uint32_t x0 = base + rnd() % (VOL - e), y0 = base + rnd() % (VOL - e),
-                       z0 = base + rnd() % (VOL - e);
-        const bool hit = rnd() % 3u == 0u;
-        const unsigned reps = 1u + rnd() % 3u;
+        const uint32_t e = 1u + ev_rnd() % 6u;
+        const uint32_t x0 = base + ev_rnd() % (VOL - e), y0 = base + ev_rnd() % (VOL - e),
+                       z0 = base + ev_rnd() % (VOL - e);
+        const bool hit = ev_rnd() % 3u == 0u;
+        const unsigned reps = 1u + ev_rnd() % 3u;
         size_t n = 0;
         for (uint32_t z = 0; z < e; z++) {
             for (uint32_t y = 0; y < e; y++) {
@@ -158,12 +99,12 @@ static void random_content(occ_map_t *m, const uint32_t base, const unsigned n_c
                     k.k[0] = x0 + x;
                     k.k[1] = y0 + y;
                     k.k[2] = z0 + z;
-                    const bool h = (rnd() % 8u == 0u) ? !hit : hit;
+                    const bool h = (ev_rnd() % 8u == 0u) ? !hit : hit;
                     codes[n++] = occ_morton_encode(k) | (h ? OCC_CODE_HIT_BIT : 0u);
                 }
             }
         }
-        n = sort_unique(codes, n);
+        n = ev_sort_unique(codes, n);
         for (unsigned r = 0; r < reps; r++) {
             assert_int_equal(occ_map_observe_codes(m, codes, n, NULL), OCC_OK);
         }
@@ -250,7 +191,7 @@ static void test_args(void **state)
 {
     (void)state;
     occ_map_t m;
-    const occ_map_config_t cfg = cfg_res(0.1f);
+    const occ_map_config_t cfg = ev_cfg_res(0.1f);
     assert_int_equal(occ_map_init(&m, &cfg, arena_a, 1u << 16), OCC_OK);
     occ_evict_policy_t p = occ_evict_policy_default();
     occ_evict_out_t out;
@@ -305,28 +246,28 @@ static void shadow_case(const occ_evict_mode_t mode, const occ_evict_shape_t sha
                         const bool sliced, const bool to_exhaustion)
 {
     occ_map_t m;
-    occ_map_config_t cfg = cfg_res(0.1f);
-    const bool band = rnd() % 2u == 0u;
+    occ_map_config_t cfg = ev_cfg_res(0.1f);
+    const bool band = ev_rnd() % 2u == 0u;
     if (band) { /* an unknown band between free and occupied: -0.4 and 0.45 read UNKNOWN */
         cfg.free_max = -0.5f;
         cfg.occupied_min = 0.5f;
     }
     assert_int_equal(occ_map_init(&m, &cfg, arena_a, sizeof arena_a), OCC_OK);
-    const uint32_t base = (1u << 15) - VOL / 2u + 16u * (rnd() % 2u);
-    random_content(&m, base, 150u + rnd() % 200u);
+    const uint32_t base = (1u << 15) - VOL / 2u + 16u * (ev_rnd() % 2u);
+    random_content(&m, base, 150u + ev_rnd() % 200u);
     snapshot(&m, base, &before_grid);
     occ_evict_policy_t p = occ_evict_policy_default();
     p.mode = mode;
     p.shape = shape;
-    p.keep_radius_m = 0.5f + 2.0f * rndf();
-    p.keep_half_m.x = 0.3f + 1.5f * rndf();
-    p.keep_half_m.y = 0.3f + 1.5f * rndf();
-    p.keep_half_m.z = 0.3f + 1.5f * rndf();
-    p.coarse_min_level = (uint8_t)(1u + rnd() % 3u);
-    p.coarse_max_level = (uint8_t)(p.coarse_min_level + rnd() % 3u);
-    p.budget_blocks = sliced ? 4u + rnd() % 60u : 0u;
+    p.keep_radius_m = 0.5f + 2.0f * ev_rndf();
+    p.keep_half_m.x = 0.3f + 1.5f * ev_rndf();
+    p.keep_half_m.y = 0.3f + 1.5f * ev_rndf();
+    p.keep_half_m.z = 0.3f + 1.5f * ev_rndf();
+    p.coarse_min_level = (uint8_t)(1u + ev_rnd() % 3u);
+    p.coarse_max_level = (uint8_t)(p.coarse_min_level + ev_rnd() % 3u);
+    p.budget_blocks = sliced ? 4u + ev_rnd() % 60u : 0u;
     const float lo = ((float)base - 32768.0f) * cfg.resolution_m;
-    const occ_vec3_t c = {lo + 6.4f * rndf(), lo + 6.4f * rndf(), lo + 6.4f * rndf()};
+    const occ_vec3_t c = {lo + 6.4f * ev_rndf(), lo + 6.4f * ev_rndf(), lo + 6.4f * ev_rndf()};
     occ_map_stats_t st;
     occ_map_pool_stats(&m, &st);
     const uint32_t used = st.inner_used + st.leaf_used;
@@ -406,7 +347,7 @@ static void test_coarsen_rule(void **state)
 {
     (void)state;
     occ_map_t m;
-    const occ_map_config_t cfg = cfg_res(0.1f);
+    const occ_map_config_t cfg = ev_cfg_res(0.1f);
     assert_int_equal(occ_map_init(&m, &cfg, arena_a, 1u << 20), OCC_OK);
     const uint32_t b = 1u << 15;
     /* three level-2 cubes (4x4x4 voxels) at x = b+64, b+68, b+72, far from the centre at 0 */
@@ -496,12 +437,12 @@ static void test_coarsen_rule(void **state)
 static void test_slices_match_oneshot(void **state)
 {
     (void)state;
-    const occ_map_config_t cfg = cfg_res(0.1f);
+    const occ_map_config_t cfg = ev_cfg_res(0.1f);
     const uint32_t base = (1u << 15) - VOL / 2u;
-    const uint64_t keep_state = rng_state;
+    const uint64_t keep_state = ev_rng_get();
     for (unsigned mode = 0; mode < 2u; mode++) {
         occ_map_t m1, m2;
-        rng_state = keep_state;
+        ev_rng_set(keep_state);
         assert_int_equal(occ_map_init(&m1, &cfg, arena_a, sizeof arena_a), OCC_OK);
         random_content(&m1, base, 200u);
         occ_evict_policy_t p = occ_evict_policy_default();
@@ -514,7 +455,7 @@ static void test_slices_match_oneshot(void **state)
         assert_true(o1.exhausted);
         snapshot(&m1, base, &before_grid);
         for (uint32_t budget = 1u; budget <= 8u; budget *= 2u) {
-            rng_state = keep_state;
+            ev_rng_set(keep_state);
             assert_int_equal(occ_map_init(&m2, &cfg, arena_b, sizeof arena_b), OCC_OK);
             random_content(&m2, base, 200u);
             p.budget_blocks = budget;
@@ -547,20 +488,20 @@ static void test_slices_match_oneshot(void **state)
 static void test_observe_need(void **state)
 {
     (void)state;
-    const occ_map_config_t cfg = cfg_res(0.1f);
+    const occ_map_config_t cfg = ev_cfg_res(0.1f);
     static occ_code_t codes[2048];
     const uint32_t base = (1u << 15) - VOL / 2u;
     for (unsigned round = 0; round < 40u; round++) {
         occ_map_t m;
         assert_int_equal(occ_map_init(&m, &cfg, arena_a, sizeof arena_a), OCC_OK);
-        random_content(&m, base, 20u + rnd() % 50u);
+        random_content(&m, base, 20u + ev_rnd() % 50u);
         for (unsigned b = 0; b < 10u; b++) {
-            size_t n = 1u + rnd() % 2000u;
+            size_t n = 1u + ev_rnd() % 2000u;
             for (size_t i = 0; i < n; i++) {
-                occ_key_t k = {{base + rnd() % VOL, base + rnd() % VOL, base + rnd() % VOL}};
-                codes[i] = occ_morton_encode(k) | (rnd() % 2u ? OCC_CODE_HIT_BIT : 0u);
+                occ_key_t k = {{base + ev_rnd() % VOL, base + ev_rnd() % VOL, base + ev_rnd() % VOL}};
+                codes[i] = occ_morton_encode(k) | (ev_rnd() % 2u ? OCC_CODE_HIT_BIT : 0u);
             }
-            n = sort_unique(codes, n);
+            n = ev_sort_unique(codes, n);
             uint32_t ni, nl;
             assert_int_equal(occ_map_observe_need(&m, codes, n, &ni, &nl), OCC_OK);
             const uint32_t pi = m.inner.used, pl = m.leaf.used;
@@ -572,12 +513,12 @@ static void test_observe_need(void **state)
             assert_true(m.leaf.used <= pl + nl);
         }
         /* A fresh map of exactly the needed size accepts the batch; one byte less refuses. */
-        size_t n = 1u + rnd() % 500u;
+        size_t n = 1u + ev_rnd() % 500u;
         for (size_t i = 0; i < n; i++) {
-            occ_key_t k = {{base + rnd() % VOL, base + rnd() % VOL, base + rnd() % VOL}};
-            codes[i] = occ_morton_encode(k) | (rnd() % 2u ? OCC_CODE_HIT_BIT : 0u);
+            occ_key_t k = {{base + ev_rnd() % VOL, base + ev_rnd() % VOL, base + ev_rnd() % VOL}};
+            codes[i] = occ_morton_encode(k) | (ev_rnd() % 2u ? OCC_CODE_HIT_BIT : 0u);
         }
-        n = sort_unique(codes, n);
+        n = ev_sort_unique(codes, n);
         occ_map_t e;
         assert_int_equal(occ_map_init(&e, &cfg, arena_b, sizeof arena_b), OCC_OK);
         uint32_t ni, nl;
@@ -591,260 +532,6 @@ static void test_observe_need(void **state)
     }
 }
 
-/* ---- automatic mode ----------------------------------------------------------------------------- */
-
-typedef struct {
-    occ_code_t *codes;
-    size_t n;
-    occ_vec3_t origin;
-} scan_codes_t;
-
-typedef struct {
-    size_t chunks, chunk_fails, evict_calls;
-    bool check_each; /* occ_map_check() after every eviction call, not only per scan */
-} auto_stats_t;
-
-/* The integrator's automatic mode as documented for occ_map_insert_cloud: apply in Morton
- * chunks; on NOMEM ask eviction for what the chunk needs and retry (the need can grow when
- * eviction prunes a node the chunk lies in, hence the loop). */
-static void auto_observe(occ_map_t *m, const scan_codes_t *s, const occ_evict_policy_t *p,
-                         occ_evict_out_t *ev, auto_stats_t *as)
-{
-    const size_t chunk = 4096u;
-    for (size_t s0 = 0; s0 < s->n; s0 += chunk) {
-        const size_t n = s->n - s0 < chunk ? s->n - s0 : chunk;
-        occ_err_t e = occ_map_observe_codes(m, s->codes + s0, n, NULL);
-        for (unsigned r = 0; r < 8u && e == OCC_ERR_NOMEM; r++) {
-            uint32_t ni, nl;
-            assert_int_equal(occ_map_observe_need(m, s->codes + s0, n, &ni, &nl), OCC_OK);
-            as->evict_calls++;
-            const occ_err_t ee = occ_map_evict_for(m, &s->origin, p, ni, nl, ev);
-            if (as->check_each) {
-                assert_int_equal(occ_map_check(m), OCC_OK);
-            }
-            if (ee != OCC_OK) {
-                break;
-            }
-            e = occ_map_observe_codes(m, s->codes + s0, n, NULL);
-        }
-        as->chunks++;
-        if (e != OCC_OK) {
-            as->chunk_fails++;
-        }
-    }
-}
-
-/* Voxels within r of c read the same in both maps. */
-static size_t compare_ball(const occ_map_t *a, const occ_map_t *b, const occ_vec3_t c,
-                           const float r, size_t *n_known)
-{
-    occ_key_t kc;
-    assert_int_equal(occ_map_key(a, c, &kc), OCC_OK);
-    const int32_t ext = (int32_t)(r / a->cfg.resolution_m) + 1;
-    size_t bad = 0, known = 0;
-    for (int32_t dz = -ext; dz <= ext; dz++) {
-        for (int32_t dy = -ext; dy <= ext; dy++) {
-            for (int32_t dx = -ext; dx <= ext; dx++) {
-                occ_key_t k = {{(uint32_t)((int32_t)kc.k[0] + dx), (uint32_t)((int32_t)kc.k[1] + dy),
-                                (uint32_t)((int32_t)kc.k[2] + dz)}};
-                const occ_vec3_t p = occ_map_key_center(a, k, 0u);
-                const float ddx = p.x - c.x, ddy = p.y - c.y, ddz = p.z - c.z;
-                if (ddx * ddx + ddy * ddy + ddz * ddz > r * r) {
-                    continue;
-                }
-                occ_node_info_t ia, ib;
-                assert_int_equal(occ_map_read_key(a, k, 0u, &ia), OCC_OK);
-                assert_int_equal(occ_map_read_key(b, k, 0u, &ib), OCC_OK);
-                known += ib.observed ? 1u : 0u;
-                if (ia.observed != ib.observed || ia.logodds < ib.logodds ||
-                    ia.logodds > ib.logodds) {
-                    bad++;
-                }
-            }
-        }
-    }
-    *n_known = known;
-    return bad;
-}
-
-/* A straight flight: each step observes clustered voxels within 0.6 m of the position. */
-static void test_auto_path(void **state)
-{
-    (void)state;
-    const occ_map_config_t cfg = cfg_res(0.1f);
-    enum { STEPS = 150 };
-    static scan_codes_t scans[STEPS];
-    const float obs_r = 0.6f;
-    occ_map_t ref;
-    assert_int_equal(occ_map_init(&ref, &cfg, arena_b, sizeof arena_b), OCC_OK);
-    for (unsigned t = 0; t < STEPS; t++) {
-        const occ_vec3_t o = {0.2f * (float)t - 15.0f, 0.05f * (float)t, 0.0f};
-        occ_code_t *c = malloc(3000u * sizeof *c);
-        assert_non_null(c);
-        size_t n = 0;
-        while (n < 3000u) {
-            const occ_vec3_t q = {o.x + (2.0f * rndf() - 1.0f) * obs_r,
-                                  o.y + (2.0f * rndf() - 1.0f) * obs_r,
-                                  o.z + (2.0f * rndf() - 1.0f) * obs_r};
-            const float dx = q.x - o.x, dy = q.y - o.y, dz = q.z - o.z;
-            if (dx * dx + dy * dy + dz * dz > obs_r * obs_r) {
-                continue;
-            }
-            occ_key_t k;
-            assert_int_equal(occ_map_key(&ref, q, &k), OCC_OK);
-            c[n++] = occ_morton_encode(k) | (fabsf(q.z - 0.3f) < 0.05f ? OCC_CODE_HIT_BIT : 0u);
-        }
-        scans[t].codes = c;
-        scans[t].n = sort_unique(c, n);
-        scans[t].origin = o;
-    }
-    /* unbounded reference */
-    for (unsigned t = 0; t < STEPS; t++) {
-        assert_int_equal(occ_map_observe_codes(&ref, scans[t].codes, scans[t].n, NULL), OCC_OK);
-    }
-    occ_map_stats_t st;
-    occ_map_pool_stats(&ref, &st);
-    const size_t full = st.bytes_peak;
-    printf("auto path: unbounded map %zu bytes\n", full);
-    const float fracs[] = {0.1f, 0.25f, 0.5f, 1.0f, 1.2f};
-    for (unsigned mode = 0; mode < 2u; mode++) {
-        for (size_t f = 0; f < sizeof fracs / sizeof fracs[0]; f++) {
-            const size_t bytes = (size_t)((float)full * fracs[f]);
-            occ_map_t m;
-            assert_int_equal(occ_map_init(&m, &cfg, arena_a, bytes), OCC_OK);
-            occ_evict_policy_t p = occ_evict_policy_default();
-            p.mode = (occ_evict_mode_t)mode;
-            p.keep_radius_m = obs_r + 0.2f;
-            occ_evict_out_t ev;
-            occ_evict_out_init(&ev);
-            auto_stats_t as = {0u, 0u, 0u, true};
-            for (unsigned t = 0; t < STEPS; t++) {
-                auto_observe(&m, &scans[t], &p, &ev, &as);
-                assert_int_equal(occ_map_check(&m), OCC_OK);
-                occ_map_pool_stats(&m, &st);
-                assert_true(st.bytes_used <= m.arena_bytes);
-            }
-            size_t known;
-            const size_t bad = compare_ball(&m, &ref, scans[STEPS - 1].origin, obs_r, &known);
-            printf("auto path %s arena %.2f of the map (%zu B): chunks %zu failed %zu, "
-                   "evictions %llu, blocks freed %llu, peak %zu B; within %.1f m of the last "
-                   "position %zu known voxels, %zu differ\n",
-                   mode ? "coarsen" : "robot", (double)fracs[f], bytes, as.chunks,
-                   as.chunk_fails, (unsigned long long)ev.evictions,
-                   (unsigned long long)ev.blocks_freed, st.bytes_peak, (double)obs_r, known, bad);
-            assert_int_equal(as.chunk_fails, 0u);
-            assert_int_equal(bad, 0u);
-            assert_true(known > 0u);
-        }
-    }
-    for (unsigned t = 0; t < STEPS; t++) {
-        free(scans[t].codes);
-    }
-}
-
-/* ---- the real depth frames ----------------------------------------------------------------------- */
-
-static void test_tum_exhaustion(void **state)
-{
-    (void)state;
-    if (access(TUM_DIR "/my_association.txt", R_OK) != 0) {
-        printf("SKIP test_tum_exhaustion: %s absent (needs ../shared)\n", TUM_DIR);
-        skip();
-    }
-    const occ_map_config_t cfg = cfg_res(0.05f);
-    occ_scan_frame_t *fr = NULL;
-    size_t nf = 0;
-    char msg[256];
-    assert_int_equal(occ_depth_read_tum_dir(TUM_DIR, 12u, 0u, &fr, &nf, msg, sizeof msg), OCC_OK);
-    assert_int_equal(nf, 10u);
-    occ_map_t ref;
-    assert_int_equal(occ_map_init(&ref, &cfg, arena_b, sizeof arena_b), OCC_OK);
-    scan_codes_t scans[10];
-    const size_t kcap = 4096u;
-    occ_key_t *keys = malloc(kcap * sizeof *keys);
-    assert_non_null(keys);
-    for (size_t i = 0; i < nf; i++) {
-        size_t cap = 1u << 18, len = 0;
-        occ_code_t *c = malloc(cap * sizeof *c);
-        assert_non_null(c);
-        for (size_t j = 0; j < fr[i].n_points; j++) {
-            size_t nk;
-            if (occ_ray_keys(&ref, fr[i].origin, fr[i].points[j], keys, kcap, &nk) != OCC_OK) {
-                continue;
-            }
-            if (len + nk + 1u > cap) {
-                cap *= 2u;
-                c = realloc(c, cap * sizeof *c);
-                assert_non_null(c);
-            }
-            for (size_t k = 0; k < nk; k++) {
-                c[len++] = occ_morton_encode(keys[k]);
-            }
-            occ_key_t ek;
-            if (occ_map_key(&ref, fr[i].points[j], &ek) == OCC_OK) {
-                c[len++] = occ_morton_encode(ek) | OCC_CODE_HIT_BIT;
-            }
-        }
-        scans[i].codes = c;
-        scans[i].n = sort_unique(c, len);
-        scans[i].origin = fr[i].origin;
-        assert_int_equal(occ_map_observe_codes(&ref, c, scans[i].n, NULL), OCC_OK);
-    }
-    free(keys);
-    occ_map_stats_t st;
-    occ_map_pool_stats(&ref, &st);
-    const size_t full = st.bytes_peak;
-    printf("TUM: 10 frames (every 12th pixel), 0.05 m, unbounded map %zu bytes\n", full);
-    /* Arenas from a tenth of the map to all of it. The protected radius must hold the map near
-     * the sensor: 4 m (the camera moves 0.9 m, so every voxel within 3 m of the last origin
-     * stays protected from its first observation on) fits from half the map; smaller arenas use
-     * 1 m and are checked for no failure and invariants. */
-    const struct { float frac, keep; occ_evict_mode_t mode; bool equal3m; } cases[] = {
-        {0.10f, 1.0f, OCC_EVICT_ROBOT, false},   {0.10f, 1.0f, OCC_EVICT_COARSEN, false},
-        {0.50f, 4.0f, OCC_EVICT_ROBOT, true},
-        {0.50f, 4.0f, OCC_EVICT_COARSEN, true},  {1.00f, 4.0f, OCC_EVICT_ROBOT, true},
-    };
-    for (size_t ci = 0; ci < sizeof cases / sizeof cases[0]; ci++) {
-        const size_t bytes = (size_t)((float)full * cases[ci].frac);
-        occ_map_t m;
-        assert_int_equal(occ_map_init(&m, &cfg, arena_a, bytes), OCC_OK);
-        occ_evict_policy_t p = occ_evict_policy_default();
-        p.mode = cases[ci].mode;
-        p.keep_radius_m = cases[ci].keep;
-        occ_evict_out_t ev;
-        occ_evict_out_init(&ev);
-        auto_stats_t as = {0u, 0u, 0u, ci == 0u};
-        for (size_t i = 0; i < nf; i++) {
-            auto_observe(&m, &scans[i], &p, &ev, &as);
-            assert_int_equal(occ_map_check(&m), OCC_OK);
-        }
-        occ_map_pool_stats(&m, &st);
-        size_t known = 0, bad = 0;
-        if (cases[ci].equal3m) {
-            bad = compare_ball(&m, &ref, scans[nf - 1u].origin, 3.0f, &known);
-        }
-        printf("TUM %s keep %.1f m arena %.2f of the map (%zu B): chunks %zu failed %zu, "
-               "evictions %llu, blocks freed %llu, peak %zu B%s",
-               cases[ci].mode == OCC_EVICT_ROBOT ? "robot" : "coarsen", (double)cases[ci].keep,
-               (double)cases[ci].frac, bytes, as.chunks, as.chunk_fails,
-               (unsigned long long)ev.evictions, (unsigned long long)ev.blocks_freed,
-               st.bytes_peak, cases[ci].equal3m ? "" : "\n");
-        if (cases[ci].equal3m) {
-            printf("; within 3 m of the last origin %zu known voxels, %zu differ\n", known, bad);
-        }
-        assert_int_equal(as.chunk_fails, 0u);
-        assert_true(st.bytes_peak <= m.arena_bytes);
-        assert_int_equal(bad, 0u);
-        if (cases[ci].equal3m) {
-            assert_true(known > 1000u);
-        }
-    }
-    for (size_t i = 0; i < nf; i++) {
-        free(scans[i].codes);
-    }
-    occ_scan_frames_free(fr, nf);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -855,8 +542,6 @@ int main(void)
         cmocka_unit_test(test_coarsen_rule),
         cmocka_unit_test(test_slices_match_oneshot),
         cmocka_unit_test(test_observe_need),
-        cmocka_unit_test(test_auto_path),
-        cmocka_unit_test(test_tum_exhaustion),
     };
-    return cmocka_run_group_tests(tests, setup_seed, NULL);
+    return cmocka_run_group_tests(tests, ev_setup_seed, NULL);
 }

@@ -387,11 +387,11 @@ static void test_issue_case(void **state)
     assert_int_equal(r.key.k[0], 32768u + 10u);
     /* The decimal resolution the map holds: 0.1, 0.08 (shortest decimals of the floats). */
 #if OCC_RAY_DOUBLE
-    assert_true(feq(map.geo_res, 0.1));
+    assert_true(feq(map.priv.geo_res, 0.1));
     init_free_map(0.08f, 16u);
-    assert_true(feq(map.geo_res, 0.08));
+    assert_true(feq(map.priv.geo_res, 0.08));
     init_free_map(0.15f, 16u);
-    assert_true(feq(map.geo_res, 0.15));
+    assert_true(feq(map.priv.geo_res, 0.15));
 #endif
 }
 

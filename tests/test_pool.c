@@ -104,7 +104,7 @@ static void test_alloc_free_inner(void **state)
     /* Blocks sit at the top of the arena, inside it, without overlap. */
     for (unsigned i = 0; i < 6u; i++) {
         const uint8_t *const b = (const uint8_t *)occ_inner_at(&map, idx[i]);
-        assert_true(b >= map.arena && b + sizeof(occ_inner_block_t) <= map.arena + map.arena_bytes);
+        assert_true(b >= map.priv.arena && b + sizeof(occ_inner_block_t) <= map.priv.arena + map.arena_bytes);
         assert_true(((uintptr_t)b % 4u) == 0u);
     }
     assert_true(occi_pool_free_inner(&map, idx[2]));
@@ -140,7 +140,7 @@ static void test_alloc_free_leaf(void **state)
     }
     for (unsigned i = 0; i < 5u; i++) {
         const uint8_t *const b = (const uint8_t *)occ_leaf_at(&map, i);
-        assert_true(b >= map.arena && b + sizeof(occ_leaf_block_t) <= map.arena + map.arena_bytes);
+        assert_true(b >= map.priv.arena && b + sizeof(occ_leaf_block_t) <= map.priv.arena + map.arena_bytes);
     }
     assert_true(occi_pool_free_leaf(&map, 1u));
     assert_true(occi_pool_free_leaf(&map, 3u));
@@ -278,8 +278,8 @@ static void test_arena_sizing(void **state)
                     continue; /* may or may not hold one block of each (see B1) */
                 }
                 assert_int_equal(e, OCC_OK);
-                assert_true(m.arena >= arena + mis && m.arena + m.arena_bytes <= arena + mis + bytes);
-                assert_true(((uintptr_t)m.arena % OCC_ARENA_ALIGN) == 0u);
+                assert_true(m.priv.arena >= arena + mis && m.priv.arena + m.arena_bytes <= arena + mis + bytes);
+                assert_true(((uintptr_t)m.priv.arena % OCC_ARENA_ALIGN) == 0u);
                 assert_true(occi_pool_can_supply(&m, i, j));
                 for (uint32_t a = 0; a < i; a++) {
                     assert_int_equal(occi_pool_alloc_inner(&m), a);

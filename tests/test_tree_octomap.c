@@ -384,8 +384,8 @@ static unsigned make_patterns(pattern_t *p, unsigned want)
         for (unsigned i = 0; i < c.len; i++) {
             c.hit[i] = urand(4u) < (bias < 2u ? 3u : (bias < 4u ? 1u : 2u));
             f = octo_step(f, i > 0u, c.hit[i] ? h : m, lo, hi);
-            q = occ_step(q, i > 0u, c.hit[i] ? map.q_hit : map.q_miss, map.q_clamp_min,
-                         map.q_clamp_max);
+            q = occ_step(q, i > 0u, c.hit[i] ? map.priv.q_hit : map.priv.q_miss, map.priv.q_clamp_min,
+                         map.priv.q_clamp_max);
         }
         c.f = f;
         c.q = (occ_value_t)q;

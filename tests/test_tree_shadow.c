@@ -228,10 +228,10 @@ static void run_depth(const occ_map_config_t *cfg, const uint32_t base[3], unsig
     assert_int_equal(occ_map_init(&map, cfg, arena, sizeof arena), OCC_OK);
     shadow_grid_t s;
     assert_true(shadow_init(&s, &map, vol_log2, base));
-    assert_memory_equal(&s.q_hit, &map.q_hit, sizeof s.q_hit);
-    assert_memory_equal(&s.q_miss, &map.q_miss, sizeof s.q_miss);
-    assert_memory_equal(&s.q_cmin, &map.q_clamp_min, sizeof s.q_cmin);
-    assert_memory_equal(&s.q_cmax, &map.q_clamp_max, sizeof s.q_cmax);
+    assert_memory_equal(&s.q_hit, &map.priv.q_hit, sizeof s.q_hit);
+    assert_memory_equal(&s.q_miss, &map.priv.q_miss, sizeof s.q_miss);
+    assert_memory_equal(&s.q_cmin, &map.priv.q_clamp_min, sizeof s.q_cmin);
+    assert_memory_equal(&s.q_cmax, &map.priv.q_clamp_max, sizeof s.q_cmax);
     hot_t h;
     new_hot(&s, &h);
     char ctx[128];

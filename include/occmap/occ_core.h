@@ -167,35 +167,27 @@ occ_map_config_t occ_map_config_default(void);
 /* How many leaf blocks fit in `arena_bytes` next to `n_inner` inner blocks (0 if none). */
 uint32_t occ_arena_blocks_for_bytes(size_t arena_bytes, uint32_t n_inner);
 
-/* One pool's counters (read-only for callers). */
+/* One pool's counters. A caller may read used, peak, hwm and free_count (never write them). */
 typedef struct {
     uint32_t used;       /* blocks handed out now */
     uint32_t peak;       /* max of used since init/clear */
     uint32_t hwm;        /* blocks ever carved from the arena (free list + used) */
-    uint32_t free_head;  /* first block of the intrusive free list, OCC_NONE if empty */
     uint32_t free_count; /* blocks on the free list */
+    struct {             /* internal: do not touch, layout may change */
+        uint32_t free_head; /* first block of the intrusive free list, OCC_NONE if empty */
+    } priv;
 } occ_pool_t;
 
 #define OCC_NONE UINT32_MAX
 
+/* A map: caller-allocated (static is fine: its size is fixed at compile time), set up by
+ * occ_map_init() and changed only through the API. A caller may read the fields above `priv`
+ * (never write them); `priv` is the map's own state: do not touch, its layout may change. */
 typedef struct {
-    occ_map_config_t cfg;
-    /* Quantized copies of the config (internal). */
-    occ_value_t q_hit, q_miss, q_clamp_min, q_clamp_max, q_free_max, q_occ_min;
-    uint8_t *arena;           /* aligned start of the arena */
-    size_t arena_bytes;       /* usable bytes from `arena` */
-    uint32_t block_budget;    /* arena_bytes / OCC_LEAF_BLOCK_BYTES: leaf-sized units */
+    occ_map_config_t cfg;     /* the configuration occ_map_init() accepted */
+    size_t arena_bytes;       /* usable bytes of the arena (after alignment) */
     occ_pool_t inner, leaf;   /* inner blocks grow down from the top, leaves up from the bottom */
-    uint32_t oom_count;       /* operations refused with OCC_ERR_NOMEM */
-    /* Voxel geometry (internal), set once by occ_map_init(): the resolution as the shortest
-     * decimal that rounds to cfg.resolution_m (0.1f -> 0.1, what OcTree(0.1) holds) and its
-     * inverse, in double when OCC_RAY_DOUBLE (0 in the float build), and as floats. */
-    double geo_res, geo_inv;
-    float geo_res_f, geo_inv_f;
-    /* The root node (level depth_levels) lives here, not in a block. */
-    uint32_t root_child;
-    occ_value_t root_value;
-    uint8_t root_flags;
+    uint32_t oom_count;       /* operations refused with OCC_ERR_NOMEM since init/clear */
     /* Write generation: +1 (mod 2^32) on every call that may change the tree (update, observe,
      * insert and integrate, set, forget, evict, clear, read into the map). Handles that keep
      * block indices between calls (occ_lookup_t, occ_query_iter_t, occ_nearest_t, occ_walk_t,
@@ -203,6 +195,21 @@ typedef struct {
      * (and occ_io_load(), which initializes) restarts it: handles taken before a re-init of the
      * same struct are not detected, so drop them with the old map. */
     uint32_t write_gen;
+    struct {
+        /* Quantized copies of the config. */
+        occ_value_t q_hit, q_miss, q_clamp_min, q_clamp_max, q_free_max, q_occ_min;
+        uint8_t *arena;           /* aligned start of the arena */
+        uint32_t block_budget;    /* arena_bytes / OCC_LEAF_BLOCK_BYTES: leaf-sized units */
+        /* Voxel geometry, set once by occ_map_init(): the resolution as the shortest decimal
+         * that rounds to cfg.resolution_m (0.1f -> 0.1, what OcTree(0.1) holds) and its
+         * inverse, in double when OCC_RAY_DOUBLE (0 in the float build), and as floats. */
+        double geo_res, geo_inv;
+        float geo_res_f, geo_inv_f;
+        /* The root node (level depth_levels) lives here, not in a block. */
+        uint32_t root_child;
+        occ_value_t root_value;
+        uint8_t root_flags;
+    } priv;                   /* internal: do not touch, layout may change */
 } occ_map_t;
 
 /* Initialize `map` on the caller's arena (any alignment; the map uses the aligned part).

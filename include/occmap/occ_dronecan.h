@@ -221,17 +221,24 @@ typedef struct {
     uint32_t proximity_sent;  /* Proximity transfers sent completely */
 } occ_dronecan_stats_t;
 
+/* The node: caller-allocated, set up by occ_dronecan_init(), changed only through the API.
+ * A caller may read the fields above `priv` (never write them); `priv` is the node's own
+ * state: do not touch, its layout may change. */
 typedef struct {
-    occ_dronecan_config_t cfg;
-    occ_can_iface_t iface;
+    occ_dronecan_config_t cfg;  /* the configuration occ_dronecan_init() accepted */
     occ_dronecan_stats_t stats;
-    uint8_t tid_proximity, tid_status;
-    bool started;
-    uint64_t start_us, next_proximity_us, next_status_us;
-    uint8_t health, mode;     /* from the last poll */
-    uint16_t last_obstacles;  /* sectors with an obstacle in the last publication (NodeStatus
-                               * vendor_specific_status_code) */
-    occ_sectors_t sectors;    /* scratch for occ_dronecan_poll_map() */
+    uint64_t next_proximity_us, next_status_us; /* when the next publications are due (valid
+                                                 * after the first poll) */
+    uint8_t health, mode;       /* OCC_NODE_HEALTH_*, OCC_NODE_MODE_* from the last poll */
+    uint16_t last_obstacles;    /* sectors with an obstacle in the last publication (NodeStatus
+                                 * vendor_specific_status_code) */
+    struct {
+        occ_can_iface_t iface;
+        uint8_t tid_proximity, tid_status;
+        bool started;
+        uint64_t start_us;
+        occ_sectors_t sectors;  /* scratch for occ_dronecan_poll_map() */
+    } priv;                     /* internal: do not touch, layout may change */
 } occ_dronecan_node_t;
 
 /* Node id 0 (must be set), sensor 0, priority 24, 10 Hz, 1 Hz, 500 ms, version 0.1. */
@@ -283,7 +290,7 @@ occ_err_t occ_dronecan_ingest(occ_dronecan_node_t *node, const occ_can_frame_t *
  * sectors_cfg->map_ned; NULL = no pose); the data is fresh when both
  * stamps are within cfg.stale_after_us of now_us (a stamp ahead of now_us counts as fresh).
  * When a Proximity publication is due and the data is fresh, sectors are computed with
- * occ_sectors_compute() into node->sectors (only then; node->sectors is ~5 KB of scratch, so
+ * occ_sectors_compute() into the node's scratch (only then; it is ~5 KB, so
  * keep the node static on a small stack). If that fails (e.g. OCC_ERR_RANGE: the vehicle is
  * outside the map), the node still publishes - a NO_DATA reading and NodeStatus - and the
  * sector error is returned. Otherwise errors as occ_dronecan_poll. */

@@ -83,7 +83,8 @@ typedef struct occ_evict_policy {
 /* ROBOT, SPHERE, keep 3 m, box 3 m each axis, no budget, coarse levels 2..5. */
 occ_evict_policy_t occ_evict_policy_default(void);
 
-/* Where a sweep stands (internal; zero is "no sweep in progress"). */
+/* Where a sweep stands (internal: do not touch, layout may change; zero is "no sweep in
+ * progress"). */
 typedef struct {
     uint8_t phase;        /* 0 idle, 1 running, 2 a sweep to continue */
     uint8_t coarse_level; /* current collapse level (COARSEN), depth+1 = forgetting */
@@ -120,7 +121,7 @@ typedef struct occ_evict_out {
     /* the map's pools after the last call */
     size_t bytes_used;
     size_t bytes_peak;        /* the pools' peak since the map's init/clear */
-    occ_evict_cursor_t cursor;
+    occ_evict_cursor_t priv;  /* internal: the sweep's cursor; do not touch, layout may change */
 } occ_evict_out_t;
 
 void occ_evict_out_init(occ_evict_out_t *out);

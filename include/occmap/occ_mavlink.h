@@ -113,11 +113,14 @@ typedef struct {
     uint32_t junk_bytes;    /* bytes outside frames */
 } occ_mav_counters_t;
 
+/* A caller may read `counters` (never write them); `priv` is the parser's own state. */
 typedef struct {
     occ_mav_counters_t counters;
-    uint16_t pos;           /* bytes of the current frame held in buf */
-    uint16_t need;          /* total frame length once known, else 0 */
-    uint8_t buf[OCC_MAV_FRAME_MAX];
+    struct {                /* internal: do not touch, layout may change */
+        uint16_t pos;       /* bytes of the current frame held in buf */
+        uint16_t need;      /* total frame length once known, else 0 */
+        uint8_t buf[OCC_MAV_FRAME_MAX];
+    } priv;
 } occ_mav_parser_t;
 
 /* Reset the parser and its counters. O(1). */
@@ -274,21 +277,26 @@ typedef struct {
     uint32_t sector_errors;          /* occ_sectors_compute() failures (vehicle off the map) */
 } occ_mav_feed_counters_t;
 
+/* The feed: caller-allocated, set up by occ_mav_feed_init(), changed only through the API.
+ * A caller may read the fields above `priv` (never write them); `priv` is the feed's own
+ * state: do not touch, its layout may change. */
 typedef struct {
-    occ_mav_feed_config_t cfg;
-    occ_mav_parser_t parser;
-    occ_mav_sender_t tx;
+    occ_mav_feed_config_t cfg;       /* the configuration occ_mav_feed_init() accepted */
+    occ_mav_parser_t parser;         /* parser.counters: every byte and frame received */
     occ_mav_feed_counters_t counters;
-    bool have_pos, have_att, started;
     bool have_autopilot;             /* ap_sysid known (given or learned) */
-    uint8_t ap_sysid, ap_compid;
-    uint8_t request_mask;            /* streams still to ask for in this round: 1 pos, 2 att */
-    uint64_t pos_us, att_us;         /* receive times */
-    uint64_t next_request_us;
-    occ_vec3_t ned_m;                /* last position, local NED metres */
-    occ_quat_t ned_from_frd;         /* last attitude, body FRD -> local NED (unit) */
-    uint64_t next_obstacle_us, next_heartbeat_us;
-    occ_sectors_t sectors;           /* last result + scratch */
+    uint8_t ap_sysid, ap_compid;     /* the autopilot poses are taken from */
+    struct {
+        occ_mav_sender_t tx;
+        bool have_pos, have_att, started;
+        uint8_t request_mask;        /* streams still to ask for in this round: 1 pos, 2 att */
+        uint64_t pos_us, att_us;     /* receive times */
+        uint64_t next_request_us;
+        occ_vec3_t ned_m;            /* last position, local NED metres */
+        occ_quat_t ned_from_frd;     /* last attitude, body FRD -> local NED (unit) */
+        uint64_t next_obstacle_us, next_heartbeat_us;
+        occ_sectors_t sectors;       /* last result + scratch */
+    } priv;                          /* internal: do not touch, layout may change */
 } occ_mav_feed_t;
 
 occ_mav_feed_config_t occ_mav_feed_config_default(void);

@@ -36,7 +36,7 @@ static bool tally_complete(const tally_t *const t, const uint32_t hwm)
 static bool check_free_lists(const occ_map_t *const m, tally_t *const inner, tally_t *const leaf)
 {
     uint32_t n = 0u;
-    for (uint32_t i = m->inner.free_head; i != OCC_NONE; i = occ_inner_at(m, i)->child[0]) {
+    for (uint32_t i = m->inner.priv.free_head; i != OCC_NONE; i = occ_inner_at(m, i)->child[0]) {
         if (i >= m->inner.hwm || n++ > m->inner.hwm ||
             occ_inner_at(m, i)->flags[7] != OCC_INNER_FREE_MARK) {
             return false; /* foreign index, cycle, or a used block on the list */
@@ -47,7 +47,7 @@ static bool check_free_lists(const occ_map_t *const m, tally_t *const inner, tal
         return false;
     }
     n = 0u;
-    uint32_t i = m->leaf.free_head;
+    uint32_t i = m->leaf.priv.free_head;
     while (i != OCC_NONE) {
         if (i >= m->leaf.hwm || n++ > m->leaf.hwm) {
             return false;
@@ -126,7 +126,7 @@ static bool check_subtree(const occ_map_t *const m, const unsigned depth, tally_
     uint32_t blk[OCC_MAX_DEPTH + 1];
     uint8_t lvl[OCC_MAX_DEPTH + 1], next[OCC_MAX_DEPTH + 1];
     unsigned sp = 0;
-    blk[0] = m->root_child;
+    blk[0] = m->priv.root_child;
     lvl[0] = (uint8_t)(depth - 1u);
     next[0] = 0u;
     for (;;) {
@@ -163,15 +163,15 @@ static bool check_subtree(const occ_map_t *const m, const unsigned depth, tally_
 static bool check_tree(const occ_map_t *const m, tally_t *const inner, tally_t *const leaf)
 {
     const unsigned depth = m->cfg.depth_levels;
-    if (m->root_child == OCC_NONE) {
-        return m->root_flags == occ_value_flags(m, m->root_value);
+    if (m->priv.root_child == OCC_NONE) {
+        return m->priv.root_flags == occ_value_flags(m, m->priv.root_value);
     }
     /* The auditor survives any bytes: depth, counters and every index are range-checked here
      * before they are followed, so the accessors' asserts never see a bad one from this walk. */
     if (depth < 1u || depth > OCC_MAX_DEPTH) {
         return false;
     }
-    if (!check_child(m, m->root_child, depth, m->root_value, m->root_flags, inner, leaf)) {
+    if (!check_child(m, m->priv.root_child, depth, m->priv.root_value, m->priv.root_flags, inner, leaf)) {
         return false;
     }
     return depth == 1u || check_subtree(m, depth, inner, leaf);
@@ -189,7 +189,7 @@ occ_err_t occ_map_check(const occ_map_t *const m)
     }
     /* Every block below the high-water marks owned exactly once, by the tree or a free list;
      * an empty tree owns none (its blocks are all free). */
-    if (m->root_child != OCC_NONE && (inner.count - m->inner.free_count != m->inner.used ||
+    if (m->priv.root_child != OCC_NONE && (inner.count - m->inner.free_count != m->inner.used ||
                                       leaf.count - m->leaf.free_count != m->leaf.used)) {
         return OCC_ERR_CORRUPT;
     }

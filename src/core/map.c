@@ -38,12 +38,12 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
         return OCC_ERR_ARG;
     }
     map->cfg = *cfg;
-    map->q_hit = occ_value_from_logodds(cfg->hit);
-    map->q_miss = occ_value_from_logodds(cfg->miss);
-    map->q_clamp_min = occ_value_from_logodds(cfg->clamp_min);
-    map->q_clamp_max = occ_value_from_logodds(cfg->clamp_max);
-    map->q_free_max = occ_value_from_logodds(cfg->free_max);
-    map->q_occ_min = occ_value_from_logodds(cfg->occupied_min);
+    map->priv.q_hit = occ_value_from_logodds(cfg->hit);
+    map->priv.q_miss = occ_value_from_logodds(cfg->miss);
+    map->priv.q_clamp_min = occ_value_from_logodds(cfg->clamp_min);
+    map->priv.q_clamp_max = occ_value_from_logodds(cfg->clamp_max);
+    map->priv.q_free_max = occ_value_from_logodds(cfg->free_max);
+    map->priv.q_occ_min = occ_value_from_logodds(cfg->occupied_min);
     occi_geom_init(map);
     /* Align the start and the size to 8 so both block kinds stay aligned from either end. */
     uintptr_t start = (uintptr_t)arena;
@@ -54,9 +54,9 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
         bytes = bytes > adj ? bytes - adj : 0u;
         start += adj;
     }
-    map->arena = (uint8_t *)start;
+    map->priv.arena = (uint8_t *)start;
     map->arena_bytes = bytes - bytes % OCC_ARENA_ALIGN;
-    map->block_budget = (uint32_t)(map->arena_bytes / OCC_LEAF_BLOCK_BYTES);
+    map->priv.block_budget = (uint32_t)(map->arena_bytes / OCC_LEAF_BLOCK_BYTES);
     map->write_gen = 0u; /* occ_map_clear() makes it 1 */
     occ_map_clear(map);
     return OCC_OK;
@@ -67,13 +67,13 @@ void occ_map_clear(occ_map_t *const map)
     if (map == NULL) {
         return;
     }
-    const occ_pool_t empty = {0u, 0u, 0u, OCC_NONE, 0u};
+    const occ_pool_t empty = {0u, 0u, 0u, 0u, {OCC_NONE}};
     map->inner = empty;
     map->leaf = empty;
     map->oom_count = 0u;
-    map->root_child = OCC_NONE;
-    map->root_value = OCC_VALUE_UNOBSERVED;
-    map->root_flags = (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    map->priv.root_child = OCC_NONE;
+    map->priv.root_value = OCC_VALUE_UNOBSERVED;
+    map->priv.root_flags = (uint8_t)OCC_NODE_HAS_UNKNOWN;
     map->write_gen++; /* every handle on the old content is stale */
 }
 

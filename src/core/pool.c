@@ -48,13 +48,13 @@ bool occi_pool_can_supply(const occ_map_t *const m, const uint32_t n_inner, cons
 
 uint32_t occi_pool_alloc_inner(occ_map_t *const m)
 {
-    uint32_t idx = m->inner.free_head;
+    uint32_t idx = m->inner.priv.free_head;
     OCC_ASSERT(pools_fit(m));
     if (idx != OCC_NONE) {
         OCC_ASSERT(m->inner.free_count > 0u);
         OCC_ASSERT(occ_inner_at(m, idx)->flags[7] == OCC_INNER_FREE_MARK);
-        m->inner.free_head = occ_inner_at(m, idx)->child[0];
-        OCC_ASSERT(m->inner.free_head == OCC_NONE || m->inner.free_head < m->inner.hwm);
+        m->inner.priv.free_head = occ_inner_at(m, idx)->child[0];
+        OCC_ASSERT(m->inner.priv.free_head == OCC_NONE || m->inner.priv.free_head < m->inner.hwm);
         m->inner.free_count--;
     } else if (gap_bytes(m) >= sizeof(occ_inner_block_t)) {
         idx = m->inner.hwm++;
@@ -68,12 +68,12 @@ uint32_t occi_pool_alloc_inner(occ_map_t *const m)
 
 uint32_t occi_pool_alloc_leaf(occ_map_t *const m)
 {
-    uint32_t idx = m->leaf.free_head;
+    uint32_t idx = m->leaf.priv.free_head;
     OCC_ASSERT(pools_fit(m));
     if (idx != OCC_NONE) {
         OCC_ASSERT(m->leaf.free_count > 0u);
-        memcpy(&m->leaf.free_head, occ_leaf_at(m, idx)->value, sizeof(uint32_t));
-        OCC_ASSERT(m->leaf.free_head == OCC_NONE || m->leaf.free_head < m->leaf.hwm);
+        memcpy(&m->leaf.priv.free_head, occ_leaf_at(m, idx)->value, sizeof(uint32_t));
+        OCC_ASSERT(m->leaf.priv.free_head == OCC_NONE || m->leaf.priv.free_head < m->leaf.hwm);
         m->leaf.free_count--;
     } else if (gap_bytes(m) >= sizeof(occ_leaf_block_t)) {
         idx = m->leaf.hwm++;
@@ -94,8 +94,8 @@ bool occi_pool_free_inner(occ_map_t *const m, const uint32_t idx)
         return false;  /* already free */
     }
     b->flags[7] = OCC_INNER_FREE_MARK;
-    b->child[0] = m->inner.free_head;
-    m->inner.free_head = idx;
+    b->child[0] = m->inner.priv.free_head;
+    m->inner.priv.free_head = idx;
     m->inner.free_count++;
     m->inner.used--;
     return true;
@@ -107,7 +107,7 @@ bool occi_pool_free_leaf(occ_map_t *const m, const uint32_t idx)
         return false;
     }
 #if OCC_POOL_PARANOID
-    uint32_t it = m->leaf.free_head;
+    uint32_t it = m->leaf.priv.free_head;
     for (uint32_t n = 0; it != OCC_NONE && n <= m->leaf.free_count; n++) {
         if (it == idx) {
             return false;  /* already free */
@@ -115,8 +115,8 @@ bool occi_pool_free_leaf(occ_map_t *const m, const uint32_t idx)
         memcpy(&it, occ_leaf_at(m, it)->value, sizeof it);
     }
 #endif
-    memcpy(occ_leaf_at(m, idx)->value, &m->leaf.free_head, sizeof(uint32_t));
-    m->leaf.free_head = idx;
+    memcpy(occ_leaf_at(m, idx)->value, &m->leaf.priv.free_head, sizeof(uint32_t));
+    m->leaf.priv.free_head = idx;
     m->leaf.free_count++;
     m->leaf.used--;
     return true;

@@ -7,7 +7,7 @@
 static double volume_resolution(const occ_map_t *const map)
 {
 #if OCC_RAY_DOUBLE
-    return map->geo_res;
+    return map->priv.geo_res;
 #else
     return occi_geom_decimal(map->cfg.resolution_m);
 #endif

@@ -174,9 +174,9 @@ occ_err_t occ_map_read_key(const occ_map_t *const map, const occ_key_t key, cons
     }
     const occ_code_t code = occ_morton_encode(key);
     unsigned l = map->cfg.depth_levels;
-    uint32_t child = map->root_child;
-    occ_value_t v = map->root_value;
-    uint8_t f = map->root_flags;
+    uint32_t child = map->priv.root_child;
+    occ_value_t v = map->priv.root_value;
+    uint8_t f = map->priv.root_flags;
     while (l > level && child != OCC_NONE) {
         const unsigned slot = occ_code_slot(code, l);
         l--;
@@ -276,7 +276,7 @@ static occ_value_t delta_of(const occ_map_t *const m, const occ_code_t code, con
     if (mode == DELTA_FIXED) {
         return fixed;
     }
-    return (code & OCC_CODE_HIT_BIT) != 0u ? m->q_hit : m->q_miss;
+    return (code & OCC_CODE_HIT_BIT) != 0u ? m->priv.q_hit : m->priv.q_miss;
 }
 
 /* Checks order and range, and bounds the blocks the batch can need without reading the tree:
@@ -316,9 +316,9 @@ static void count_blocks(const occ_map_t *const m, const occ_code_t *const codes
     path_t p;
     const unsigned depth = m->cfg.depth_levels;
     /* Read only: the path starts at a copy of the root, so the map can stay const. */
-    uint32_t root_child = m->root_child;
-    occ_value_t root_value = m->root_value;
-    uint8_t root_flags = m->root_flags;
+    uint32_t root_child = m->priv.root_child;
+    occ_value_t root_value = m->priv.root_value;
+    uint8_t root_flags = m->priv.root_flags;
     p.node[depth].child = &root_child;
     p.node[depth].value = &root_value;
     p.node[depth].flags = &root_flags;

@@ -73,35 +73,35 @@ typedef struct {
 static inline occ_inner_block_t *occ_inner_at(const occ_map_t *m, uint32_t idx)
 {
     OCC_ASSERT(idx < m->inner.hwm);
-    return (occ_inner_block_t *)(void *)(m->arena + m->arena_bytes -
+    return (occ_inner_block_t *)(void *)(m->priv.arena + m->arena_bytes -
                                          ((size_t)idx + 1u) * sizeof(occ_inner_block_t));
 }
 
 static inline occ_leaf_block_t *occ_leaf_at(const occ_map_t *m, uint32_t idx)
 {
     OCC_ASSERT(idx < m->leaf.hwm);
-    return (occ_leaf_block_t *)(void *)(m->arena + (size_t)idx * sizeof(occ_leaf_block_t));
+    return (occ_leaf_block_t *)(void *)(m->priv.arena + (size_t)idx * sizeof(occ_leaf_block_t));
 }
 
 /* Where block 0 of each pool is (carved or not), for walks that index from a base pointer:
  * they assert the index against the high-water mark themselves. */
 static inline const occ_inner_block_t *occ_inner_base(const occ_map_t *m)
 {
-    return (const occ_inner_block_t *)(const void *)(m->arena + m->arena_bytes -
+    return (const occ_inner_block_t *)(const void *)(m->priv.arena + m->arena_bytes -
                                                      sizeof(occ_inner_block_t));
 }
 
 static inline const occ_leaf_block_t *occ_leaf_base(const occ_map_t *m)
 {
-    return (const occ_leaf_block_t *)(const void *)m->arena;
+    return (const occ_leaf_block_t *)(const void *)m->priv.arena;
 }
 
 static inline occ_nodep_t occ_root(occ_map_t *m)
 {
     occ_nodep_t n;
-    n.child = &m->root_child;
-    n.value = &m->root_value;
-    n.flags = &m->root_flags;
+    n.child = &m->priv.root_child;
+    n.value = &m->priv.root_value;
+    n.flags = &m->priv.root_flags;
     return n;
 }
 
@@ -202,10 +202,10 @@ static inline occ_state_t occ_value_state(const occ_map_t *const m, const occ_va
     if (!occ_is_observed(v)) {
         return OCC_STATE_UNKNOWN;
     }
-    if (v >= m->q_occ_min) {
+    if (v >= m->priv.q_occ_min) {
         return OCC_STATE_OCCUPIED;
     }
-    return v < m->q_free_max ? OCC_STATE_FREE : OCC_STATE_UNKNOWN;
+    return v < m->priv.q_free_max ? OCC_STATE_FREE : OCC_STATE_UNKNOWN;
 }
 
 static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_t v)
@@ -213,10 +213,10 @@ static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_
     if (!occ_is_observed(v)) {
         return (uint8_t)OCC_NODE_HAS_UNKNOWN;
     }
-    if (v >= m->q_occ_min) {
+    if (v >= m->priv.q_occ_min) {
         return (uint8_t)OCC_NODE_HAS_OCCUPIED;
     }
-    return (uint8_t)(v < m->q_free_max ? OCC_NODE_HAS_FREE : OCC_NODE_HAS_UNKNOWN);
+    return (uint8_t)(v < m->priv.q_free_max ? OCC_NODE_HAS_FREE : OCC_NODE_HAS_UNKNOWN);
 }
 
 /* OctoMap's update of one voxel value: an unobserved voxel starts at 0; a value at a clamp
@@ -226,7 +226,7 @@ static inline occ_value_t occ_value_apply_delta(const occ_map_t *const m, const 
 {
     const bool observed = occ_is_observed(v);
     /* OctoMap's updateNode returns early when the voxel sits at a clamp bound already. */
-    if (observed && ((delta >= 0 && v >= m->q_clamp_max) || (delta <= 0 && v <= m->q_clamp_min))) {
+    if (observed && ((delta >= 0 && v >= m->priv.q_clamp_max) || (delta <= 0 && v <= m->priv.q_clamp_min))) {
         return v;
     }
 #if OCC_VALUE_FLOAT
@@ -234,10 +234,10 @@ static inline occ_value_t occ_value_apply_delta(const occ_map_t *const m, const 
 #else
     int32_t nv = (int32_t)(observed ? v : 0) + (int32_t)delta;
 #endif
-    if (nv < m->q_clamp_min) {
-        nv = m->q_clamp_min;
-    } else if (nv > m->q_clamp_max) {
-        nv = m->q_clamp_max;
+    if (nv < m->priv.q_clamp_min) {
+        nv = m->priv.q_clamp_min;
+    } else if (nv > m->priv.q_clamp_max) {
+        nv = m->priv.q_clamp_max;
     }
     return (occ_value_t)nv;
 }

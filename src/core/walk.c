@@ -46,19 +46,19 @@ bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
     }
     if (!w->started) {
         w->started = true;
-        if (!occ_is_observed(m->root_value)) {
+        if (!occ_is_observed(m->priv.root_value)) {
             return false;
         }
         const occ_key_t zero = {{0u, 0u, 0u}};
         node->key = zero;
         node->level = m->cfg.depth_levels;
-        node->has_children = m->root_child != OCC_NONE;
-        node->value = m->root_value;
+        node->has_children = m->priv.root_child != OCC_NONE;
+        node->value = m->priv.root_value;
         node->observed = true;
-        node->flags = (uint8_t)(m->root_flags | (node->has_children ? 0u : OCC_NODE_UNIFORM));
+        node->flags = (uint8_t)(m->priv.root_flags | (node->has_children ? 0u : OCC_NODE_UNIFORM));
         w->code = 0u;
         if (node->has_children) {
-            push(w, m->root_child, (unsigned)m->cfg.depth_levels - 1u);
+            push(w, m->priv.root_child, (unsigned)m->cfg.depth_levels - 1u);
         }
         return true;
     }

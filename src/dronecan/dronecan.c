@@ -95,7 +95,7 @@ occ_err_t occ_dronecan_init(occ_dronecan_node_t *node, const occ_dronecan_config
     }
     memset(node, 0, sizeof *node);
     node->cfg = *cfg;
-    node->iface = *iface;
+    node->priv.iface = *iface;
     node->health = OCC_NODE_HEALTH_ERROR;
     node->mode = OCC_NODE_MODE_INITIALIZATION;
     return OCC_OK;
@@ -107,7 +107,7 @@ static occ_err_t send_counted(occ_dronecan_node_t *node, uint32_t can_id, uint64
                               uint8_t *tid, const uint8_t *payload, size_t len)
 {
     size_t sent = 0;
-    const occ_err_t e = occ_dronecan_send_transfer(&node->iface, can_id, sig,
+    const occ_err_t e = occ_dronecan_send_transfer(&node->priv.iface, can_id, sig,
                                                    (uint8_t)(*tid & OCC_DRONECAN_TAIL_TID),
                                                    payload, len, &sent);
     node->stats.tx_frames += (uint32_t)sent;
@@ -134,7 +134,7 @@ occ_err_t occ_dronecan_publish_proximity(occ_dronecan_node_t *node,
     (void)occ_dronecan_encode_proximity(msg, payload);
     const uint32_t id = occ_dronecan_msg_id(node->cfg.priority, OCC_DRONECAN_PROXIMITY_ID,
                                             node->cfg.node_id);
-    const occ_err_t e = send_counted(node, id, OCC_DRONECAN_PROXIMITY_SIG, &node->tid_proximity,
+    const occ_err_t e = send_counted(node, id, OCC_DRONECAN_PROXIMITY_SIG, &node->priv.tid_proximity,
                                      payload, sizeof payload);
     if (e == OCC_OK) {
         node->stats.proximity_sent++;
@@ -147,7 +147,7 @@ occ_err_t occ_dronecan_publish_status(occ_dronecan_node_t *node, uint64_t now_us
     if (node == NULL) {
         return OCC_ERR_ARG;
     }
-    const uint64_t up_us = (node->started && now_us > node->start_us) ? now_us - node->start_us : 0u;
+    const uint64_t up_us = (node->priv.started && now_us > node->priv.start_us) ? now_us - node->priv.start_us : 0u;
     occ_dronecan_node_status_t st;
     st.uptime_sec = (uint32_t)(up_us / 1000000u);
     st.health = node->health;
@@ -158,7 +158,7 @@ occ_err_t occ_dronecan_publish_status(occ_dronecan_node_t *node, uint64_t now_us
     (void)occ_dronecan_encode_node_status(&st, payload);
     const uint32_t id = occ_dronecan_msg_id(node->cfg.priority, OCC_DRONECAN_NODESTATUS_ID,
                                             node->cfg.node_id);
-    return send_counted(node, id, OCC_DRONECAN_NODESTATUS_SIG, &node->tid_status, payload,
+    return send_counted(node, id, OCC_DRONECAN_NODESTATUS_SIG, &node->priv.tid_status, payload,
                         sizeof payload);
 }
 
@@ -237,9 +237,9 @@ occ_err_t occ_dronecan_poll(occ_dronecan_node_t *node, uint64_t now_us,
     if (good && (view->sectors == NULL || view->sectors_cfg == NULL)) {
         return OCC_ERR_ARG;
     }
-    if (!node->started) {
-        node->started = true;
-        node->start_us = now_us;
+    if (!node->priv.started) {
+        node->priv.started = true;
+        node->priv.start_us = now_us;
         node->next_proximity_us = now_us;
         node->next_status_us = now_us;
     }
@@ -275,7 +275,7 @@ static occ_err_t answer_node_info(occ_dronecan_node_t *node, uint8_t priority, u
 {
     occ_dronecan_node_info_t info;
     memset(&info, 0, sizeof info);
-    const uint64_t up_us = (node->started && now_us > node->start_us) ? now_us - node->start_us : 0u;
+    const uint64_t up_us = (node->priv.started && now_us > node->priv.start_us) ? now_us - node->priv.start_us : 0u;
     info.status.uptime_sec = (uint32_t)(up_us / 1000000u);
     info.status.health = node->health;
     info.status.mode = node->mode;

@@ -21,16 +21,16 @@ occ_err_t occ_dronecan_poll_map(occ_dronecan_node_t *node, uint64_t now_us, cons
                  within(now_us, pose_stamp_us, node->cfg.stale_after_us);
     view.sectors = NULL;
     view.sectors_cfg = sectors_cfg;
-    const bool due = !node->started || now_us >= node->next_proximity_us;
+    const bool due = !node->priv.started || now_us >= node->next_proximity_us;
     occ_err_t se = OCC_OK;
     if (view.fresh && due) {
-        se = occ_sectors_compute(map, pose, sectors_cfg, &node->sectors);
+        se = occ_sectors_compute(map, pose, sectors_cfg, &node->priv.sectors);
         if (se != OCC_OK) {
             view.fresh = false; /* e.g. the vehicle left the map: say NO_DATA, keep NodeStatus */
         }
     }
     if (view.fresh) {
-        view.sectors = &node->sectors; /* only read when due, i.e. just computed */
+        view.sectors = &node->priv.sectors; /* only read when due, i.e. just computed */
     }
     const occ_err_t pe = occ_dronecan_poll(node, now_us, &view);
     return (se != OCC_OK) ? se : pe;

@@ -218,10 +218,10 @@ static bool begin_pass(ctx_t *const x)
 {
     occ_evict_cursor_t *const cur = x->cur;
     cur->sp = 0u;
-    if (x->m->root_child == OCC_NONE) {
+    if (x->m->priv.root_child == OCC_NONE) {
         return false;
     }
-    push(cur, x->m->root_child, 0u);
+    push(cur, x->m->priv.root_child, 0u);
     return true;
 }
 
@@ -442,7 +442,7 @@ static void ctx_init(ctx_t *const x, occ_map_t *const map, const occ_vec3_t *con
     x->m = map;
     x->c = *center;
     x->p = policy;
-    x->cur = &out->cursor;
+    x->cur = &out->priv;
     x->need_inner = n_inner;
     x->need_leaf = n_leaf;
     x->budget = budget;
@@ -533,7 +533,7 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
     ctx_init(&x, map, center, policy, n_inner, n_leaf, budget, out);
     const uint32_t inner_before = map->inner.used, leaf_before = map->leaf.used;
     run_end_t end = RUN_TARGET;
-    bool sweep_on = out->cursor.phase == PHASE_RESUME && out->cursor.depth == map->cfg.depth_levels;
+    bool sweep_on = out->priv.phase == PHASE_RESUME && out->priv.depth == map->cfg.depth_levels;
     if (!target_ok(&x)) {
         if (map->cfg.depth_levels < 2u) {
             end = RUN_EXHAUSTED; /* the root is a level-1 node: nothing to take apart */
@@ -545,7 +545,7 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
     if (x.evictions != 0u) {
         map->write_gen++; /* collapses are this path's only writes: handles on the map are stale */
     }
-    out->cursor.phase = sweep_on ? PHASE_RESUME : PHASE_IDLE;
+    out->priv.phase = sweep_on ? PHASE_RESUME : PHASE_IDLE;
     report(&x, end, sweep_on, inner_before, leaf_before, out);
     return OCC_OK;
 }

@@ -26,15 +26,15 @@ void occi_geom_init(occ_map_t *const m)
 {
     const float r = m->cfg.resolution_m;
 #if OCC_RAY_DOUBLE
-    m->geo_res = occi_geom_decimal(r);
-    m->geo_inv = 1.0 / m->geo_res;
-    m->geo_res_f = (float)m->geo_res;
-    m->geo_inv_f = (float)m->geo_inv;
+    m->priv.geo_res = occi_geom_decimal(r);
+    m->priv.geo_inv = 1.0 / m->priv.geo_res;
+    m->priv.geo_res_f = (float)m->priv.geo_res;
+    m->priv.geo_inv_f = (float)m->priv.geo_inv;
 #else
-    m->geo_res = 0;
-    m->geo_inv = 0;
-    m->geo_res_f = r;
-    m->geo_inv_f = 1.0f / r;
+    m->priv.geo_res = 0;
+    m->priv.geo_inv = 0;
+    m->priv.geo_res_f = r;
+    m->priv.geo_inv_f = 1.0f / r;
 #endif
 }
 

@@ -42,18 +42,18 @@ static inline bool occ_finite3(occ_vec3_t v)
 static inline occ_real_t occ_geom_res(const occ_map_t *m)
 {
 #if OCC_RAY_DOUBLE
-    return m->geo_res;
+    return m->priv.geo_res;
 #else
-    return m->geo_res_f;
+    return m->priv.geo_res_f;
 #endif
 }
 
 static inline occ_real_t occ_geom_inv(const occ_map_t *m)
 {
 #if OCC_RAY_DOUBLE
-    return m->geo_inv;
+    return m->priv.geo_inv;
 #else
-    return m->geo_inv_f;
+    return m->priv.geo_inv_f;
 #endif
 }
 

@@ -40,9 +40,9 @@ void occi_build_root_uniform(occ_build_t *const b, const occ_value_t v)
     b->root_uniform = true;
     b->root_value = v;
     if (b->map != NULL) {
-        b->map->root_child = OCC_NONE;
-        b->map->root_value = v;
-        b->map->root_flags = occ_value_flags(b->map, v);
+        b->map->priv.root_child = OCC_NONE;
+        b->map->priv.root_value = v;
+        b->map->priv.root_flags = occ_value_flags(b->map, v);
     }
 }
 
@@ -93,7 +93,7 @@ void occi_build_open_root(occ_build_t *const b)
     if (b->map != NULL) {
         blk = new_block(b->map, b->top);
         OCC_ASSERT(blk != OCC_NONE);
-        b->map->root_child = blk;
+        b->map->priv.root_child = blk;
     }
     push(b, b->top, 0u, blk);
 }

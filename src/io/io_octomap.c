@@ -284,7 +284,7 @@ static unsigned ml_of_entry(const occ_map_t *const m, const occ_inner_block_t *c
     const bool fr = (f & OCC_NODE_HAS_FREE) != 0u;
     const bool unk = (f & OCC_NODE_HAS_UNKNOWN) != 0u;
     if (unk) {
-        const bool band_empty = !(m->q_free_max < m->q_occ_min);
+        const bool band_empty = !(m->priv.q_free_max < m->priv.q_occ_min);
         if (band_empty || has_unobserved(m, ib->child[slot], level)) {
             return BT_INNER;
         }
@@ -316,12 +316,12 @@ static uint16_t bt_codes_of(const occ_map_t *const m, const uint32_t block, cons
 void occi_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const nodes)
 {
     *nodes = 0u;
-    if (!occ_is_observed(m->root_value)) {
+    if (!occ_is_observed(m->priv.root_value)) {
         return;
     }
-    if (m->root_child == OCC_NONE) {
+    if (m->priv.root_child == OCC_NONE) {
         /* OctoMap never prunes the root: a uniform map is a root with 8 equal leaves. */
-        const unsigned k = ml_of_value(m, m->root_value);
+        const unsigned k = ml_of_value(m, m->priv.root_value);
         uint16_t codes = 0u;
         for (unsigned i = 0; i < 8u; i++) {
             codes = (uint16_t)(codes | (k << (2u * i)));
@@ -332,10 +332,10 @@ void occi_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const
     }
     emit_frame_t st[OCC_MAX_DEPTH + 1];
     unsigned sp = 0u;
-    st[0].block = m->root_child;
+    st[0].block = m->priv.root_child;
     st[0].level = m->cfg.depth_levels;
     st[0].next = 0u;
-    st[0].codes = bt_codes_of(m, m->root_child, m->cfg.depth_levels);
+    st[0].codes = bt_codes_of(m, m->priv.root_child, m->cfg.depth_levels);
     occi_sink_u16(s, st[0].codes);
     *nodes = 1u + bt_count(st[0].codes);
     sp = 1u;
@@ -385,23 +385,23 @@ static void ot_rec(occ_sink_t *const s, const occ_value_t v, const uint8_t mask)
 void occi_ot_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const nodes)
 {
     *nodes = 0u;
-    if (!occ_is_observed(m->root_value)) {
+    if (!occ_is_observed(m->priv.root_value)) {
         return;
     }
-    if (m->root_child == OCC_NONE) {
-        ot_rec(s, m->root_value, 0xFFu);
+    if (m->priv.root_child == OCC_NONE) {
+        ot_rec(s, m->priv.root_value, 0xFFu);
         for (unsigned i = 0; i < 8u; i++) {
-            ot_rec(s, m->root_value, 0u);
+            ot_rec(s, m->priv.root_value, 0u);
         }
         *nodes = 9u;
         return;
     }
     emit_frame_t st[OCC_MAX_DEPTH + 1];
     unsigned sp = 1u;
-    st[0].block = m->root_child;
+    st[0].block = m->priv.root_child;
     st[0].level = m->cfg.depth_levels;
     st[0].next = 0u;
-    ot_rec(s, m->root_value, observed_mask(m, m->root_child, st[0].level));
+    ot_rec(s, m->priv.root_value, observed_mask(m, m->priv.root_child, st[0].level));
     *nodes = 1u;
     while (sp > 0u && s->err == OCC_OK) {
         emit_frame_t *const f = &st[sp - 1u];

@@ -243,22 +243,22 @@ static uint8_t put_node(const occ_map_t *const m, occ_sink_t *const s, const uin
 
 static void put_payload(const occ_map_t *const m, occ_sink_t *const s)
 {
-    if (!occ_is_observed(m->root_value)) {
+    if (!occ_is_observed(m->priv.root_value)) {
         occi_sink_u8(s, 0u);
         return;
     }
-    if (m->root_child == OCC_NONE) {
+    if (m->priv.root_child == OCC_NONE) {
         occi_sink_u8(s, 1u);
-        put_value(s, m->root_value);
+        put_value(s, m->priv.root_value);
         return;
     }
     occi_sink_u8(s, 2u);
     snap_frame_t st[OCC_MAX_DEPTH + 1];
     unsigned sp = 1u;
-    st[0].block = m->root_child;
+    st[0].block = m->priv.root_child;
     st[0].level = m->cfg.depth_levels;
     st[0].next = 0u;
-    st[0].blk = put_node(m, s, m->root_child, st[0].level);
+    st[0].blk = put_node(m, s, m->priv.root_child, st[0].level);
     while (sp > 0u && s->err == OCC_OK) {
         snap_frame_t *const f = &st[sp - 1u];
         unsigned i = f->next;

@@ -72,7 +72,7 @@ void occ_mav_parser_init(occ_mav_parser_t *p)
 
 static occ_mav_result_t finish(occ_mav_parser_t *p, occ_mav_frame_t *frame)
 {
-    const uint8_t *const b = p->buf;
+    const uint8_t *const b = p->priv.buf;
     occ_mav_frame_t f;
     const bool v2 = b[0] == STX_V2;
     const uint16_t hdr = v2 ? HDR_V2 : HDR_V1;
@@ -87,9 +87,9 @@ static occ_mav_result_t finish(occ_mav_parser_t *p, occ_mav_frame_t *frame)
     f.is_signed = v2 && (f.incompat_flags & MAVLINK_IFLAG_SIGNED) != 0u;
     f.payload = b + hdr;
     f.frame = b;
-    f.frame_len = p->pos;
-    p->pos = 0;
-    p->need = 0;
+    f.frame_len = p->priv.pos;
+    p->priv.pos = 0;
+    p->priv.need = 0;
     if (frame != NULL) {
         *frame = f;
     }
@@ -124,33 +124,33 @@ occ_mav_result_t occ_mav_parser_push(occ_mav_parser_t *p, uint8_t byte, occ_mav_
         return OCC_MAV_NONE;
     }
     p->counters.bytes++;
-    if (p->pos == 0u) {
+    if (p->priv.pos == 0u) {
         if (byte != STX_V1 && byte != STX_V2) {
             p->counters.junk_bytes++;
             return OCC_MAV_JUNK;
         }
-        p->buf[0] = byte;
-        p->pos = 1;
-        p->need = 0;
+        p->priv.buf[0] = byte;
+        p->priv.pos = 1;
+        p->priv.need = 0;
         return OCC_MAV_NONE;
     }
-    if (p->pos >= OCC_MAV_FRAME_MAX) { /* cannot happen: need <= OCC_MAV_FRAME_MAX */
-        p->pos = 0;
+    if (p->priv.pos >= OCC_MAV_FRAME_MAX) { /* cannot happen: need <= OCC_MAV_FRAME_MAX */
+        p->priv.pos = 0;
         p->counters.junk_bytes++;
         return OCC_MAV_JUNK;
     }
-    p->buf[p->pos++] = byte;
-    if (p->need == 0u) {
-        const bool v2 = p->buf[0] == STX_V2;
-        if (!v2 && p->pos == 2u) {
-            p->need = (uint16_t)(HDR_V1 + p->buf[1] + 2u);
-        } else if (v2 && p->pos == 3u) {
-            p->need = (uint16_t)(HDR_V2 + p->buf[1] + 2u +
-                                 (((p->buf[2] & MAVLINK_IFLAG_SIGNED) != 0u) ? SIG_LEN : 0u));
+    p->priv.buf[p->priv.pos++] = byte;
+    if (p->priv.need == 0u) {
+        const bool v2 = p->priv.buf[0] == STX_V2;
+        if (!v2 && p->priv.pos == 2u) {
+            p->priv.need = (uint16_t)(HDR_V1 + p->priv.buf[1] + 2u);
+        } else if (v2 && p->priv.pos == 3u) {
+            p->priv.need = (uint16_t)(HDR_V2 + p->priv.buf[1] + 2u +
+                                 (((p->priv.buf[2] & MAVLINK_IFLAG_SIGNED) != 0u) ? SIG_LEN : 0u));
         }
         return OCC_MAV_NONE;
     }
-    if (p->pos < p->need) {
+    if (p->priv.pos < p->priv.need) {
         return OCC_MAV_NONE;
     }
     return finish(p, frame);

@@ -56,9 +56,9 @@ occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg)
     f->cfg = *cfg;
     f->cfg.sectors.map_ned = cfg->map_frame == OCC_MAP_FRAME_NED;
     occ_mav_parser_init(&f->parser);
-    f->tx.sysid = cfg->sysid;
-    f->tx.compid = cfg->compid;
-    f->tx.seq = 0;
+    f->priv.tx.sysid = cfg->sysid;
+    f->priv.tx.compid = cfg->compid;
+    f->priv.tx.seq = 0;
     f->have_autopilot = cfg->autopilot_sysid != 0u;
     f->ap_sysid = cfg->autopilot_sysid;
     f->ap_compid = cfg->autopilot_compid;
@@ -123,11 +123,11 @@ static bool set_position(occ_mav_feed_t *f, float north, float east, float down,
     if (!isfinite(north) || !isfinite(east) || !isfinite(down)) {
         return false;
     }
-    f->ned_m.x = north;
-    f->ned_m.y = east;
-    f->ned_m.z = down;
-    f->pos_us = now_us;
-    f->have_pos = true;
+    f->priv.ned_m.x = north;
+    f->priv.ned_m.y = east;
+    f->priv.ned_m.z = down;
+    f->priv.pos_us = now_us;
+    f->priv.have_pos = true;
     f->counters.positions_rx++;
     return true;
 }
@@ -135,11 +135,11 @@ static bool set_position(occ_mav_feed_t *f, float north, float east, float down,
 /* An attitude NED <- FRD, kept unit; NaN, Inf or a zero quaternion is not taken. */
 static bool set_attitude(occ_mav_feed_t *f, occ_quat_t ned_from_frd, uint64_t now_us)
 {
-    if (occ_quat_normalize(ned_from_frd, &f->ned_from_frd) != OCC_OK) {
+    if (occ_quat_normalize(ned_from_frd, &f->priv.ned_from_frd) != OCC_OK) {
         return false;
     }
-    f->att_us = now_us;
-    f->have_att = true;
+    f->priv.att_us = now_us;
+    f->priv.have_att = true;
     f->counters.attitudes_rx++;
     return true;
 }
@@ -239,32 +239,32 @@ static bool fresh_at(const occ_mav_feed_t *f, bool have, uint64_t at_us, uint64_
 
 bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pose)
 {
-    if (f == NULL || !f->have_pos || !f->have_att) {
+    if (f == NULL || !f->priv.have_pos || !f->priv.have_att) {
         return false;
     }
-    const bool fresh = fresh_at(f, f->have_pos, f->pos_us, now_us) &&
-                       fresh_at(f, f->have_att, f->att_us, now_us);
+    const bool fresh = fresh_at(f, f->priv.have_pos, f->priv.pos_us, now_us) &&
+                       fresh_at(f, f->priv.have_att, f->priv.att_us, now_us);
     if (pose == NULL) {
         return fresh;
     }
     if (f->cfg.map_frame == OCC_MAP_FRAME_NED) {
-        pose->p = f->ned_m;
-        pose->q = f->ned_from_frd;
+        pose->p = f->priv.ned_m;
+        pose->q = f->priv.ned_from_frd;
         return fresh;
     }
     /* Both parts were checked when taken: this cannot fail, but never reads as fresh if it does. */
-    return occ_pose_from_ned(f->ned_m, f->ned_from_frd, pose) == OCC_OK && fresh;
+    return occ_pose_from_ned(f->priv.ned_m, f->priv.ned_from_frd, pose) == OCC_OK && fresh;
 }
 
 uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f)
 {
-    if (f == NULL || !f->started) {
+    if (f == NULL || !f->priv.started) {
         return 0;
     }
-    uint64_t due = f->next_obstacle_us < f->next_heartbeat_us ? f->next_obstacle_us
-                                                               : f->next_heartbeat_us;
-    if (f->have_autopilot && f->cfg.pose_interval_us > 0u && f->next_request_us < due) {
-        due = f->next_request_us;
+    uint64_t due = f->priv.next_obstacle_us < f->priv.next_heartbeat_us ? f->priv.next_obstacle_us
+                                                               : f->priv.next_heartbeat_us;
+    if (f->have_autopilot && f->cfg.pose_interval_us > 0u && f->priv.next_request_us < due) {
+        due = f->priv.next_request_us;
     }
     return due;
 }
@@ -286,16 +286,16 @@ static size_t poll_request(occ_mav_feed_t *f, uint64_t now_us, uint8_t *out, siz
     if (!f->have_autopilot || f->cfg.pose_interval_us == 0u) {
         return 0;
     }
-    if (f->request_mask == 0u && now_us >= f->next_request_us) {
-        f->next_request_us = now_us + f->cfg.request_period_us;
-        f->request_mask = (uint8_t)((fresh_at(f, f->have_pos, f->pos_us, now_us) ? 0u : 1u) |
-                                    (fresh_at(f, f->have_att, f->att_us, now_us) ? 0u : 2u));
+    if (f->priv.request_mask == 0u && now_us >= f->priv.next_request_us) {
+        f->priv.next_request_us = now_us + f->cfg.request_period_us;
+        f->priv.request_mask = (uint8_t)((fresh_at(f, f->priv.have_pos, f->priv.pos_us, now_us) ? 0u : 1u) |
+                                    (fresh_at(f, f->priv.have_att, f->priv.att_us, now_us) ? 0u : 2u));
     }
-    if (f->request_mask == 0u) {
+    if (f->priv.request_mask == 0u) {
         return 0;
     }
-    const bool pos = (f->request_mask & 1u) != 0u;
-    f->request_mask = (uint8_t)(f->request_mask & (pos ? ~1u : ~2u));
+    const bool pos = (f->priv.request_mask & 1u) != 0u;
+    f->priv.request_mask = (uint8_t)(f->priv.request_mask & (pos ? ~1u : ~2u));
     occ_mav_command_long_t c;
     memset(&c, 0, sizeof c);
     c.target_system = f->ap_sysid;
@@ -303,7 +303,7 @@ static size_t poll_request(occ_mav_feed_t *f, uint64_t now_us, uint8_t *out, siz
     c.command = OCC_MAV_CMD_SET_MESSAGE_INTERVAL;
     c.param[0] = (float)(pos ? OCC_MAV_MSG_LOCAL_POSITION_NED : OCC_MAV_MSG_ATTITUDE);
     c.param[1] = (float)f->cfg.pose_interval_us;
-    const size_t n = occ_mav_encode_command_long(&f->tx, &c, out, cap);
+    const size_t n = occ_mav_encode_command_long(&f->priv.tx, &c, out, cap);
     if (n > 0u) {
         f->counters.requests_tx++;
     }
@@ -316,13 +316,13 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     if (f == NULL || out == NULL || cap < OCC_MAV_FRAME_MAX) {
         return 0;
     }
-    if (!f->started) {
-        f->started = true;
-        f->next_heartbeat_us = now_us;
-        f->next_obstacle_us = now_us;
+    if (!f->priv.started) {
+        f->priv.started = true;
+        f->priv.next_heartbeat_us = now_us;
+        f->priv.next_obstacle_us = now_us;
     }
-    if (now_us >= f->next_heartbeat_us) {
-        f->next_heartbeat_us = advance(f->next_heartbeat_us, f->cfg.heartbeat_period_us, now_us);
+    if (now_us >= f->priv.next_heartbeat_us) {
+        f->priv.next_heartbeat_us = advance(f->priv.next_heartbeat_us, f->cfg.heartbeat_period_us, now_us);
         occ_mav_heartbeat_t hb;
         hb.custom_mode = 0;
         hb.type = MAV_TYPE_ONBOARD_CONTROLLER_;
@@ -330,7 +330,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         hb.base_mode = 0;
         hb.system_status = MAV_STATE_ACTIVE_;
         hb.mavlink_version = 3;
-        const size_t n = occ_mav_encode_heartbeat(&f->tx, &hb, out, cap);
+        const size_t n = occ_mav_encode_heartbeat(&f->priv.tx, &hb, out, cap);
         if (n > 0u) {
             f->counters.heartbeat_tx++;
         }
@@ -340,17 +340,17 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     if (nr > 0u) {
         return nr;
     }
-    if (now_us < f->next_obstacle_us) {
+    if (now_us < f->priv.next_obstacle_us) {
         return 0;
     }
-    f->next_obstacle_us = advance(f->next_obstacle_us, f->cfg.period_us, now_us);
+    f->priv.next_obstacle_us = advance(f->priv.next_obstacle_us, f->cfg.period_us, now_us);
     occ_pose_t pose;
     if (map == NULL || !occ_mav_feed_pose(f, now_us, &pose)) {
         f->counters.stale_skips++;
         return 0;
     }
     const occ_sectors_config_t *const sc = &f->cfg.sectors;
-    if (occ_sectors_compute(map, &pose, sc, &f->sectors) != OCC_OK) {
+    if (occ_sectors_compute(map, &pose, sc, &f->priv.sectors) != OCC_OK) {
         f->counters.sector_errors++;
         return 0;
     }
@@ -358,7 +358,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     m.time_usec = now_us;
     m.sensor_type = f->cfg.sensor_type;
     for (unsigned i = 0; i < 72u; i++) {
-        m.distances[i] = i < f->sectors.n ? f->sectors.distance_cm[i] : UINT16_MAX;
+        m.distances[i] = i < f->priv.sectors.n ? f->priv.sectors.distance_cm[i] : UINT16_MAX;
     }
     const float inc = sc->increment_deg;
     m.increment = 0;
@@ -370,7 +370,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
     m.increment_f = inc;
     m.angle_offset = sc->angle_offset_deg;
     m.frame = OCC_MAV_FRAME_BODY_FRD;
-    const size_t n = occ_mav_encode_obstacle_distance(&f->tx, &m, out, cap);
+    const size_t n = occ_mav_encode_obstacle_distance(&f->priv.tx, &m, out, cap);
     if (n > 0u) {
         f->counters.obstacle_tx++;
     }

@@ -70,12 +70,12 @@ static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3], 
     c->key[1] = key[1];
     c->key[2] = key[2];
     const unsigned d = m->cfg.depth_levels;
-    if (m->root_child == OCC_NONE || (m->root_flags & stop) == 0u) {
+    if (m->priv.root_child == OCC_NONE || (m->priv.root_flags & stop) == 0u) {
         c->lu = d;
-        c->val = m->root_value;
+        c->val = m->priv.root_value;
         return;
     }
-    c->blk[d] = m->root_child;
+    c->blk[d] = m->priv.root_child;
     descend(c, d);
 }
 
@@ -280,8 +280,8 @@ static void cast_walk(const occ_map_t *map, cursor_t *c, dda_t *d, const walk_t 
                       bool ignore_unknown, occ_ray_result_t *out)
 {
     const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
-    const occ_value_t occ_min = map->q_occ_min;
-    const occ_value_t free_max = map->q_free_max;
+    const occ_value_t occ_min = map->priv.q_occ_min;
+    const occ_value_t free_max = map->priv.q_free_max;
     /* The last key a step may leave from, per axis (never reached for a zero step). */
     const uint32_t lim[3] = {d->step[0] > 0 ? kmax : 0u, d->step[1] > 0 ? kmax : 0u,
                              d->step[2] > 0 ? kmax : 0u};
@@ -405,8 +405,8 @@ static los_end_t los_walk(const occ_map_t *map, cursor_t *c, dda_t *d, const uin
                           real_t len, bool unknown_blocks)
 {
     const uint32_t kmax = ((uint32_t)1 << map->cfg.depth_levels) - 1u;
-    const occ_value_t occ_min = map->q_occ_min;
-    const occ_value_t free_max = map->q_free_max;
+    const occ_value_t occ_min = map->priv.q_occ_min;
+    const occ_value_t free_max = map->priv.q_free_max;
     bool entered = true;
     for (;;) {
         if (entered && c->lu > 0u) {

@@ -80,9 +80,9 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
     for (unsigned t = 0; t < n; t++) {
         const occ_key_t key = start[t];
         unsigned level = depth;
-        uint32_t child = m->root_child;
-        occ_value_t val = m->root_value;
-        uint8_t flags = m->root_flags;
+        uint32_t child = m->priv.root_child;
+        occ_value_t val = m->priv.root_value;
+        uint8_t flags = m->priv.root_flags;
         bool check = true;
         if (t > 0u) {
             const uint32_t x = (key.k[0] ^ start[t - 1u].k[0]) | (key.k[1] ^ start[t - 1u].k[1]) |

@@ -42,11 +42,11 @@ occ_state_t occ_map_state_at(const occ_map_t *const map, const occ_vec3_t p)
     if (map == NULL || !point_key(map, p, &k)) {
         return OCC_STATE_UNKNOWN;
     }
-    if (map->root_child == OCC_NONE) {
-        return occ_value_state(map, map->root_value);
+    if (map->priv.root_child == OCC_NONE) {
+        return occ_value_state(map, map->priv.root_value);
     }
     unsigned lu;
-    return occ_value_state(map, descend(map, &k, map->cfg.depth_levels, map->root_child, NULL, &lu));
+    return occ_value_state(map, descend(map, &k, map->cfg.depth_levels, map->priv.root_child, NULL, &lu));
 }
 
 void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map)
@@ -87,13 +87,13 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
     } else {
         lk->key = k;
         lk->valid = true;
-        if (m->root_child == OCC_NONE) {
+        if (m->priv.root_child == OCC_NONE) {
             lk->lu = (uint8_t)depth;
-            lk->val = m->root_value;
+            lk->val = m->priv.root_value;
             return occ_value_state(m, lk->val);
         }
         level = depth;
-        b = m->root_child;
+        b = m->priv.root_child;
         lk->blk[depth] = b;
     }
     unsigned lu;

@@ -92,8 +92,8 @@ static inline unsigned occ_q_inner_match(const occ_inner_block_t *b, unsigned st
 static inline unsigned occ_q_leaf_match(const occ_map_t *m, const occ_leaf_block_t *b,
                                         unsigned states)
 {
-    const occ_value_t occ_min = m->q_occ_min;
-    const occ_value_t free_max = m->q_free_max;
+    const occ_value_t occ_min = m->priv.q_occ_min;
+    const occ_value_t free_max = m->priv.q_free_max;
     unsigned occ = 0u;
     unsigned fr = 0u;
     for (unsigned s = 0; s < 8u; s++) {

@@ -23,7 +23,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             continue;
         }
         results++;
-        if (f.frame != p.buf || f.frame_len > OCC_MAV_FRAME_MAX ||
+        if (f.frame != p.priv.buf || f.frame_len > OCC_MAV_FRAME_MAX ||
             f.payload + f.len > f.frame + f.frame_len) {
             abort();
         }
