@@ -55,6 +55,18 @@ typedef struct {
     png_err_t pe;
 } png_job_t;
 
+/* A cleared job with its file open; OCC_ERR_IO (and `msg`) when the file cannot be opened. */
+static occ_err_t job_open(png_job_t *const j, const char *path, char *msg, size_t msg_len)
+{
+    memset(j, 0, sizeof *j);
+    j->f = fopen(path, "rb");
+    if (j->f == NULL) {
+        set_msg(msg, msg_len, path, -1, strerror(errno));
+        return OCC_ERR_IO;
+    }
+    return OCC_OK;
+}
+
 static occ_err_t decode(png_job_t *const j, const char *path, uint32_t *w_out, uint32_t *h_out,
                         char *msg, size_t msg_len)
 {
@@ -121,10 +133,7 @@ occ_err_t occ_depth_read_png(const char *path, const occ_depth_camera_t *cam, co
     }
     memset(frame, 0, sizeof *frame);
     png_job_t j;
-    memset(&j, 0, sizeof j);
-    j.f = fopen(path, "rb");
-    if (j.f == NULL) {
-        set_msg(msg, msg_len, path, -1, strerror(errno));
+    if (job_open(&j, path, msg, msg_len) != OCC_OK) {
         return OCC_ERR_IO;
     }
     uint32_t w = 0, h = 0;
@@ -192,10 +201,7 @@ occ_err_t occ_depth_read_png_image(const char *path, uint16_t **pixels, uint32_t
     }
     *pixels = NULL;
     png_job_t j;
-    memset(&j, 0, sizeof j);
-    j.f = fopen(path, "rb");
-    if (j.f == NULL) {
-        set_msg(msg, msg_len, path, -1, strerror(errno));
+    if (job_open(&j, path, msg, msg_len) != OCC_OK) {
         return OCC_ERR_IO;
     }
     const occ_err_t e = decode(&j, path, width, height, msg, msg_len);
