@@ -1,18 +1,21 @@
 # tests/io.mk - the files issue: OctoMap .bt/.ot and snapshot tests, fuzzing, float build.
 APT_PKGS += libclang-rt-14-dev
 
-# The shared maps (4.6 M nodes) are too slow under ASan: the same test file, optimized, runs
+# The OctoMap file tests, split by topic: round trips (test_io_octomap.c) and refused input
+# (test_io_corrupt.c). Both are built again below (optimized; float values) and run as steps.
+IO_OCTOMAP_TESTS := test_io_octomap test_io_corrupt
+
+# The shared maps (4.6 M nodes) are too slow under ASan: the same test files, optimized, run
 # them as a step (OCC_IO_FULL=1 enables test_shared_maps).
-IO_FULL_BIN := $(BUILD)/io/test_io_octomap_full
-IO_FULL_OBJ := $(BUILD)/relhost/tests/test_io_octomap.o $(BUILD)/relhost/tests/support/iotest.o \
-               $(BUILD)/relhost/tests/support/oracle_io.o
-$(IO_FULL_BIN): $(IO_FULL_OBJ) $(BUILD)/libocc.a
+IO_FULL_BINS := $(IO_OCTOMAP_TESTS:%=$(BUILD)/io/%_full)
+$(BUILD)/io/%_full: $(BUILD)/relhost/tests/%.o $(BUILD)/relhost/tests/support/iotest.o \
+                    $(BUILD)/relhost/tests/support/oracle_io.o $(BUILD)/libocc.a
 	@mkdir -p $(dir $@)
 	$(CXX) -o $@ $^ $(HOST_LIBS)
-io-octomap-full: $(IO_FULL_BIN)
-	OCC_IO_FULL=1 $(IO_FULL_BIN)
+io-octomap-full: $(IO_FULL_BINS)
+	@set -e; for b in $(IO_FULL_BINS); do echo "== $$b"; OCC_IO_FULL=1 $$b; done
 TEST_STEPS += io-octomap-full
-TEST_BUILD_EXTRA += $(IO_FULL_BIN)
+TEST_BUILD_EXTRA += $(IO_FULL_BINS)
 .PHONY: io-octomap-full
 
 # occmap convert against OctoMap's command-line tools (convert_octree, compare_octrees).
@@ -90,12 +93,12 @@ $(IO_FLOAT_DIR)/%.o: %.c
 $(IO_FLOAT_DIR)/%.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXWARN) -O2 -g $(INC) -DOCC_VALUE_FLOAT=1 -MMD -MP -c $< -o $@
-IO_FLOAT_BIN := $(IO_FLOAT_DIR)/test_io_octomap_float
-$(IO_FLOAT_BIN): $(OCC_CORE_SRC:%.c=$(IO_FLOAT_DIR)/%.o) $(IO_FLOAT_DIR)/tests/test_io_octomap.o \
-                 $(IO_FLOAT_DIR)/tests/support/iotest.o $(IO_FLOAT_DIR)/tests/support/oracle_io.o
+IO_FLOAT_BINS := $(IO_OCTOMAP_TESTS:%=$(IO_FLOAT_DIR)/%_float)
+$(IO_FLOAT_DIR)/%_float: $(OCC_CORE_SRC:%.c=$(IO_FLOAT_DIR)/%.o) $(IO_FLOAT_DIR)/tests/%.o \
+                         $(IO_FLOAT_DIR)/tests/support/iotest.o $(IO_FLOAT_DIR)/tests/support/oracle_io.o
 	$(CXX) -o $@ $^ $(HOST_LIBS)
-io-float-exact: $(IO_FLOAT_BIN)
-	OCC_IO_FULL=1 OCC_IO_ONLY_OT=1 $(IO_FLOAT_BIN)
+io-float-exact: $(IO_FLOAT_BINS)
+	@set -e; for b in $(IO_FLOAT_BINS); do echo "== $$b"; OCC_IO_FULL=1 OCC_IO_ONLY_OT=1 $$b; done
 TEST_STEPS += io-float-exact
-TEST_BUILD_EXTRA += $(IO_FLOAT_BIN)
+TEST_BUILD_EXTRA += $(IO_FLOAT_BINS)
 .PHONY: io-float-exact
