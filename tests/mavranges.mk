@@ -31,3 +31,10 @@ $(MAV_REF)/synth.tlog: tools/mav_tlog_synth.py $(BUILD)/.deps-ok
 	@mkdir -p $(dir $@)
 	$(PY) tools/mav_tlog_synth.py $@
 TEST_BUILD_EXTRA += $(MAV_REF)/synth.tlog
+
+# The README's rangefinder snippet compiles under the core's warnings against libocc.a and
+# integrates a downward reading with the pose from a two-sample history (tests/readme_ranges.sh).
+ranges-readme: $(BUILD)/libocc.a
+	bash tests/readme_ranges.sh $(BUILD)
+TEST_STEPS += ranges-readme
+.PHONY: ranges-readme
