@@ -7,10 +7,8 @@ set -euo pipefail
 build=$1
 out=$build/readme_depth
 mkdir -p "$out"
-awk '/^### Depth camera/{f=1} f&&/^```c/{g=1;next} g&&/^```/{exit} g{print}' README.md > "$out/snippet.c"
-[ -s "$out/snippet.c" ] || { echo "no depth snippet found in README.md"; exit 1; }
-lines=$(wc -l < "$out/snippet.c")
-[ "$lines" -lt 15 ] || { echo "the depth snippet has $lines lines (must be under 15)"; exit 1; }
+. "$(dirname "$0")/readme_snippet.sh"
+readme_snippet "Depth camera" "$out/snippet.c"
 {
   grep '^#include' "$out/snippet.c"
   echo '#include <stdio.h>'

@@ -8,10 +8,8 @@ set -euo pipefail
 build=$1
 out=$build/readme_ranges
 mkdir -p "$out"
-awk '/^### Rangefinder/{f=1} f&&/^```c/{g=1;next} g&&/^```/{exit} g{print}' README.md > "$out/snippet.c"
-[ -s "$out/snippet.c" ] || { echo "no rangefinder snippet found in README.md"; exit 1; }
-lines=$(wc -l < "$out/snippet.c")
-[ "$lines" -lt 15 ] || { echo "the rangefinder snippet has $lines lines (must be under 15)"; exit 1; }
+. "$(dirname "$0")/readme_snippet.sh"
+readme_snippet "Rangefinder" "$out/snippet.c"
 grep -q 'sizeof scratch, NULL);' "$out/snippet.c" || { echo "the snippet's insert call changed: update $0"; exit 1; }
 {
   grep '^#include' "$out/snippet.c"
