@@ -93,6 +93,117 @@ static occ_vec3_t transform(const double t[3], const double q[4], const double p
     return o;
 }
 
+/* A node's np points, stored at pts_off before its pose: read them now that the pose is known,
+ * into f->points in the map frame. On error nothing stays allocated. */
+static occ_err_t read_points(rd_t *r, size_t pts_off, uint32_t np, const double t[3],
+                             const double q[4], occ_scan_frame_t *f)
+{
+    f->points = malloc((np > 0u ? np : 1u) * sizeof *f->points);
+    if (f->points == NULL) {
+        return OCC_ERR_NOMEM;
+    }
+    const size_t end_off = r->off;
+    r->off = pts_off;
+    for (uint32_t i = 0; i < np; i++) {
+        double v[3];
+        const occ_err_t e = get_vec(r, 3, v, "truncated point");
+        if (e != OCC_OK) {
+            free(f->points);
+            f->points = NULL;
+            return e;
+        }
+        f->points[i] = transform(t, q, v);
+    }
+    r->off = end_off;
+    f->n_points = np;
+    return OCC_OK;
+}
+
+static void set_pose(occ_scan_frame_t *f, const double t[3], const double q[4], uint32_t id)
+{
+    f->origin.x = (float)t[0];
+    f->origin.y = (float)t[1];
+    f->origin.z = (float)t[2];
+    for (unsigned i = 0; i < 3u; i++) {
+        f->pose_t[i] = (float)t[i];
+    }
+    for (unsigned i = 0; i < 4u; i++) {
+        f->pose_q[i] = (float)q[i];
+    }
+    (void)snprintf(f->name, sizeof f->name, "node %u", (unsigned)id);
+}
+
+/* One node: point count, the points, then the pose they are in, then the node id. */
+static occ_err_t read_node(rd_t *r, occ_scan_frame_t *f, uint32_t *id)
+{
+    uint32_t np;
+    if (!get(r, &np, 4u)) {
+        return fail(r, "truncated point count");
+    }
+    if ((size_t)np > (r->len - r->off) / 28u) {
+        r->off -= 4u;
+        return fail(r, "point count larger than the file");
+    }
+    const size_t pts_off = r->off;
+    r->off += (size_t)np * 28u; /* points are transformed once the pose is known */
+    double t[3], q[4];
+    occ_err_t e = get_pose(r, t, q);
+    if (e != OCC_OK) {
+        return e;
+    }
+    if (!get(r, id, 4u)) {
+        return fail(r, "truncated node id");
+    }
+    e = read_points(r, pts_off, np, t, q, f);
+    if (e == OCC_OK) {
+        set_pose(f, t, q, *id);
+    }
+    return e;
+}
+
+static bool has_id(const uint32_t *ids, uint32_t n, uint32_t id)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        if (ids[i] == id) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* The edges (checked, then dropped: a map needs only the nodes) and the end of the file. */
+static occ_err_t read_edges(rd_t *r, const uint32_t *ids, uint32_t n_nodes)
+{
+    uint32_t n_edges;
+    if (!get(r, &n_edges, 4u)) {
+        return fail(r, "truncated edge count");
+    }
+    if ((size_t)n_edges > (r->len - r->off) / 80u) {
+        r->off -= 4u;
+        return fail(r, "edge count larger than the file");
+    }
+    for (uint32_t k = 0; k < n_edges; k++) {
+        uint32_t a, b;
+        double t[3], q[4], w;
+        const size_t at = r->off;
+        if (!get(r, &a, 4u) || !get(r, &b, 4u)) {
+            return fail(r, "truncated edge");
+        }
+        if (!has_id(ids, n_nodes, a) || !has_id(ids, n_nodes, b)) {
+            r->off = at;
+            return fail(r, "edge names a node that does not exist");
+        }
+        const occ_err_t e = get_pose(r, t, q);
+        if (e != OCC_OK) {
+            return e;
+        }
+        if (!get(r, &w, 8u)) {
+            return fail(r, "truncated edge weight");
+        }
+    }
+    return r->off == r->len ? OCC_OK : fail(r, "trailing bytes after the last edge");
+}
+
 static occ_err_t parse(rd_t *r, occ_scan_frame_t **frames_out, size_t *n_out)
 {
     uint32_t n_nodes;
@@ -114,93 +225,10 @@ static occ_err_t parse(rd_t *r, occ_scan_frame_t **frames_out, size_t *n_out)
     occ_err_t e = OCC_OK;
     size_t done = 0;
     for (; done < n_nodes && e == OCC_OK; done++) {
-        occ_scan_frame_t *const f = &fr[done];
-        uint32_t np;
-        if (!get(r, &np, 4u)) {
-            e = fail(r, "truncated point count");
-            break;
-        }
-        if ((size_t)np > (r->len - r->off) / 28u) {
-            r->off -= 4u;
-            e = fail(r, "point count larger than the file");
-            break;
-        }
-        const size_t pts_off = r->off;
-        r->off += (size_t)np * 28u; /* points are transformed once the pose is known */
-        double t[3], q[4];
-        e = get_pose(r, t, q);
-        if (e != OCC_OK) {
-            break;
-        }
-        if (!get(r, &ids[done], 4u)) {
-            e = fail(r, "truncated node id");
-            break;
-        }
-        f->points = malloc((np > 0u ? np : 1u) * sizeof *f->points);
-        if (f->points == NULL) {
-            e = OCC_ERR_NOMEM;
-            break;
-        }
-        const size_t end_off = r->off;
-        r->off = pts_off;
-        for (uint32_t i = 0; i < np && e == OCC_OK; i++) {
-            double v[3];
-            e = get_vec(r, 3, v, "truncated point");
-            if (e == OCC_OK) {
-                f->points[i] = transform(t, q, v);
-            }
-        }
-        if (e != OCC_OK) {
-            done++; /* free its points too */
-            break;
-        }
-        r->off = end_off;
-        f->n_points = np;
-        f->origin.x = (float)t[0];
-        f->origin.y = (float)t[1];
-        f->origin.z = (float)t[2];
-        for (unsigned i = 0; i < 3u; i++) {
-            f->pose_t[i] = (float)t[i];
-        }
-        for (unsigned i = 0; i < 4u; i++) {
-            f->pose_q[i] = (float)q[i];
-        }
-        (void)snprintf(f->name, sizeof f->name, "node %u", (unsigned)ids[done]);
+        e = read_node(r, &fr[done], &ids[done]);
     }
     if (e == OCC_OK) {
-        uint32_t n_edges;
-        if (!get(r, &n_edges, 4u)) {
-            e = fail(r, "truncated edge count");
-        } else if ((size_t)n_edges > (r->len - r->off) / 80u) {
-            r->off -= 4u;
-            e = fail(r, "edge count larger than the file");
-        }
-        for (uint32_t k = 0; e == OCC_OK && k < n_edges; k++) {
-            uint32_t a, b;
-            double t[3], q[4], w;
-            const size_t at = r->off;
-            if (!get(r, &a, 4u) || !get(r, &b, 4u)) {
-                e = fail(r, "truncated edge");
-                break;
-            }
-            bool fa = false, fb = false;
-            for (uint32_t i = 0; i < n_nodes; i++) {
-                fa = fa || ids[i] == a;
-                fb = fb || ids[i] == b;
-            }
-            if (!fa || !fb) {
-                r->off = at;
-                e = fail(r, "edge names a node that does not exist");
-                break;
-            }
-            e = get_pose(r, t, q);
-            if (e == OCC_OK && !get(r, &w, 8u)) {
-                e = fail(r, "truncated edge weight");
-            }
-        }
-        if (e == OCC_OK && r->off != r->len) {
-            e = fail(r, "trailing bytes after the last edge");
-        }
+        e = read_edges(r, ids, n_nodes);
     }
     free(ids);
     if (e != OCC_OK) {
