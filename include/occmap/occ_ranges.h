@@ -5,8 +5,8 @@
  *  - min <= d < max: free space up to d, a hit at d (the voxel at the end point is occupied);
  *  - d >= max ("no return within max"): free space up to max, no hit;
  *  - d < min, NaN/Inf, or valid == false: skipped, counted, nothing integrated for it.
- * Work is bounded per call: beams x rays per beam x (max / resolution + 2) voxels.
- * Interface fixed by the lead; the implementation lives in src/sensors/ranges.c.
+ * Work is bounded per call: beams x rays per beam x (3 (max / resolution + 2) + 2) voxels
+ * (src/sensors/ranges.c; the call's contract below).
  *
  * Inf is not "no return" (ROS REP 117 reads +Inf so): a non-finite distance is skipped, so
  * that a broken computation never clears space (fail closed). A driver that knows "nothing
