@@ -147,8 +147,12 @@ test-build: $(DEPS_STAMP) $(TEST_BINS) $(BUILD)/occmap $(TEST_BUILD_EXTRA)
 
 # Each step prints PASS/FAIL lines the runner counts; the runner prints "N passed, N failed,
 # N skipped" (a step skips with exit 77 and a "SKIP: reason" line; under CI=true a skip fails).
+# The build runs one job per core unless the caller gave -j (CI's plain `make test` on 2 cores
+# builds in half the time); the tests themselves then run one at a time, undisturbed.
+TEST_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+TEST_J = $(if $(filter -j%,$(MAKEFLAGS)),,-j$(TEST_JOBS))
 test: $(DEPS_STAMP)
-	@$(MAKE) --no-print-directory test-build
+	@$(MAKE) --no-print-directory $(TEST_J) test-build
 	@bash tests/run_all.sh $(BUILD) "$(TEST_BINS)" "$(TEST_STEPS)"
 
 # ---- cross (Cortex-M) ---------------------------------------------------------------------------
