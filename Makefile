@@ -123,6 +123,12 @@ LIB_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC) $(OCC_CCD_SRC)
 $(BUILD)/libocc.a: $(LIB_SRC:%.c=$(BUILD)/rel/%.o)
 	@rm -f $@
 	$(AR) rcs $@ $^
+# The shared library for hosts (Python bindings, install): the release objects built with -fPIC.
+$(BUILD)/pic/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(REL_CFLAGS) -fPIC $(EXTRA_CFLAGS) -MMD -MP -c $< -o $@
+$(BUILD)/libocc.so: $(LIB_SRC:%.c=$(BUILD)/pic/%.o)
+	$(CC) -shared -Wl,-soname,libocc.so.0 -o $@ $^ -lccd -lm
 $(BUILD)/asan/libocc.a: $(LIB_SRC:%.c=$(BUILD)/asan/%.o)
 	@rm -f $@
 	$(AR) rcs $@ $^
