@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# test-install (tests/install.mk): `make install` into a staging DESTDIR, then a consumer outside
+# the tree built both ways against what was installed - pkg-config (shared libocc.so.0 and the
+# static host port) and CMake's find_package (static occmap::occmap) - and run; its answers are
+# the hand-computed ones in consumer.c. Then `make uninstall` must leave nothing behind.
+# usage: run.sh BUILD_DIR
+set -euo pipefail
+build=$1
+work=$(realpath -m "$build/install-test")
+stage=$work/stage
+prefix=/opt/occmap
+rm -rf "$work"; mkdir -p "$work"
+fail() { echo "FAIL test-install: $*"; exit 1; }
+
+make --no-print-directory -s install PREFIX=$prefix DESTDIR="$stage" >"$work/install.log" 2>&1 \
+  || { cat "$work/install.log"; fail "make install"; }
+root=$stage$prefix
+for f in bin/occmap lib/libocc.a lib/libocc_posix.a lib/libocc.so lib/libocc.so.0 \
+         include/occmap/occmap.h include/occmap/host/occ_file.h lib/pkgconfig/occmap.pc \
+         lib/cmake/occmap/occmapConfig.cmake lib/cmake/occmap/occmapConfigVersion.cmake; do
+  [ -e "$root/$f" ] || fail "$f not installed"
+done
+"$root/bin/occmap" --help | grep -q "info MAP" || fail "installed occmap --help"
+[ "$(readelf -d "$root/lib/libocc.so" | sed -n 's/.*SONAME.*\[\(.*\)\]/\1/p')" = libocc.so.0 ] \
+  || fail "libocc.so soname is not libocc.so.0"
+echo "PASS test-install: make install PREFIX=$prefix DESTDIR=$stage"
+
+# pkg-config: the .pc files keep the real prefix; the sysroot maps it into the staging tree.
+export PKG_CONFIG_PATH=$root/lib/pkgconfig PKG_CONFIG_SYSROOT_DIR=$stage
+[ "$(pkg-config --modversion occmap)" = "$(sed -n 's/^OCC_VERSION := //p' port/install.mk)" ] \
+  || fail "pkg-config --modversion occmap"
+# shellcheck disable=SC2046
+gcc -std=c99 -pedantic-errors -Wall -Wextra -Werror tests/install_consumer/consumer.c \
+  $(pkg-config --cflags --libs occmap-host) -o "$work/consumer_pc"
+LD_LIBRARY_PATH=$root/lib ldd "$work/consumer_pc" | grep -q "libocc.so.0 => $root/lib/libocc.so.0" \
+  || fail "the pkg-config consumer does not use the installed libocc.so.0"
+LD_LIBRARY_PATH=$root/lib "$work/consumer_pc" "$work/pc.occ" || fail "pkg-config consumer"
+echo "PASS test-install: pkg-config consumer (shared libocc.so.0, static host port)"
+
+# CMake: find_package(occmap 0.1) from the staged prefix, static occmap::occmap.
+unset PKG_CONFIG_PATH PKG_CONFIG_SYSROOT_DIR
+cmake -S tests/install_consumer -B "$work/cmake" -DCMAKE_PREFIX_PATH="$root" \
+  -DCMAKE_BUILD_TYPE=Release >"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "cmake configure"; }
+cmake --build "$work/cmake" >>"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "cmake build"; }
+if ldd "$work/cmake/consumer" | grep -q libocc; then fail "CMake consumer is not static"; fi
+"$work/cmake/consumer" "$work/cmake.occ" || fail "CMake consumer"
+cmp -s "$work/pc.occ" "$work/cmake.occ" || fail "the two consumers saved different maps"
+echo "PASS test-install: CMake consumer (find_package(occmap 0.1), static occmap::occmap)"
+
+make --no-print-directory -s uninstall PREFIX=$prefix DESTDIR="$stage" >/dev/null 2>&1 || fail "make uninstall"
+left=$(find "$stage" -type f -o -type l)
+[ -z "$left" ] || fail "make uninstall left: $left"
+echo "PASS test-install: make uninstall removes every installed file"
