@@ -2,6 +2,7 @@
 #include <stdio.h>
 #include <string.h>
 #include "cli.h"
+#include "view.h"
 
 static const struct {
     const char *name;
@@ -15,6 +16,7 @@ static const struct {
     {"convert", cmd_convert, "convert IN OUT: between .bt, .ot and .occ"},
     {"feed", cmd_feed, "feed --map MAP --udp HOST:PORT ...: OBSTACLE_DISTANCE over MAVLink"},
     {"can-feed", cmd_can_feed, "can-feed --map MAP --socketcan IF|--mcast BUS ...: DroneCAN"},
+    {"view", cmd_view, "view MAP -o OUT.html: the map in 3D, one page that opens offline"},
 };
 
 static void usage(FILE *f)
