@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# test-view (tools/view.mk): `occmap view` on a real map, opened in headless Chromium offline.
+#  - the page is one file: no src/href to anything outside it, and Chromium runs with every host
+#    name unresolvable;
+#  - the number of occupied cubes the renderer drew (the page writes it into #status after its
+#    first frame) equals the map's occupied leaf count from `occmap info --json`, and so does the
+#    page's own array;
+#  - the screenshot is not blank and shows the height colours (tests/view_png.py).
+# usage: view_check.sh BUILD_DIR MAP
+set -uo pipefail
+build=$1; map=$2
+work=$build/view-test
+mkdir -p "$work"
+fail() { echo "FAIL test-view: $*"; exit 1; }
+command -v chromium >/dev/null || { echo "SKIP: test-view: chromium not installed"; exit 77; }
+[ -r "$map" ] || { echo "SKIP: test-view: $map absent (Debian's liboctomap-dev)"; exit 77; }
+
+want=$("$build/occmap" info "$map" --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["occupied_leaves"])') \
+  || fail "occmap info --json $map"
+page=$work/map.html
+"$build/occmap" view "$map" -o "$page" || fail "occmap view $map"
+[ "$(grep -cE '<(script|link|img|iframe)[^>]*(src|href)=' "$page")" -eq 0 ] || fail "the page loads something from outside"
+in_page=$(grep -o '"occupied": {"n": [0-9]*' "$page" | grep -o '[0-9]*$')
+[ "$in_page" = "$want" ] || fail "the page holds $in_page occupied leaves, occmap info says $want"
+
+# Root in a container: no sandbox; WebGL on SwiftShader (no GPU); no network.
+chrome=(chromium --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader
+        --hide-scrollbars --window-size=960,540 --virtual-time-budget=5000
+        --host-resolver-rules="MAP * ~NOTFOUND" --user-data-dir="$(realpath -m "$work/profile")")
+url="file://$(realpath "$page")"
+timeout 60 "${chrome[@]}" --dump-dom "$url" >"$work/dom.html" 2>"$work/chromium.log" || fail "chromium --dump-dom (log: $work/chromium.log)"
+status=$(grep -o '<div id="status"[^>]*>' "$work/dom.html")
+err=$(sed -n 's/.*data-error="\([^"]*\)".*/\1/p' <<<"$status")
+[ -z "$err" ] || fail "the page reports: $err"
+drawn=$(sed -n 's/.*data-drawn="\([-0-9.]*\)".*/\1/p' <<<"$status")
+[ "$drawn" = "$want" ] || fail "Chromium drew $drawn occupied cubes, the map has $want occupied leaves"
+echo "PASS test-view: Chromium drew $drawn occupied cubes = occmap info's occupied_leaves ($want)"
+
+timeout 60 "${chrome[@]}" --screenshot="$(realpath -m "$work/shot.png")" "$url" 2>>"$work/chromium.log" \
+  || fail "chromium --screenshot (log: $work/chromium.log)"
+python3 tests/view_png.py "$work/shot.png" || fail "the screenshot $work/shot.png looks blank"
+echo "PASS test-view: screenshot $work/shot.png shows the map (offline page, $(stat -c %s "$page") bytes)"
