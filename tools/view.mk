@@ -7,7 +7,8 @@
 # (examples/js), so both inline as plain <script> elements without a module loader.
 THREE_VERSION := 0.147.0
 THREE_INTEGRITY := sha512-LPTOslYQXFkmvceQjFTNnVVli2LaVF6C99Pv34fJypp8NbQLbTlu3KinZ0zURghS5zEehK+VQyvWuPZ/Sm8fzw==
-THREE_TGZ := $(BUILD)/npm/three-$(THREE_VERSION).tgz
+# In build/cache (make clean keeps it): the registry is asked once per machine.
+THREE_TGZ := $(BUILD)/cache/npm/three-$(THREE_VERSION).tgz
 VIEW_ASSETS := $(BUILD)/view
 APT_PKGS += chromium
 # nodesource's nodejs carries its own npm; Debian's npm package would conflict with it.
