@@ -5,6 +5,7 @@
 #                    libocc_posix.a (the POSIX port: what include/occmap/host/ declares)
 #   $(INCLUDEDIR)    occmap/*.h (portable), occmap/host/*.h (hosts)
 #   $(BINDIR)        occmap
+#   $(PREFIX)/share/occmap/view  the scripts occmap view inlines (if `make view-assets` ran)
 #   $(LIBDIR)/pkgconfig/occmap.pc, occmap-host.pc
 #   $(LIBDIR)/cmake/occmap/occmapConfig.cmake, occmapConfigVersion.cmake: occmap::occmap
 #                    (static), occmap::occmap_shared, occmap::host
@@ -31,10 +32,14 @@ INSTALL_SUBST = sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@LIBDIR@|$(LIBDIR)|g' \
   -e 's|@REL_LIBDIR@|$(shell realpath -m --relative-to=$(PREFIX) $(LIBDIR))|g' \
   -e 's|@REL_INCLUDEDIR@|$(shell realpath -m --relative-to=$(PREFIX) $(INCLUDEDIR))|g'
 INSTALL_SO := libocc.so.$(OCC_VERSION)
+# occmap view's scripts (tools/view.mk), when they were fetched: the installed tool looks for
+# them in ../share/occmap/view next to itself.
+VIEW_SHARE = $(PREFIX)/share/occmap/view
+VIEW_FILES := three.min.js OrbitControls.js view_app.js LICENSE.three
 INSTALL_FILES = $(BINDIR)/occmap $(LIBDIR)/libocc.a $(LIBDIR)/libocc_posix.a $(LIBDIR)/$(INSTALL_SO) \
   $(LIBDIR)/libocc.so.$(OCC_SOVERSION) $(LIBDIR)/libocc.so $(LIBDIR)/pkgconfig/occmap.pc \
   $(LIBDIR)/pkgconfig/occmap-host.pc $(LIBDIR)/cmake/occmap/occmapConfig.cmake \
-  $(LIBDIR)/cmake/occmap/occmapConfigVersion.cmake \
+  $(LIBDIR)/cmake/occmap/occmapConfigVersion.cmake $(VIEW_FILES:%=$(VIEW_SHARE)/%) \
   $(patsubst include/%,$(INCLUDEDIR)/%,$(wildcard include/occmap/*.h include/occmap/host/*.h))
 
 install: $(BUILD)/libocc.a $(BUILD)/libocc.so $(BUILD)/libocc_posix.a $(BUILD)/occmap
@@ -53,10 +58,15 @@ install: $(BUILD)/libocc.a $(BUILD)/libocc.so $(BUILD)/libocc_posix.a $(BUILD)/o
 	$(INSTALL_SUBST) port/install/occmapConfig.cmake.in > $(DESTDIR)$(LIBDIR)/cmake/occmap/occmapConfig.cmake
 	$(INSTALL_SUBST) port/install/occmapConfigVersion.cmake.in \
 	  > $(DESTDIR)$(LIBDIR)/cmake/occmap/occmapConfigVersion.cmake
+	@if [ -r $(VIEW_ASSETS)/three.min.js ]; then \
+	  echo "$(INSTALL) -m 644 $(VIEW_FILES:%=$(VIEW_ASSETS)/%) $(DESTDIR)$(VIEW_SHARE)/"; \
+	  $(INSTALL) -d $(DESTDIR)$(VIEW_SHARE) && \
+	  $(INSTALL) -m 644 $(VIEW_FILES:%=$(VIEW_ASSETS)/%) $(DESTDIR)$(VIEW_SHARE)/; \
+	else echo "install: no $(VIEW_ASSETS) (make view-assets): the installed occmap view needs --assets"; fi
 
 uninstall:
 	rm -f $(addprefix $(DESTDIR),$(INSTALL_FILES))
 	-rmdir $(DESTDIR)$(INCLUDEDIR)/occmap/host $(DESTDIR)$(INCLUDEDIR)/occmap \
-	  $(DESTDIR)$(LIBDIR)/cmake/occmap 2>/dev/null
+	  $(DESTDIR)$(LIBDIR)/cmake/occmap $(DESTDIR)$(VIEW_SHARE) $(DESTDIR)$(PREFIX)/share/occmap 2>/dev/null
 
 .PHONY: install uninstall

@@ -25,18 +25,19 @@ in_page=$(grep -o '"occupied": {"n": [0-9]*' "$page" | grep -o '[0-9]*$')
 
 # Root in a container: no sandbox; WebGL on SwiftShader (no GPU); no network.
 chrome=(chromium --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader
-        --hide-scrollbars --window-size=960,540 --virtual-time-budget=5000
+        --hide-scrollbars --window-size=960,540 --virtual-time-budget=2000
         --host-resolver-rules="MAP * ~NOTFOUND" --user-data-dir="$(realpath -m "$work/profile")")
 url="file://$(realpath "$page")"
-timeout 60 "${chrome[@]}" --dump-dom "$url" >"$work/dom.html" 2>"$work/chromium.log" || fail "chromium --dump-dom (log: $work/chromium.log)"
+shot=$(realpath -m "$work/shot.png")
+rm -f "$shot"
+timeout 60 "${chrome[@]}" --screenshot="$shot" --dump-dom "$url" >"$work/dom.html" 2>"$work/chromium.log" \
+  || fail "chromium (log: $work/chromium.log)"
 status=$(grep -o '<div id="status"[^>]*>' "$work/dom.html")
 err=$(sed -n 's/.*data-error="\([^"]*\)".*/\1/p' <<<"$status")
 [ -z "$err" ] || fail "the page reports: $err"
 drawn=$(sed -n 's/.*data-drawn="\([-0-9.]*\)".*/\1/p' <<<"$status")
 [ "$drawn" = "$want" ] || fail "Chromium drew $drawn occupied cubes, the map has $want occupied leaves"
 echo "PASS test-view: Chromium drew $drawn occupied cubes = occmap info's occupied_leaves ($want)"
-
-timeout 60 "${chrome[@]}" --screenshot="$(realpath -m "$work/shot.png")" "$url" 2>>"$work/chromium.log" \
-  || fail "chromium --screenshot (log: $work/chromium.log)"
-python3 tests/view_png.py "$work/shot.png" || fail "the screenshot $work/shot.png looks blank"
-echo "PASS test-view: screenshot $work/shot.png shows the map (offline page, $(stat -c %s "$page") bytes)"
+[ -s "$shot" ] || fail "chromium wrote no screenshot (log: $work/chromium.log)"
+python3 tests/view_png.py "$shot" || fail "the screenshot $shot looks blank"
+echo "PASS test-view: screenshot $shot shows the map (offline page, $(stat -c %s "$page") bytes)"

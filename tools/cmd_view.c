@@ -2,16 +2,42 @@
  * self-contained HTML page (view_page.c) that opens offline in a browser. */
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "view.h"
 #include "occmap/host/occ_file.h"
 
-/* Where tools/view.mk put three.js and view_app.js (the build tree); --assets or the
- * OCCMAP_VIEW_ASSETS environment variable override it. */
+/* Where tools/view.mk put three.js and view_app.js (the build tree). An installed tool finds
+ * them in PREFIX/share/occmap/view first (make install puts them there); --assets or the
+ * OCCMAP_VIEW_ASSETS environment variable override both. */
 #ifndef OCC_VIEW_ASSETS
 #define OCC_VIEW_ASSETS "build/view"
 #endif
+#define VIEW_INSTALLED_ASSETS "/share/occmap/view"
+
+/* "PREFIX/share/occmap/view" for this executable in PREFIX/bin (Linux: its path from
+ * /proc/self/exe) when that folder holds three.min.js, else the build tree's folder. */
+static const char *default_assets(char *buf, const size_t len)
+{
+    const ssize_t n = readlink("/proc/self/exe", buf, len - 1u);
+    if (n > 0 && (size_t)n + sizeof VIEW_INSTALLED_ASSETS + sizeof "/three.min.js" < len) {
+        buf[n] = '\0';
+        char *bin = strrchr(buf, '/');
+        if (bin != NULL) {
+            *bin = '\0';
+            char *prefix_end = strrchr(buf, '/');
+            if (prefix_end != NULL) {
+                strcpy(prefix_end, VIEW_INSTALLED_ASSETS "/three.min.js");
+                if (access(buf, R_OK) == 0) {
+                    prefix_end[sizeof VIEW_INSTALLED_ASSETS - 1u] = '\0';
+                    return buf;
+                }
+            }
+        }
+    }
+    return OCC_VIEW_ASSETS;
+}
 
 static void usage(void)
 {
@@ -20,7 +46,9 @@ static void usage(void)
            "  height, free and unknown space behind toggles, the bounding box, orbit controls\n"
            "  (drag: rotate, right drag: pan, wheel: zoom).\n"
            "  --assets DIR  three.min.js, OrbitControls.js and view_app.js (default:\n"
-           "                $OCCMAP_VIEW_ASSETS, else %s, made by `make view-assets`)\n"
+           "                $OCCMAP_VIEW_ASSETS, else PREFIX/share/occmap/view for a tool\n"
+           "                installed in PREFIX/bin, else %s,\n"
+           "                made by `make view-assets`)\n"
            "  --title TEXT  the page's title (default: the map's file name)\n",
            OCC_VIEW_ASSETS);
 }
@@ -29,11 +57,12 @@ typedef struct {
     const char *map, *out, *assets, *title;
 } view_args_t;
 
-/* 0 ok, 1 help printed, 2 usage error. */
-static int parse_args(int argc, char **argv, view_args_t *a)
+/* 0 ok, 1 help printed, 2 usage error. `buf` holds the default assets path. */
+static int parse_args(int argc, char **argv, view_args_t *a, char *buf, const size_t len)
 {
     const char *env = getenv("OCCMAP_VIEW_ASSETS");
-    *a = (view_args_t){NULL, NULL, env != NULL && env[0] != '\0' ? env : OCC_VIEW_ASSETS, NULL};
+    *a = (view_args_t){NULL, NULL, env != NULL && env[0] != '\0' ? env : default_assets(buf, len),
+                       NULL};
     for (int i = 1; i < argc; i++) {
         const int has_value = i + 1 < argc;
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
@@ -85,15 +114,16 @@ static int write_out(const view_args_t *a, const occ_map_t *map, const view_sets
         }
         return 1;
     }
-    printf("view: wrote %s (%ld bytes): %zu occupied leaves, %zu free, %zu unknown\n", a->out,
-           bytes, sets->occupied.n, sets->free.n, sets->unknown.n);
+    printf("view: wrote %s (%ld bytes): %zu occupied leaves, %zu free, %zu unknown; assets %s\n",
+           a->out, bytes, sets->occupied.n, sets->free.n, sets->unknown.n, a->assets);
     return 0;
 }
 
 int cmd_view(int argc, char **argv)
 {
     view_args_t a;
-    const int prc = parse_args(argc, argv, &a);
+    static char assets[4096];
+    const int prc = parse_args(argc, argv, &a, assets, sizeof assets);
     if (prc != 0) {
         return prc == 1 ? 0 : 2;
     }

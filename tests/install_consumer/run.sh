@@ -21,6 +21,8 @@ for f in bin/occmap lib/libocc.a lib/libocc_posix.a lib/libocc.so lib/libocc.so.
   [ -e "$root/$f" ] || fail "$f not installed"
 done
 "$root/bin/occmap" --help | grep -q "info MAP" || fail "installed occmap --help"
+"$root/bin/occmap" view /usr/share/doc/liboctomap-dev/examples/data/geb079.bt -o "$work/geb079.html" \
+  | grep -q "assets $root/share/occmap/view\$" || fail "the installed occmap view does not use its installed scripts"
 [ "$(readelf -d "$root/lib/libocc.so" | sed -n 's/.*SONAME.*\[\(.*\)\]/\1/p')" = libocc.so.0 ] \
   || fail "libocc.so soname is not libocc.so.0"
 echo "PASS test-install: make install PREFIX=$prefix DESTDIR=$stage"
