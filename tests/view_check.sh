@@ -4,7 +4,7 @@
 #    name unresolvable;
 #  - the number of occupied cubes the renderer drew (the page writes it into #status after its
 #    first frame) equals the map's occupied leaf count from `occmap info --json`, and so does the
-#    page's own array;
+#    page's own array (and its free array holds occmap info's free leaf count);
 #  - the screenshot is not blank and shows the height colours (tests/view_png.py).
 # usage: view_check.sh BUILD_DIR MAP
 set -uo pipefail
@@ -15,13 +15,16 @@ fail() { echo "FAIL test-view: $*"; exit 1; }
 command -v chromium >/dev/null || { echo "SKIP: test-view: chromium not installed"; exit 77; }
 [ -r "$map" ] || { echo "SKIP: test-view: $map absent (Debian's liboctomap-dev)"; exit 77; }
 
-want=$("$build/occmap" info "$map" --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["occupied_leaves"])') \
-  || fail "occmap info --json $map"
+info=$("$build/occmap" info "$map" --json) || fail "occmap info --json $map"
+leaves() { python3 -c 'import json,sys; print(json.loads(sys.argv[1])[sys.argv[2] + "_leaves"])' "$info" "$1"; }
+want=$(leaves occupied); want_free=$(leaves free)
 page=$work/map.html
 "$build/occmap" view "$map" -o "$page" || fail "occmap view $map"
 [ "$(grep -cE '<(script|link|img|iframe)[^>]*(src|href)=' "$page")" -eq 0 ] || fail "the page loads something from outside"
 in_page=$(grep -o '"occupied": {"n": [0-9]*' "$page" | grep -o '[0-9]*$')
 [ "$in_page" = "$want" ] || fail "the page holds $in_page occupied leaves, occmap info says $want"
+in_page=$(grep -o '"free": {"n": [0-9]*' "$page" | grep -o '[0-9]*$')
+[ "$in_page" = "$want_free" ] || fail "the page holds $in_page free leaves, occmap info says $want_free"
 
 # Root in a container: no sandbox; WebGL on SwiftShader (no GPU); no network.
 chrome=(chromium --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader

@@ -4,7 +4,8 @@
  * little-endian) then level[n]; a node's centre is (key - 2^(depth-1) + 2^level / 2) * res and
  * its edge res * 2^level, as the library's occ_map_key_center(). Each kind is one InstancedMesh
  * of unit cubes; the map frame is ENU (z up). After the first frame the page writes the number
- * of occupied cubes the renderer drew into #status (data-drawn), for tests/view_check.sh. */
+ * of cubes the renderer drew in it into #status (data-drawn): the occupied ones, as free and
+ * unknown start hidden (tests/view_check.sh compares it with the map's occupied leaves). */
 (function () {
   'use strict';
   var status = document.getElementById('status');
@@ -83,7 +84,7 @@
     var free = cubes(decode(map.free, res, depth), new THREE.MeshBasicMaterial(
       {color: 0x55cc66, transparent: true, opacity: 0.06, depthWrite: false}));
     var unknown = cubes(decode(map.unknown, res, depth), new THREE.MeshBasicMaterial(
-      {color: 0xb0b0b0, transparent: true, opacity: 0.18, depthWrite: false}));
+      {color: 0xb0b0b0, transparent: true, opacity: 0.07, depthWrite: false}));
     free.visible = false;
     unknown.visible = false;
     var box = new THREE.Box3(new THREE.Vector3(lo[0], lo[1], lo[2]), new THREE.Vector3(hi[0], hi[1], hi[2]));
