@@ -1,11 +1,13 @@
 /* consumer.c - a program outside the tree that uses an installed occmap (tests/install.mk):
  * one scan of a wall 2 m ahead, then the answers worked out by hand, then a save and a load
- * through the host port (libocc_posix). Exit 0 and "consumer ok" when every answer holds. */
+ * through the host port (libocc_posix; not with -DCONSUMER_CORE_ONLY). Exit 0 and "consumer ok" when every answer holds. */
 #include <stdio.h>
 #include <stdlib.h>
 
 #include <occmap/occmap.h>
+#ifndef CONSUMER_CORE_ONLY /* built against the core only (occmap::occmap_shared): no files */
 #include <occmap/host/occ_file.h>
+#endif
 
 #define N_POINTS 10
 static uint8_t arena[OCC_ARENA_BYTES(256, 512)];
@@ -62,6 +64,7 @@ int main(int argc, char **argv)
     occ_err_t e = occ_map_insert_cloud(&map, &origin, pts, N_POINTS, &ip, scratch, sizeof scratch,
                                        NULL);
     int bad = check(e == OCC_OK, "insert_cloud") + check_wall(&map);
+#ifndef CONSUMER_CORE_ONLY
     if (argc > 1) { /* the host port: save, load into a fresh arena, the same answers */
         char msg[256];
         e = occ_file_save(argv[1], &map, msg, sizeof msg);
@@ -75,6 +78,10 @@ int main(int argc, char **argv)
         }
         free(arena2);
     }
+#else
+    (void)argv;
+    bad += check(argc == 1, "no file argument for a core-only consumer");
+#endif
     bad += check(occ_map_check(&map) == OCC_OK, "occ_map_check");
     if (bad == 0) {
         printf("consumer ok (%s)\n", occ_err_str(OCC_OK));

@@ -20,9 +20,10 @@ for f in bin/occmap lib/libocc.a lib/libocc_posix.a lib/libocc.so lib/libocc.so.
          lib/cmake/occmap/occmapConfig.cmake lib/cmake/occmap/occmapConfigVersion.cmake; do
   [ -e "$root/$f" ] || fail "$f not installed"
 done
-"$root/bin/occmap" --help | grep -q "info MAP" || fail "installed occmap --help"
-"$root/bin/occmap" view /usr/share/doc/liboctomap-dev/examples/data/geb079.bt -o "$work/geb079.html" \
-  | grep -q "assets $root/share/occmap/view\$" || fail "the installed occmap view does not use its installed scripts"
+out=$("$root/bin/occmap" --help)
+grep -q "view MAP" <<<"$out" || fail "installed occmap --help"
+out=$("$root/bin/occmap" view /usr/share/doc/liboctomap-dev/examples/data/geb079.bt -o "$work/geb079.html")
+grep -q "assets $root/share/occmap/view\$" <<<"$out" || fail "the installed occmap view does not use its installed scripts"
 [ "$(readelf -d "$root/lib/libocc.so" | sed -n 's/.*SONAME.*\[\(.*\)\]/\1/p')" = libocc.so.0 ] \
   || fail "libocc.so soname is not libocc.so.0"
 echo "PASS test-install: make install PREFIX=$prefix DESTDIR=$stage"
@@ -34,8 +35,9 @@ export PKG_CONFIG_PATH=$root/lib/pkgconfig PKG_CONFIG_SYSROOT_DIR=$stage
 # shellcheck disable=SC2046
 gcc -std=c99 -pedantic-errors -Wall -Wextra -Werror tests/install_consumer/consumer.c \
   $(pkg-config --cflags --libs occmap-host) -o "$work/consumer_pc"
-LD_LIBRARY_PATH=$root/lib ldd "$work/consumer_pc" | grep -q "libocc.so.0 => $root/lib/libocc.so.0" \
-  || fail "the pkg-config consumer does not use the installed libocc.so.0"
+# (ldd's output is read whole: grep -q stopping early would fail the pipe under pipefail)
+libs=$(LD_LIBRARY_PATH=$root/lib ldd "$work/consumer_pc")
+grep -q "libocc.so.0 => $root/lib/libocc.so.0" <<<"$libs" || fail "the pkg-config consumer does not use the installed libocc.so.0"
 LD_LIBRARY_PATH=$root/lib "$work/consumer_pc" "$work/pc.occ" || fail "pkg-config consumer"
 echo "PASS test-install: pkg-config consumer (shared libocc.so.0, static host port)"
 
@@ -44,10 +46,15 @@ unset PKG_CONFIG_PATH PKG_CONFIG_SYSROOT_DIR
 cmake -S tests/install_consumer -B "$work/cmake" -DCMAKE_PREFIX_PATH="$root" \
   -DCMAKE_BUILD_TYPE=Release >"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "cmake configure"; }
 cmake --build "$work/cmake" >>"$work/cmake.log" 2>&1 || { cat "$work/cmake.log"; fail "cmake build"; }
-if ldd "$work/cmake/consumer" | grep -q libocc; then fail "CMake consumer is not static"; fi
+libs=$(ldd "$work/cmake/consumer")
+if grep -q libocc <<<"$libs"; then fail "CMake consumer is not static"; fi
 "$work/cmake/consumer" "$work/cmake.occ" || fail "CMake consumer"
 cmp -s "$work/pc.occ" "$work/cmake.occ" || fail "the two consumers saved different maps"
 echo "PASS test-install: CMake consumer (find_package(occmap 0.1), static occmap::occmap)"
+libs=$(ldd "$work/cmake/consumer_shared")
+grep -q "libocc.so.0 => $root/lib/libocc.so.0" <<<"$libs" || fail "CMake consumer_shared does not load the installed libocc.so.0 (RPATH)"
+"$work/cmake/consumer_shared" || fail "CMake consumer_shared"
+echo "PASS test-install: CMake consumer_shared (occmap::occmap_shared, libocc.so.0 by RPATH)"
 
 make --no-print-directory -s uninstall PREFIX=$prefix DESTDIR="$stage" >/dev/null 2>&1 || fail "make uninstall"
 left=$(find "$stage" -type f -o -type l)
