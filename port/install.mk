@@ -24,16 +24,19 @@ $(BUILD)/libocc_posix.a: $(PORT_SRC:%.c=$(BUILD)/relhost/%.o)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
+# The pointer size of the library's compiler (the CMake version file refuses other consumers).
+INSTALL_PTR_BYTES = $(shell printf '' | $(CC) -dM -E - | sed -n 's/^\#define __SIZEOF_POINTER__ //p')
 # The templates' @...@ fields; the CMake files find the prefix relative to their own folder.
 INSTALL_SUBST = sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@LIBDIR@|$(LIBDIR)|g' \
   -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|g' -e 's|@VERSION@|$(OCC_VERSION)|g' \
-  -e 's|@SOVERSION@|$(OCC_SOVERSION)|g' -e 's|@SIZEOF_VOID_P@|8|g' -e 's|@SIZEOF_VOID_P_BITS@|64|g' \
+  -e 's|@SOVERSION@|$(OCC_SOVERSION)|g' -e 's|@SIZEOF_VOID_P@|$(INSTALL_PTR_BYTES)|g' \
+  -e 's|@SIZEOF_VOID_P_BITS@|$(shell echo $$(( $(INSTALL_PTR_BYTES) * 8 )))|g' \
   -e 's|@REL_PREFIX@|$(shell realpath -m --relative-to=$(LIBDIR)/cmake/occmap $(PREFIX))|g' \
   -e 's|@REL_LIBDIR@|$(shell realpath -m --relative-to=$(PREFIX) $(LIBDIR))|g' \
   -e 's|@REL_INCLUDEDIR@|$(shell realpath -m --relative-to=$(PREFIX) $(INCLUDEDIR))|g'
 INSTALL_SO := libocc.so.$(OCC_VERSION)
 # occmap view's scripts (tools/view.mk), when they were fetched: the installed tool looks for
-# them in ../share/occmap/view next to itself.
+# them in PREFIX/share/occmap/view (tools/cmd_view.c).
 VIEW_SHARE = $(PREFIX)/share/occmap/view
 VIEW_FILES := three.min.js OrbitControls.js view_app.js LICENSE.three
 INSTALL_FILES = $(BINDIR)/occmap $(LIBDIR)/libocc.a $(LIBDIR)/libocc_posix.a $(LIBDIR)/$(INSTALL_SO) \
