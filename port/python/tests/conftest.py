@@ -10,7 +10,7 @@ import pytest
 
 ROOT = Path(os.environ.get("OCCMAP_ROOT") or Path(__file__).resolve().parents[3])
 GEB079 = Path("/usr/share/doc/liboctomap-dev/examples/data/geb079.bt")
-SHARED_MAPS = ROOT.parent / "shared" / "data" / "maps"
+SHARED_MAPS = Path(os.environ.get("OCCMAP_SHARED") or ROOT.parent / "shared") / "data" / "maps"
 FR078 = SHARED_MAPS / "fr_078_tidyup.bt"
 FR079_OT = SHARED_MAPS / "fr_079_t1_model.ot"
 
