@@ -32,7 +32,9 @@ class Map:
     Map(resolution_m, arena_bytes, depth_levels=16, hit=..., miss=..., clamp_min=...,
     clamp_max=..., free_max=..., occupied_min=...): the config fields of occ_map_config_t,
     OctoMap's defaults for those not given. The arena is allocated once (numpy, not zeroed) and
-    never grows: a write that does not fit raises OccNoMemError and changes nothing."""
+    never grows: a write that does not fit raises OccNoMemError and changes nothing.
+    As the C map, a Map is not thread-safe (ctypes releases the GIL during a call): serialize
+    access to one Map; distinct maps are independent."""
 
     def __init__(self, resolution_m=0.1, arena_bytes=64 << 20, **config):
         cfg = _config(resolution_m=float(resolution_m), **config)
@@ -289,6 +291,11 @@ class Map:
     def check(self):
         """occ_map_check: raises OccCorruptError when an invariant is broken."""
         check(lib.occ_map_check(self._ref), "occ_map_check")
+
+    def __repr__(self):
+        used = (self._map.inner.used, self._map.leaf.used)
+        return (f"occmap.Map(resolution_m={self.resolution_m:g}, depth_levels={self.depth_levels},"
+                f" arena_bytes={self.arena_bytes}, inner/leaf blocks used={used})")
 
     @property
     def config(self):
