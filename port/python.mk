@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # port/python.mk - the Python package (port/python/: ctypes over build/libocc.so, no C of its
 # own), installed editable into the project venv: `make python`. A plain `pip install
 # port/python` (any venv) copies build/libocc.so into the package (port/python/setup.py).

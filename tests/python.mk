@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/python.mk - the Python package's pytest suite (port/python/tests): the binding against
 # the C tool's answers on the real maps, the struct layouts against the headers, errors,
 # round trips. One PASS / FAIL line per test; tests of ../shared maps print SKIP when it is
