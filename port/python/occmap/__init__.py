@@ -3,7 +3,7 @@
 
     import numpy as np, occmap
     m = occmap.Map.load("geb079.bt")
-    m.state_at(np.array([[1.0, 0.0, 0.5]], np.float32))   # -> array([1], uint8): FREE
+    m.state_at(np.array([[1.0, 0.0, 0.5]], np.float32))   # -> array([1], dtype=uint8): FREE
 """
 from ._convert import FREE, OCCUPIED, UNKNOWN
 from ._lib import LIB_PATH
