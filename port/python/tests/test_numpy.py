@@ -131,3 +131,25 @@ def test_collision_and_ray_against_the_wall():
     assert not hit.safe and not hit.outside and hit.node["state"] == occmap.OCCUPIED
     assert not m.collide_capsule((0.5, 0.05, 0.05), (2.5, 0.05, 0.05), 0.05).safe
     assert m.count_aabb((2.0, -1.0, -1.0), (2.1, 1.0, 1.0))["occupied"] == 400
+
+
+def test_depth_pose_quaternion_is_w_first():
+    """README's camera mount q = (0.5, -0.5, 0.5, -0.5) (w, x, y, z) turns the optical axis z
+    into map +x: the centre pixel at 2 m from (0.05, 0.05, 0.05) hits the voxel at x = 2.05."""
+    m = occmap.Map(RES, 8 << 20)
+    r = m.insert_depth(np.array([[2000]], np.uint16), (100.0, 100.0, 0.0, 0.0),
+                       (0.05, 0.05, 0.05), (0.5, -0.5, 0.5, -0.5), max_range_m=5.0)
+    assert r["points"] == 1 and r["insert"]["voxels_occupied"] == 1
+    assert m.state_at([[2.05, 0.05, 0.05], [1.05, 0.05, 0.05]]).tolist() == \
+        [occmap.OCCUPIED, occmap.FREE]
+
+
+def test_sectors_yaw_equals_its_quaternion():
+    m, _, _ = _wall_map()
+    yaw = 0.3
+    a = m.sectors((0.05, 0.05, 0.05), yaw, band_below_m=0.05, band_above_m=0.05)
+    b = m.sectors((0.05, 0.05, 0.05), quaternion=(np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)),
+                  band_below_m=0.05, band_above_m=0.05)
+    assert (a.distance_cm == b.distance_cm).all() and len(a.distance_cm) == 72
+    c = m.sectors((0.05, 0.05, 0.05), -yaw, band_below_m=0.05, band_above_m=0.05)
+    assert (a.distance_cm != c.distance_cm).any()  # the heading matters
