@@ -1,0 +1,292 @@
+/* projective_walk.c - the top-down walk of a virtual octree over the camera frustum: each
+ * node's box is projected (8 corners) and compared with the pyramid over its footprint; whole
+ * free nodes and voxel updates are written to the output in Morton order. No tree reads. */
+#include <math.h>
+
+#include "projective_internal.h"
+
+enum { NODE_SKIP, NODE_FREE, NODE_MIXED };
+
+/* A node's projection: footprint pixels (clamped; valid when `proj`), camera depth range and
+ * the rounding slack used for it. */
+typedef struct {
+    uint32_t i0, i1, j0, j1;
+    bool proj;
+    float zmin, zmax, eps;
+} foot_t;
+
+/* Map-frame coordinate of key k's lower face. */
+static float key_low(const occ_raygeo_t *g, const uint32_t k)
+{
+    return (float)(((occ_rr_t)k - g->tmv_r) * g->res);
+}
+
+/* Camera frame of a map-frame offset w (the header's arithmetic). */
+static void to_cam(const occ_proj_camera_t *k, const float w[3], float q[3])
+{
+    for (unsigned a = 0; a < 3u; a++) {
+        q[a] = k->r[0][a] * w[0] + k->r[1][a] * w[1] + k->r[2][a] * w[2];
+    }
+}
+
+/* Squared distance from the camera to the node's box (map frame). */
+static float box_dist2(const occ_proj_camera_t *k, const float lo[3], const float s)
+{
+    const float t[3] = {k->t.x, k->t.y, k->t.z};
+    float d2 = 0.0f;
+    for (unsigned a = 0; a < 3u; a++) {
+        const float e = lo[a] - t[a] > 0.0f ? lo[a] - t[a] : (t[a] - (lo[a] + s) > 0.0f ? t[a] - (lo[a] + s) : 0.0f);
+        d2 += e * e;
+    }
+    return d2;
+}
+
+/* Corner geometry of a node: the camera-frame corners' bounds and the four side planes' maxima
+ * (the image's pixel grid as planes through the camera: inside means >= 0 on all four). */
+typedef struct {
+    float zmin, zmax, r2max, umin, umax, vmin, vmax, plane[4];
+} corners_t;
+
+static void node_corners(const occ_proj_t *x, const float q0[3], const float s, corners_t *c)
+{
+    const occ_proj_camera_t *const k = x->cam;
+    const float wf = (float)x->im->width, hf = (float)x->im->height;
+    c->zmin = INFINITY;
+    c->zmax = -INFINITY;
+    c->r2max = 0.0f;
+    c->umin = c->vmin = INFINITY;
+    c->umax = c->vmax = -INFINITY;
+    for (unsigned p = 0; p < 4u; p++) {
+        c->plane[p] = -INFINITY;
+    }
+    for (unsigned n = 0; n < 8u; n++) {
+        float q[3] = {q0[0], q0[1], q0[2]};
+        for (unsigned a = 0; a < 3u; a++) {
+            if ((n >> a) & 1u) {
+                for (unsigned b = 0; b < 3u; b++) {
+                    q[b] += s * k->r[a][b];
+                }
+            }
+        }
+        c->zmin = fminf(c->zmin, q[2]);
+        c->zmax = fmaxf(c->zmax, q[2]);
+        c->r2max = fmaxf(c->r2max, q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        c->plane[0] = fmaxf(c->plane[0], k->fx * q[0] + (k->cx + 0.5f) * q[2]);
+        c->plane[1] = fmaxf(c->plane[1], (wf - 0.5f - k->cx) * q[2] - k->fx * q[0]);
+        c->plane[2] = fmaxf(c->plane[2], k->fy * q[1] + (k->cy + 0.5f) * q[2]);
+        c->plane[3] = fmaxf(c->plane[3], (hf - 0.5f - k->cy) * q[2] - k->fy * q[1]);
+        if (q[2] > 0.0f) {
+            const float u = k->fx * (q[0] / q[2]) + k->cx, v = k->fy * (q[1] / q[2]) + k->cy;
+            c->umin = fminf(c->umin, u);
+            c->umax = fmaxf(c->umax, u);
+            c->vmin = fminf(c->vmin, v);
+            c->vmax = fmaxf(c->vmax, v);
+        }
+    }
+}
+
+/* Pixel index range [lo, hi] of a footprint interval, padded by `pad` pixels; false when it
+ * misses [0, n). *inside: the padded range lies within the image. */
+static bool pix_range(const float a, const float b, const float pad, const uint32_t n,
+                      uint32_t *lo, uint32_t *hi, bool *inside)
+{
+    const float nf = (float)n;
+    const float fa = floorf(fmaxf(a + 0.5f - pad, -1.0f)), fb = floorf(fminf(b + 0.5f + pad, nf));
+    if (fb < 0.0f || fa >= nf) {
+        return false;
+    }
+    *inside = *inside && fa >= 0.0f && fb < nf;
+    *lo = fa < 0.0f ? 0u : (uint32_t)fa;
+    *hi = fb >= nf ? n - 1u : (uint32_t)fb;
+    return true;
+}
+
+/* Classify the node at `level` whose first voxel has key k: SKIP (every voxel below unchanged
+ * and no end point in it), FREE (every voxel below free, no end point in it) or MIXED. */
+static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, foot_t *f)
+{
+    const occ_proj_camera_t *const cam = x->cam;
+    x->r->nodes_tested++;
+    const float s = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << level));
+    const float lo[3] = {key_low(&x->g, k[0]), key_low(&x->g, k[1]), key_low(&x->g, k[2])};
+    const float bd2 = box_dist2(cam, lo, s);
+    float mabs = fabsf(cam->t.x) + fabsf(cam->t.y) + fabsf(cam->t.z);
+    for (unsigned a = 0; a < 3u; a++) {
+        mabs += fmaxf(fabsf(lo[a]), fabsf(lo[a] + s));
+    }
+    const float eps = 1e-5f * (1.0f + mabs);
+    if (bd2 > x->max2 + eps * (1.0f + cam->max_range_m)) {
+        return NODE_SKIP; /* beyond max range: no free voxel, no end point */
+    }
+    const float w[3] = {lo[0] - cam->t.x, lo[1] - cam->t.y, lo[2] - cam->t.z};
+    float q0[3];
+    to_cam(cam, w, q0);
+    corners_t c;
+    node_corners(x, q0, s, &c);
+    const float peps = 1e-5f * (cam->fx + cam->fy + fabsf(cam->cx) + fabsf(cam->cy) +
+                                (float)x->im->width + (float)x->im->height) * (1.0f + mabs);
+    if (c.plane[0] < -peps || c.plane[1] < -peps || c.plane[2] < -peps || c.plane[3] < -peps ||
+        c.zmax < -eps || c.zmin > x->dmax + eps || c.zmin > cam->max_range_m + eps) {
+        return NODE_SKIP; /* outside the frustum, or behind every reading */
+    }
+    f->zmin = c.zmin;
+    f->zmax = c.zmax;
+    f->eps = eps;
+    f->proj = c.zmin > eps;
+    if (!f->proj) {
+        return NODE_MIXED; /* around the camera plane: no footprint */
+    }
+    const float pad = 0.01f + (cam->fx + cam->fy) * eps / c.zmin;
+    bool inside = true;
+    if (!pix_range(c.umin, c.umax, pad, x->im->width, &f->i0, &f->i1, &inside) ||
+        !pix_range(c.vmin, c.vmax, pad, x->im->height, &f->j0, &f->j1, &inside)) {
+        return NODE_SKIP;
+    }
+    float mn, mx;
+    occi_proj_range(x, f->i0, f->i1, f->j0, f->j1, &mn, &mx);
+    if (c.zmin > mx + eps) {
+        return NODE_SKIP;
+    }
+    if (inside && c.zmax + eps < occ_proj_front(x, mn) &&
+        c.r2max + eps * (1.0f + cam->max_range_m) <= x->max2) {
+        return NODE_FREE;
+    }
+    return NODE_MIXED;
+}
+
+/* The per-voxel rule (occ_integrate.h) for the voxel with key k. */
+static bool voxel_free(const occ_proj_t *x, const uint32_t k[3])
+{
+    const occ_proj_camera_t *const cam = x->cam;
+    const float w[3] = {occi_raygeo_center(&x->g, k[0]) - cam->t.x,
+                        occi_raygeo_center(&x->g, k[1]) - cam->t.y,
+                        occi_raygeo_center(&x->g, k[2]) - cam->t.z};
+    float q[3];
+    to_cam(cam, w, q);
+    if (!(q[2] > 0.0f)) {
+        return false;
+    }
+    const float u = cam->fx * (q[0] / q[2]) + cam->cx + 0.5f;
+    const float v = cam->fy * (q[1] / q[2]) + cam->cy + 0.5f;
+    if (!(u >= 0.0f && u < (float)x->im->width && v >= 0.0f && v < (float)x->im->height)) {
+        return false;
+    }
+    const float d = x->d0[(size_t)floorf(v) * x->im->width + (size_t)floorf(u)];
+    if (!(d > 0.0f) || !(q[2] < occ_proj_front(x, d))) {
+        return false;
+    }
+    return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= x->max2;
+}
+
+/* Which of the 8 voxels of the level-1 node with first key k hold an end point (bit = slot):
+ * the pixels of its footprint (the whole image when it has none) whose depth is in its range. */
+static unsigned hit_mask(const occ_proj_t *x, const uint32_t k[3], const foot_t *f)
+{
+    if (x->dmax < f->zmin - f->eps || x->dmin > f->zmax + f->eps) {
+        return 0u;
+    }
+    const occ_proj_camera_t *const cam = x->cam;
+    const uint32_t w = x->im->width;
+    const uint32_t i0 = f->proj ? f->i0 : 0u, i1 = f->proj ? f->i1 : w - 1u;
+    const uint32_t j0 = f->proj ? f->j0 : 0u, j1 = f->proj ? f->j1 : x->im->height - 1u;
+    const float lo = f->zmin - f->eps, hi = f->zmax + f->eps;
+    unsigned mask = 0;
+    for (uint32_t j = j0; j <= j1; j++) {
+        const float *const row = x->d0 + (size_t)j * w;
+        for (uint32_t i = i0; i <= i1; i++) {
+            const float d = row[i];
+            if (!(d >= lo && d <= hi)) {
+                continue;
+            }
+            float c[3];
+            occ_proj_back(cam, i, j, d, c);
+            if (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > x->max2) {
+                continue;
+            }
+            const float p[3] = {cam->r[0][0] * c[0] + cam->r[0][1] * c[1] + cam->r[0][2] * c[2] + cam->t.x,
+                                cam->r[1][0] * c[0] + cam->r[1][1] * c[1] + cam->r[1][2] * c[2] + cam->t.y,
+                                cam->r[2][0] * c[0] + cam->r[2][1] * c[1] + cam->r[2][2] * c[2] + cam->t.z};
+            uint32_t kk[3];
+            if (occi_raygeo_key(&x->g, p, kk) && (kk[0] >> 1) == (k[0] >> 1) &&
+                (kk[1] >> 1) == (k[1] >> 1) && (kk[2] >> 1) == (k[2] >> 1)) {
+                mask |= 1u << ((kk[0] & 1u) | ((kk[1] & 1u) << 1) | ((kk[2] & 1u) << 2));
+            }
+        }
+    }
+    return mask;
+}
+
+static bool room(occ_proj_t *x)
+{
+    if (x->nv + x->nn >= x->cap) {
+        x->overflow = true;
+        return false;
+    }
+    return true;
+}
+
+/* The 8 voxels of a MIXED level-1 node: hit, free or unchanged. */
+static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
+                         const foot_t *f)
+{
+    const unsigned mask = hit_mask(x, k, f);
+    for (unsigned s = 0; s < 8u; s++) {
+        const uint32_t kv[3] = {k[0] | (s & 1u), k[1] | ((s >> 1) & 1u), k[2] | ((s >> 2) & 1u)};
+        const bool hit = ((mask >> s) & 1u) != 0u;
+        if ((hit || voxel_free(x, kv)) && room(x)) {
+            x->out[x->nv++] = (code | s) | (hit ? OCC_CODE_HIT_BIT : 0u);
+        }
+    }
+}
+
+void occi_proj_walk(occ_proj_t *const x)
+{
+    const unsigned depth = x->g.depth;
+    struct {
+        uint32_t k[3];
+        occ_code_t code;
+        uint8_t level, next;
+    } st[OCC_MAX_DEPTH + 1u];
+    foot_t f;
+    if (depth == 1u) {
+        const uint32_t k0[3] = {0u, 0u, 0u};
+        if (test_node(x, k0, 1u, &f) != NODE_SKIP) {
+            visit_voxels(x, k0, 0u, &f); /* the root is no coarse node: its voxels decide */
+        }
+        return;
+    }
+    unsigned sp = 1;
+    st[0].k[0] = st[0].k[1] = st[0].k[2] = 0u;
+    st[0].code = 0u;
+    st[0].level = (uint8_t)depth;
+    st[0].next = 0u;
+    while (sp > 0u && !x->overflow) {
+        const unsigned t = sp - 1u;
+        if (st[t].next == 8u) {
+            sp--;
+            continue;
+        }
+        const unsigned s = st[t].next++;
+        const unsigned l = st[t].level - 1u;
+        const uint32_t k[3] = {st[t].k[0] | ((s & 1u) << l), st[t].k[1] | (((s >> 1) & 1u) << l),
+                               st[t].k[2] | (((s >> 2) & 1u) << l)};
+        const occ_code_t code = st[t].code | ((occ_code_t)s << (3u * l));
+        const int cls = test_node(x, k, l, &f);
+        if (cls == NODE_FREE && room(x)) {
+            x->nn++;
+            x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
+            x->per_level[l]++;
+        } else if (cls == NODE_MIXED && l == 1u) {
+            visit_voxels(x, k, code, &f);
+        } else if (cls == NODE_MIXED) {
+            OCC_ASSERT(sp <= OCC_MAX_DEPTH);
+            st[sp].k[0] = k[0];
+            st[sp].k[1] = k[1];
+            st[sp].k[2] = k[2];
+            st[sp].code = code;
+            st[sp].level = (uint8_t)l;
+            st[sp].next = 0u;
+            sp++;
+        }
+    }
+}
