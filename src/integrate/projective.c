@@ -7,6 +7,9 @@
 #include "projective_internal.h"
 #include "coarse_internal.h"
 
+/* The header's fixed term names the filter's 8 KiB. */
+typedef char proj_filter_matches_header[OCC_PROJ_FILTER_N * 8u == 8192u ? 1 : -1];
+
 static bool finite_pos(const float v)
 {
     return isfinite(v) && v > 0.0f;
@@ -50,8 +53,9 @@ static bool camera_ok(const occ_proj_camera_t *k)
     return isfinite(t.x) && isfinite(t.y) && isfinite(t.z) && rotation_ok(k->r);
 }
 
-/* Carve the scratch: depths and pyramid (4-byte floats), then the output (8-byte codes).
- * false when it cannot hold the depths, the pyramid and one output slot. */
+/* Carve the scratch: the filter and the sort's histograms (8-byte aligned), the depths and
+ * the pyramid (floats), then the output (8-byte codes). false when it cannot hold all that and
+ * one output slot. */
 static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
 {
     if (scratch == NULL) {
@@ -59,13 +63,17 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     }
     const uintptr_t a = (uintptr_t)scratch;
     const size_t skip = (size_t)((8u - (a & 7u)) & 7u);
+    const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u;
     const size_t px = (size_t)x->im->width * x->im->height;
     const size_t floats = 4u * px + occi_proj_pyramid_bytes(x->im->width, x->im->height);
-    const size_t head = skip + ((floats + 7u) & ~(size_t)7u);
+    const size_t head = skip + fixed + ((floats + 7u) & ~(size_t)7u);
     if (bytes < head + 8u) {
         return false;
     }
-    *mem = (float *)(void *)((unsigned char *)scratch + skip);
+    unsigned char *const base = (unsigned char *)scratch + skip;
+    x->filter = (occ_code_t *)(void *)base;
+    x->hist = (uint32_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u);
+    *mem = (float *)(void *)(base + fixed);
     x->out = (occ_code_t *)(void *)((unsigned char *)scratch + head);
     x->cap = (bytes - head) / 8u;
     x->r->insert.scratch_used = head;
@@ -76,10 +84,10 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
  * group stays in walk order: sorted). Returns the group array, or NULL when the gap is short. */
 static occ_code_t *group_nodes(occ_proj_t *x, size_t start[OCC_MAX_DEPTH + 2u])
 {
-    if (x->cap - x->nv - x->nn < x->nn) {
+    if (x->cap - x->nh - x->nv - x->nn < x->nn) {
         return NULL;
     }
-    occ_code_t *const g = x->out + x->nv;
+    occ_code_t *const g = x->out + x->nh + x->nv;
     start[0] = 0;
     for (unsigned l = 0; l <= OCC_MAX_DEPTH; l++) {
         start[l + 1u] = start[l] + x->per_level[l];
@@ -105,7 +113,11 @@ static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OC
         inner += i;
         leaf += f;
     }
-    occi_coarse_need(x->out, x->nv, 0u, depth, &i, &f);
+    occ_code_t *const fv = x->out + x->nh;
+    occi_coarse_need(fv, x->nv, 0u, depth, &i, &f);
+    inner += i;
+    leaf += f;
+    occi_coarse_need(x->out, x->nh, 0u, depth, &i, &f);
     inner += i;
     leaf += f;
     if (inner > OCC_NONE || leaf > OCC_NONE ||
@@ -118,10 +130,13 @@ static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OC
         x->r->insert.coarse_updated +=
             occi_coarse_apply(m, g + start[l], x->per_level[l], l, miss);
     }
-    size_t changed = 0;
-    const occ_err_t e = occ_map_observe_codes(m, x->out, x->nv, &changed);
-    OCC_ASSERT(e == OCC_OK); /* the check above covers it */
-    x->r->insert.voxels_changed = changed;
+    size_t changed = 0, changed_hits = 0;
+    occ_err_t e = occ_map_observe_codes(m, fv, x->nv, &changed);
+    if (e == OCC_OK) {
+        e = occ_map_observe_codes(m, x->out, x->nh, &changed_hits);
+    }
+    OCC_ASSERT(e == OCC_OK); /* the check above covers both */
+    x->r->insert.voxels_changed = changed + changed_hits;
     return e;
 }
 
@@ -129,18 +144,13 @@ static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OC
 static void count_output(occ_proj_t *x)
 {
     occ_insert_result_t *const r = &x->r->insert;
-    for (size_t n = 0; n < x->nv; n++) {
-        if ((x->out[n] & OCC_CODE_HIT_BIT) != 0u) {
-            r->voxels_occupied++;
-        } else {
-            r->voxels_free++;
-        }
-    }
-    r->voxels_updated = x->nv;
+    r->voxels_free = x->nv;
+    r->voxels_occupied = x->nh;
+    r->voxels_updated = x->nv + x->nh;
     r->voxel_visits = x->r->nodes_tested;
     r->rays_clipped = x->r->pixels_beyond_max;
     r->points_integrated = x->r->pixels - x->r->pixels_no_reading - x->r->pixels_too_close -
-                           x->r->pixels_beyond_max;
+                           x->r->pixels_beyond_max - r->points_skipped;
 }
 
 occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *image,
@@ -177,11 +187,16 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
     occ_err_t e = OCC_ERR_SCRATCH;
     if (carve(&x, scratch, scratch_bytes, &mem)) {
         occi_proj_build(&x, mem);
-        occi_proj_walk(&x);
+        const bool hits_fit = occi_proj_hits(&x);
+        if (hits_fit) {
+            occi_proj_walk(&x);
+        }
         size_t start[OCC_MAX_DEPTH + 2u];
-        const occ_code_t *const g = x.overflow ? NULL : group_nodes(&x, start);
-        res.insert.scratch_used += 8u * (x.nv + 2u * x.nn);
+        const occ_code_t *const g = !hits_fit || x.overflow ? NULL : group_nodes(&x, start);
+        const size_t slots = x.nh + x.nv + 2u * x.nn;
+        res.insert.scratch_used += 8u * (slots > x.hwm ? slots : x.hwm);
         if (g != NULL) {
+            x.nv = occi_proj_drop_hits(x.out + x.nh, x.nv, x.out, x.nh);
             count_output(&x);
             e = apply(&x, g, start);
         }

@@ -11,6 +11,8 @@
 /* Pyramid levels: level 0 is the image, each next one halves both sides (ceil) down to 1x1;
  * 65535 pixels per side need 17. */
 #define OCC_PROJ_MAX_LEVELS 18u
+/* Entries of the end points' repeat filter (direct mapped, 8 bytes each). */
+#define OCC_PROJ_FILTER_N 1024u
 
 typedef struct {
     occ_map_t *map;
@@ -26,8 +28,12 @@ typedef struct {
     float *mn[OCC_PROJ_MAX_LEVELS], *mx[OCC_PROJ_MAX_LEVELS]; /* levels >= 1 */
     uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];
     unsigned levels;
-    occ_code_t *out;        /* voxel codes from the front, whole nodes from the back (code with bit 3 level - 1 set: the level) */
-    size_t cap, nv, nn;
+    occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
+    uint32_t *hist;         /* the radix sort's histograms */
+    /* The output: sorted hit codes (nh), then the walk's free voxel codes (nv) from out + nh,
+     * whole free nodes from the back (code with bit 3 level - 1 set: the level). */
+    occ_code_t *out;
+    size_t cap, nh, nv, nn, hwm;
     size_t per_level[OCC_MAX_DEPTH + 1u];
     bool overflow;
     occ_proj_result_t *r;
@@ -58,6 +64,12 @@ void occi_proj_build(occ_proj_t *x, float *mem);
  * over-approximated by at most 2 x 2 cells of one level (so mn may be lower, mx higher). */
 void occi_proj_range(const occ_proj_t *x, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1,
                      float *mn, float *mx);
+
+/* The end points' codes into out[0..nh) (sorted, unique, hit bit set); false when the output
+ * cannot hold them and the sort's temporary. */
+bool occi_proj_hits(occ_proj_t *x);
+/* Drop from free_codes[0..nv) (sorted) the codes in hits[0..nh); returns the new count. */
+size_t occi_proj_drop_hits(occ_code_t *free_codes, size_t nv, const occ_code_t *hits, size_t nh);
 
 /* The walk: fills x->out / nv / nn / per_level, or sets x->overflow. */
 void occi_proj_walk(occ_proj_t *x);

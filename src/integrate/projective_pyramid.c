@@ -5,6 +5,17 @@
 
 #include "projective_internal.h"
 
+/* No NaN in the pyramid (no reading is -inf): plain compares, no libm call. */
+static inline float lo_of(const float a, const float b)
+{
+    return b < a ? b : a;
+}
+
+static inline float hi_of(const float a, const float b)
+{
+    return b > a ? b : a;
+}
+
 static uint32_t half_up(const uint32_t n)
 {
     return (n + 1u) / 2u;
@@ -87,8 +98,8 @@ static void reduce(const float *smn, const float *smx, const uint32_t sw, const 
             const uint32_t i0 = 2u * i, i1 = i0 + 1u < sw ? i0 + 1u : i0;
             const size_t a = (size_t)j0 * sw + i0, b = (size_t)j0 * sw + i1,
                          c = (size_t)j1 * sw + i0, e = (size_t)j1 * sw + i1;
-            const float m0 = fminf(fminf(smn[a], smn[b]), fminf(smn[c], smn[e]));
-            const float m1 = fmaxf(fmaxf(smx[a], smx[b]), fmaxf(smx[c], smx[e]));
+            const float m0 = lo_of(lo_of(smn[a], smn[b]), lo_of(smn[c], smn[e]));
+            const float m1 = hi_of(hi_of(smx[a], smx[b]), hi_of(smx[c], smx[e]));
             dmn[(size_t)j * dw + i] = m0;
             dmx[(size_t)j * dw + i] = m1;
         }
@@ -135,8 +146,8 @@ void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_
     for (uint32_t b = b0; b <= b1; b++) {
         for (uint32_t a = a0; a <= a1; a++) {
             const size_t k = (size_t)b * lw + a;
-            lo = fminf(lo, pmn[k]);
-            hi = fmaxf(hi, pmx[k]);
+            lo = lo_of(lo, pmn[k]);
+            hi = hi_of(hi, pmx[k]);
         }
     }
     *mn = lo;

@@ -5,6 +5,17 @@
 
 #include "projective_internal.h"
 
+/* Finite operands only (no NaN here): plain compares, no libm call. */
+static inline float lo_of(const float a, const float b)
+{
+    return b < a ? b : a;
+}
+
+static inline float hi_of(const float a, const float b)
+{
+    return b > a ? b : a;
+}
+
 enum { NODE_SKIP, NODE_FREE, NODE_MIXED };
 
 /* A node's projection: footprint pixels (clamped; valid when `proj`), camera depth range and
@@ -68,19 +79,19 @@ static void node_corners(const occ_proj_t *x, const float q0[3], const float s, 
                 }
             }
         }
-        c->zmin = fminf(c->zmin, q[2]);
-        c->zmax = fmaxf(c->zmax, q[2]);
-        c->r2max = fmaxf(c->r2max, q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-        c->plane[0] = fmaxf(c->plane[0], k->fx * q[0] + (k->cx + 0.5f) * q[2]);
-        c->plane[1] = fmaxf(c->plane[1], (wf - 0.5f - k->cx) * q[2] - k->fx * q[0]);
-        c->plane[2] = fmaxf(c->plane[2], k->fy * q[1] + (k->cy + 0.5f) * q[2]);
-        c->plane[3] = fmaxf(c->plane[3], (hf - 0.5f - k->cy) * q[2] - k->fy * q[1]);
+        c->zmin = lo_of(c->zmin, q[2]);
+        c->zmax = hi_of(c->zmax, q[2]);
+        c->r2max = hi_of(c->r2max, q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        c->plane[0] = hi_of(c->plane[0], k->fx * q[0] + (k->cx + 0.5f) * q[2]);
+        c->plane[1] = hi_of(c->plane[1], (wf - 0.5f - k->cx) * q[2] - k->fx * q[0]);
+        c->plane[2] = hi_of(c->plane[2], k->fy * q[1] + (k->cy + 0.5f) * q[2]);
+        c->plane[3] = hi_of(c->plane[3], (hf - 0.5f - k->cy) * q[2] - k->fy * q[1]);
         if (q[2] > 0.0f) {
             const float u = k->fx * (q[0] / q[2]) + k->cx, v = k->fy * (q[1] / q[2]) + k->cy;
-            c->umin = fminf(c->umin, u);
-            c->umax = fmaxf(c->umax, u);
-            c->vmin = fminf(c->vmin, v);
-            c->vmax = fmaxf(c->vmax, v);
+            c->umin = lo_of(c->umin, u);
+            c->umax = hi_of(c->umax, u);
+            c->vmin = lo_of(c->vmin, v);
+            c->vmax = hi_of(c->vmax, v);
         }
     }
 }
@@ -91,7 +102,7 @@ static bool pix_range(const float a, const float b, const float pad, const uint3
                       uint32_t *lo, uint32_t *hi, bool *inside)
 {
     const float nf = (float)n;
-    const float fa = floorf(fmaxf(a + 0.5f - pad, -1.0f)), fb = floorf(fminf(b + 0.5f + pad, nf));
+    const float fa = floorf(hi_of(a + 0.5f - pad, -1.0f)), fb = floorf(lo_of(b + 0.5f + pad, nf));
     if (fb < 0.0f || fa >= nf) {
         return false;
     }
@@ -112,7 +123,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     const float bd2 = box_dist2(cam, lo, s);
     float mabs = fabsf(cam->t.x) + fabsf(cam->t.y) + fabsf(cam->t.z);
     for (unsigned a = 0; a < 3u; a++) {
-        mabs += fmaxf(fabsf(lo[a]), fabsf(lo[a] + s));
+        mabs += hi_of(fabsf(lo[a]), fabsf(lo[a] + s));
     }
     const float eps = 1e-5f * (1.0f + mabs);
     if (bd2 > x->max2 + eps * (1.0f + cam->max_range_m)) {
@@ -178,63 +189,22 @@ static bool voxel_free(const occ_proj_t *x, const uint32_t k[3])
     return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= x->max2;
 }
 
-/* Which of the 8 voxels of the level-1 node with first key k hold an end point (bit = slot):
- * the pixels of its footprint (the whole image when it has none) whose depth is in its range. */
-static unsigned hit_mask(const occ_proj_t *x, const uint32_t k[3], const foot_t *f)
-{
-    if (x->dmax < f->zmin - f->eps || x->dmin > f->zmax + f->eps) {
-        return 0u;
-    }
-    const occ_proj_camera_t *const cam = x->cam;
-    const uint32_t w = x->im->width;
-    const uint32_t i0 = f->proj ? f->i0 : 0u, i1 = f->proj ? f->i1 : w - 1u;
-    const uint32_t j0 = f->proj ? f->j0 : 0u, j1 = f->proj ? f->j1 : x->im->height - 1u;
-    const float lo = f->zmin - f->eps, hi = f->zmax + f->eps;
-    unsigned mask = 0;
-    for (uint32_t j = j0; j <= j1; j++) {
-        const float *const row = x->d0 + (size_t)j * w;
-        for (uint32_t i = i0; i <= i1; i++) {
-            const float d = row[i];
-            if (!(d >= lo && d <= hi)) {
-                continue;
-            }
-            float c[3];
-            occ_proj_back(cam, i, j, d, c);
-            if (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > x->max2) {
-                continue;
-            }
-            const float p[3] = {cam->r[0][0] * c[0] + cam->r[0][1] * c[1] + cam->r[0][2] * c[2] + cam->t.x,
-                                cam->r[1][0] * c[0] + cam->r[1][1] * c[1] + cam->r[1][2] * c[2] + cam->t.y,
-                                cam->r[2][0] * c[0] + cam->r[2][1] * c[1] + cam->r[2][2] * c[2] + cam->t.z};
-            uint32_t kk[3];
-            if (occi_raygeo_key(&x->g, p, kk) && (kk[0] >> 1) == (k[0] >> 1) &&
-                (kk[1] >> 1) == (k[1] >> 1) && (kk[2] >> 1) == (k[2] >> 1)) {
-                mask |= 1u << ((kk[0] & 1u) | ((kk[1] & 1u) << 1) | ((kk[2] & 1u) << 2));
-            }
-        }
-    }
-    return mask;
-}
-
 static bool room(occ_proj_t *x)
 {
-    if (x->nv + x->nn >= x->cap) {
+    if (x->nh + x->nv + x->nn >= x->cap) {
         x->overflow = true;
         return false;
     }
     return true;
 }
 
-/* The 8 voxels of a MIXED level-1 node: hit, free or unchanged. */
-static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
-                         const foot_t *f)
+/* The 8 voxels of a MIXED level-1 node: free or not by the rule (hits are occi_proj_hits'). */
+static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code)
 {
-    const unsigned mask = hit_mask(x, k, f);
     for (unsigned s = 0; s < 8u; s++) {
         const uint32_t kv[3] = {k[0] | (s & 1u), k[1] | ((s >> 1) & 1u), k[2] | ((s >> 2) & 1u)};
-        const bool hit = ((mask >> s) & 1u) != 0u;
-        if ((hit || voxel_free(x, kv)) && room(x)) {
-            x->out[x->nv++] = (code | s) | (hit ? OCC_CODE_HIT_BIT : 0u);
+        if (voxel_free(x, kv) && room(x)) {
+            x->out[x->nh + x->nv++] = code | s;
         }
     }
 }
@@ -251,7 +221,7 @@ void occi_proj_walk(occ_proj_t *const x)
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
         if (test_node(x, k0, 1u, &f) != NODE_SKIP) {
-            visit_voxels(x, k0, 0u, &f); /* the root is no coarse node: its voxels decide */
+            visit_voxels(x, k0, 0u); /* the root is no coarse node: its voxels decide */
         }
         return;
     }
@@ -277,7 +247,7 @@ void occi_proj_walk(occ_proj_t *const x)
             x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
             x->per_level[l]++;
         } else if (cls == NODE_MIXED && l == 1u) {
-            visit_voxels(x, k, code, &f);
+            visit_voxels(x, k, code);
         } else if (cls == NODE_MIXED) {
             OCC_ASSERT(sp <= OCC_MAX_DEPTH);
             st[sp].k[0] = k[0];
