@@ -308,7 +308,10 @@ int main(int argc, char **argv)
     occ_map_t mp, ms;
     size_t used = 0;
     if (proj_only) {
-        for (int r = 0; r < reps; r++) run_proj(fr, cam, res, max_m, mp, &used, nullptr);
+        std::vector<double> t;
+        for (int r = 0; r < reps; r++) t.push_back(run_proj(fr, cam, res, max_m, mp, &used, nullptr));
+        std::printf("PROJECTIVE only: %.2f ms per frame (median of %d), scratch %zu bytes\n",
+                    pct(t, 0.5), reps, used);
         return 0;
     }
     OcTree *octo = nullptr;

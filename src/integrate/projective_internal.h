@@ -28,6 +28,7 @@ typedef struct {
     float *mn[OCC_PROJ_MAX_LEVELS], *mx[OCC_PROJ_MAX_LEVELS]; /* levels >= 1 */
     uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];
     unsigned levels;
+    float pn[4][3], pr[4][3]; /* the walk's side planes and their products with the map axes */
     occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
     uint32_t *hist;         /* the radix sort's histograms */
     /* The output: sorted hit codes (nh), then the walk's free voxel codes (nv) from out + nh,

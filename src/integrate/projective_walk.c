@@ -52,48 +52,77 @@ static float box_dist2(const occ_proj_camera_t *k, const float lo[3], const floa
     return d2;
 }
 
-/* Corner geometry of a node: the camera-frame corners' bounds and the four side planes' maxima
- * (the image's pixel grid as planes through the camera: inside means >= 0 on all four). */
-typedef struct {
-    float zmin, zmax, r2max, umin, umax, vmin, vmax, plane[4];
-} corners_t;
-
-static void node_corners(const occ_proj_t *x, const float q0[3], const float s, corners_t *c)
+/* The four side planes of the pixel grid through the camera (camera frame; inside: >= 0 on
+ * all four) and their dot products with the map axes' camera-frame directions. */
+static void planes_init(occ_proj_t *x)
 {
     const occ_proj_camera_t *const k = x->cam;
     const float wf = (float)x->im->width, hf = (float)x->im->height;
-    c->zmin = INFINITY;
-    c->zmax = -INFINITY;
-    c->r2max = 0.0f;
-    c->umin = c->vmin = INFINITY;
-    c->umax = c->vmax = -INFINITY;
+    const float n[4][3] = {{k->fx, 0.0f, k->cx + 0.5f},
+                           {-k->fx, 0.0f, wf - 0.5f - k->cx},
+                           {0.0f, k->fy, k->cy + 0.5f},
+                           {0.0f, -k->fy, hf - 0.5f - k->cy}};
     for (unsigned p = 0; p < 4u; p++) {
-        c->plane[p] = -INFINITY;
+        for (unsigned a = 0; a < 3u; a++) {
+            x->pn[p][a] = n[p][a];
+            x->pr[p][a] = n[p][0] * k->r[a][0] + n[p][1] * k->r[a][1] + n[p][2] * k->r[a][2];
+        }
     }
+}
+
+/* Does the box (camera-frame corner q0, edge s) lie wholly outside one of the side planes? */
+static bool outside_planes(const occ_proj_t *x, const float q0[3], const float s,
+                           const float peps)
+{
+    for (unsigned p = 0; p < 4u; p++) {
+        float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2];
+        for (unsigned a = 0; a < 3u; a++) {
+            m += x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
+        }
+        if (m < -peps) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* The box's image footprint: u, v bounds of its 8 corners (all in front of the camera). */
+typedef struct {
+    float umin, umax, vmin, vmax;
+} uv_t;
+
+static void footprint(const occ_proj_camera_t *k, const float q0[3], const float s, uv_t *f)
+{
+    f->umin = f->vmin = INFINITY;
+    f->umax = f->vmax = -INFINITY;
     for (unsigned n = 0; n < 8u; n++) {
         float q[3] = {q0[0], q0[1], q0[2]};
         for (unsigned a = 0; a < 3u; a++) {
             if ((n >> a) & 1u) {
-                for (unsigned b = 0; b < 3u; b++) {
-                    q[b] += s * k->r[a][b];
-                }
+                q[0] += s * k->r[a][0];
+                q[1] += s * k->r[a][1];
+                q[2] += s * k->r[a][2];
             }
         }
-        c->zmin = lo_of(c->zmin, q[2]);
-        c->zmax = hi_of(c->zmax, q[2]);
-        c->r2max = hi_of(c->r2max, q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-        c->plane[0] = hi_of(c->plane[0], k->fx * q[0] + (k->cx + 0.5f) * q[2]);
-        c->plane[1] = hi_of(c->plane[1], (wf - 0.5f - k->cx) * q[2] - k->fx * q[0]);
-        c->plane[2] = hi_of(c->plane[2], k->fy * q[1] + (k->cy + 0.5f) * q[2]);
-        c->plane[3] = hi_of(c->plane[3], (hf - 0.5f - k->cy) * q[2] - k->fy * q[1]);
-        if (q[2] > 0.0f) {
-            const float u = k->fx * (q[0] / q[2]) + k->cx, v = k->fy * (q[1] / q[2]) + k->cy;
-            c->umin = lo_of(c->umin, u);
-            c->umax = hi_of(c->umax, u);
-            c->vmin = lo_of(c->vmin, v);
-            c->vmax = hi_of(c->vmax, v);
-        }
+        const float iz = 1.0f / q[2];
+        const float u = k->fx * (q[0] * iz) + k->cx, v = k->fy * (q[1] * iz) + k->cy;
+        f->umin = lo_of(f->umin, u);
+        f->umax = hi_of(f->umax, u);
+        f->vmin = lo_of(f->vmin, v);
+        f->vmax = hi_of(f->vmax, v);
     }
+}
+
+/* Squared distance from the camera to the box's farthest corner (map frame). */
+static float far_dist2(const occ_proj_camera_t *k, const float lo[3], const float s)
+{
+    const float t[3] = {k->t.x, k->t.y, k->t.z};
+    float d2 = 0.0f;
+    for (unsigned a = 0; a < 3u; a++) {
+        const float e0 = lo[a] - t[a], e1 = lo[a] + s - t[a];
+        d2 += hi_of(e0 * e0, e1 * e1);
+    }
+    return d2;
 }
 
 /* Pixel index range [lo, hi] of a footprint interval, padded by `pad` pixels; false when it
@@ -132,22 +161,28 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     const float w[3] = {lo[0] - cam->t.x, lo[1] - cam->t.y, lo[2] - cam->t.z};
     float q0[3];
     to_cam(cam, w, q0);
-    corners_t c;
-    node_corners(x, q0, s, &c);
+    float zmin = q0[2], zmax = q0[2];
+    for (unsigned a = 0; a < 3u; a++) {
+        const float dz = s * cam->r[a][2];
+        zmin += dz < 0.0f ? dz : 0.0f;
+        zmax += dz > 0.0f ? dz : 0.0f;
+    }
     const float peps = 1e-5f * (cam->fx + cam->fy + fabsf(cam->cx) + fabsf(cam->cy) +
                                 (float)x->im->width + (float)x->im->height) * (1.0f + mabs);
-    if (c.plane[0] < -peps || c.plane[1] < -peps || c.plane[2] < -peps || c.plane[3] < -peps ||
-        c.zmax < -eps || c.zmin > x->dmax + eps || c.zmin > cam->max_range_m + eps) {
+    if (zmax < -eps || zmin > x->dmax + eps || zmin > cam->max_range_m + eps ||
+        outside_planes(x, q0, s, peps)) {
         return NODE_SKIP; /* outside the frustum, or behind every reading */
     }
-    f->zmin = c.zmin;
-    f->zmax = c.zmax;
+    f->zmin = zmin;
+    f->zmax = zmax;
     f->eps = eps;
-    f->proj = c.zmin > eps;
+    f->proj = zmin > eps;
     if (!f->proj) {
         return NODE_MIXED; /* around the camera plane: no footprint */
     }
-    const float pad = 0.01f + (cam->fx + cam->fy) * eps / c.zmin;
+    uv_t c;
+    footprint(cam, q0, s, &c);
+    const float pad = 0.01f + (cam->fx + cam->fy) * eps / zmin;
     bool inside = true;
     if (!pix_range(c.umin, c.umax, pad, x->im->width, &f->i0, &f->i1, &inside) ||
         !pix_range(c.vmin, c.vmax, pad, x->im->height, &f->j0, &f->j1, &inside)) {
@@ -155,11 +190,11 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     }
     float mn, mx;
     occi_proj_range(x, f->i0, f->i1, f->j0, f->j1, &mn, &mx);
-    if (c.zmin > mx + eps) {
+    if (zmin > mx + eps) {
         return NODE_SKIP;
     }
-    if (inside && c.zmax + eps < occ_proj_front(x, mn) &&
-        c.r2max + eps * (1.0f + cam->max_range_m) <= x->max2) {
+    if (inside && zmax + eps < occ_proj_front(x, mn) &&
+        far_dist2(cam, lo, s) + eps * (1.0f + cam->max_range_m) <= x->max2) {
         return NODE_FREE;
     }
     return NODE_MIXED;
@@ -218,6 +253,7 @@ void occi_proj_walk(occ_proj_t *const x)
         uint8_t level, next;
     } st[OCC_MAX_DEPTH + 1u];
     foot_t f;
+    planes_init(x);
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
         if (test_node(x, k0, 1u, &f) != NODE_SKIP) {
