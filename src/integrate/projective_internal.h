@@ -35,6 +35,7 @@ typedef struct {
      * whole free nodes from the back (code with bit 3 level - 1 set: the level). */
     occ_code_t *out;
     size_t cap, nh, nv, nn, hwm;
+    size_t hit_cur;         /* the walk's cursor over the sorted hits */
     size_t per_level[OCC_MAX_DEPTH + 1u];
     bool overflow;
     occ_proj_result_t *r;

@@ -233,12 +233,43 @@ static bool room(occ_proj_t *x)
     return true;
 }
 
-/* The 8 voxels of a MIXED level-1 node: free or not by the rule (hits are occi_proj_hits'). */
-static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code)
+/* Does the level-l node starting at `code` hold an end point? The walk asks in increasing code
+ * order, so one cursor over the sorted hits serves the whole walk. */
+static bool holds_hit(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
+    const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
+    while (x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < code) {
+        x->hit_cur++;
+    }
+    return x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < end;
+}
+
+/* Record a whole free node at level l >= 1 (from the back of the output). */
+static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
+{
+    if (room(x)) {
+        x->nn++;
+        x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
+        x->per_level[l]++;
+    }
+}
+
+/* The 8 voxels of a MIXED level-1 node, free or not by the rule (hits are occi_proj_hits');
+ * all 8 free: one whole level-1 node (the same updates, fewer slots). */
+static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
+                         const bool may_merge)
+{
+    unsigned mask = 0;
     for (unsigned s = 0; s < 8u; s++) {
         const uint32_t kv[3] = {k[0] | (s & 1u), k[1] | ((s >> 1) & 1u), k[2] | ((s >> 2) & 1u)};
-        if (voxel_free(x, kv) && room(x)) {
+        mask |= voxel_free(x, kv) ? 1u << s : 0u;
+    }
+    if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
+        emit_node(x, code, 1u);
+        return;
+    }
+    for (unsigned s = 0; s < 8u; s++) {
+        if (((mask >> s) & 1u) != 0u && room(x)) {
             x->out[x->nh + x->nv++] = code | s;
         }
     }
@@ -257,7 +288,7 @@ void occi_proj_walk(occ_proj_t *const x)
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
         if (test_node(x, k0, 1u, &f) != NODE_SKIP) {
-            visit_voxels(x, k0, 0u); /* the root is no coarse node: its voxels decide */
+            visit_voxels(x, k0, 0u, false); /* the root is no coarse node */
         }
         return;
     }
@@ -277,13 +308,15 @@ void occi_proj_walk(occ_proj_t *const x)
         const uint32_t k[3] = {st[t].k[0] | ((s & 1u) << l), st[t].k[1] | (((s >> 1) & 1u) << l),
                                st[t].k[2] | (((s >> 2) & 1u) << l)};
         const occ_code_t code = st[t].code | ((occ_code_t)s << (3u * l));
-        const int cls = test_node(x, k, l, &f);
-        if (cls == NODE_FREE && room(x)) {
-            x->nn++;
-            x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
-            x->per_level[l]++;
+        int cls = test_node(x, k, l, &f);
+        if (cls == NODE_FREE && holds_hit(x, code, l)) {
+            cls = NODE_MIXED; /* hits win: not expected (a free node is in front of every end
+                               * point of its footprint), kept exact by descending */
+        }
+        if (cls == NODE_FREE) {
+            emit_node(x, code, l);
         } else if (cls == NODE_MIXED && l == 1u) {
-            visit_voxels(x, k, code);
+            visit_voxels(x, k, code, true);
         } else if (cls == NODE_MIXED) {
             OCC_ASSERT(sp <= OCC_MAX_DEPTH);
             st[sp].k[0] = k[0];
