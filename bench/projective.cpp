@@ -100,6 +100,16 @@ static occ_depth_image_t image_of(const Frame &f)
     return occ_depth_image_t{f.pix, OCC_DEPTH_U16, f.w, f.h, (size_t)f.w * 2u, 1.0f / 5000.0f};
 }
 
+static size_t g_nodes, g_free, g_hits, g_coarse, g_frames; // projective counters, summed
+
+static void print_counters()
+{
+    const double n = (double)std::max<size_t>(g_frames, 1);
+    std::printf("  per projective frame: %.0f nodes tested, %.0f voxel free updates, %.0f hit voxels, "
+                "%.0f whole free nodes\n",
+                (double)g_nodes / n, (double)g_free / n, (double)g_hits / n, (double)g_coarse / n);
+}
+
 // Projective inserts of all frames into a fresh map: CPU ms per frame; *used: max scratch.
 static double run_proj(const std::vector<Frame> &fr, const occ_depth_camera_t &cam, float res,
                        float max_m, occ_map_t &m, size_t *used, std::vector<double> *per_frame)
@@ -124,6 +134,11 @@ static double run_proj(const std::vector<Frame> &fr, const occ_depth_camera_t &c
             std::exit(1);
         }
         if (used != nullptr) *used = std::max(*used, r.insert.scratch_used);
+        g_nodes += r.insert.voxel_visits;
+        g_free += r.insert.voxels_free;
+        g_hits += r.insert.voxels_occupied;
+        g_coarse += r.insert.coarse_updated;
+        g_frames++;
     }
     return total / (double)fr.size();
 }
@@ -312,6 +327,7 @@ int main(int argc, char **argv)
         for (int r = 0; r < reps; r++) t.push_back(run_proj(fr, cam, res, max_m, mp, &used, nullptr));
         std::printf("PROJECTIVE only: %.2f ms per frame (median of %d), scratch %zu bytes\n",
                     pct(t, 0.5), reps, used);
+        print_counters();
         return 0;
     }
     OcTree *octo = nullptr;
@@ -341,6 +357,7 @@ int main(int argc, char **argv)
                 used, (double)used / (double)px,
                 (size_t)OCC_PROJ_SCRATCH_BYTES(640, 480, OCC_PROJ_OUT_DEFAULT(640, 480)),
                 (double)OCC_PROJ_SCRATCH_BYTES(640, 480, OCC_PROJ_OUT_DEFAULT(640, 480)) / (double)px);
+    print_counters();
     agreement(mp, *octo, res);
     collisions(mp, *octo, fr, res);
     std::printf("  (SUPER_RAYS' map against OctoMap, for scale:)\n");

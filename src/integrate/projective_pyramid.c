@@ -135,7 +135,7 @@ void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_
                      const uint32_t j0, const uint32_t j1, float *const mn, float *const mx)
 {
     unsigned l = 0;
-    while (((i1 >> l) - (i0 >> l)) > 1u || ((j1 >> l) - (j0 >> l)) > 1u) {
+    while (((i1 >> l) - (i0 >> l)) > 2u || ((j1 >> l) - (j0 >> l)) > 2u) {
         l++;
     }
     OCC_ASSERT(l < x->levels);

@@ -131,13 +131,16 @@ static bool pix_range(const float a, const float b, const float pad, const uint3
                       uint32_t *lo, uint32_t *hi, bool *inside)
 {
     const float nf = (float)n;
-    const float fa = floorf(hi_of(a + 0.5f - pad, -1.0f)), fb = floorf(lo_of(b + 0.5f + pad, nf));
-    if (fb < 0.0f || fa >= nf) {
+    /* clamped to [-1, n] first, so that +2 makes them positive and truncation is floor */
+    const float ca = lo_of(hi_of(a + 0.5f - pad, -1.0f), nf);
+    const float cb = lo_of(hi_of(b + 0.5f + pad, -1.0f), nf);
+    const int32_t fa = (int32_t)(ca + 2.0f) - 2, fb = (int32_t)(cb + 2.0f) - 2;
+    if (fb < 0 || fa >= (int32_t)n) {
         return false;
     }
-    *inside = *inside && fa >= 0.0f && fb < nf;
-    *lo = fa < 0.0f ? 0u : (uint32_t)fa;
-    *hi = fb >= nf ? n - 1u : (uint32_t)fb;
+    *inside = *inside && fa >= 0 && fb < (int32_t)n;
+    *lo = fa < 0 ? 0u : (uint32_t)fa;
+    *hi = fb >= (int32_t)n ? n - 1u : (uint32_t)fb;
     return true;
 }
 
@@ -200,13 +203,11 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     return NODE_MIXED;
 }
 
-/* The per-voxel rule (occ_integrate.h) for the voxel with key k. */
-static bool voxel_free(const occ_proj_t *x, const uint32_t k[3])
+/* The per-voxel rule (occ_integrate.h) for the voxel whose centre minus the camera position is
+ * w (map frame, per axis: OctoMap's float centre - t). */
+static bool voxel_free(const occ_proj_t *x, const float w[3])
 {
     const occ_proj_camera_t *const cam = x->cam;
-    const float w[3] = {occi_raygeo_center(&x->g, k[0]) - cam->t.x,
-                        occi_raygeo_center(&x->g, k[1]) - cam->t.y,
-                        occi_raygeo_center(&x->g, k[2]) - cam->t.z};
     float q[3];
     to_cam(cam, w, q);
     if (!(q[2] > 0.0f)) {
@@ -217,13 +218,15 @@ static bool voxel_free(const occ_proj_t *x, const uint32_t k[3])
     if (!(u >= 0.0f && u < (float)x->im->width && v >= 0.0f && v < (float)x->im->height)) {
         return false;
     }
-    const float d = x->d0[(size_t)floorf(v) * x->im->width + (size_t)floorf(u)];
+    /* u, v >= 0: truncation is floor */
+    const float d = x->d0[(size_t)v * x->im->width + (size_t)u];
     if (!(d > 0.0f) || !(q[2] < occ_proj_front(x, d))) {
         return false;
     }
     return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= x->max2;
 }
 
+/* Is there an output slot left? (Else the call ends with OCC_ERR_SCRATCH.) */
 static bool room(occ_proj_t *x)
 {
     if (x->nh + x->nv + x->nn >= x->cap) {
@@ -259,10 +262,17 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
 static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
                          const bool may_merge)
 {
+    const occ_proj_camera_t *const cam = x->cam;
+    const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
+    float wc[3][2]; /* per axis the two voxel centres' offsets from the camera */
+    for (unsigned a = 0; a < 3u; a++) {
+        wc[a][0] = occi_raygeo_center(&x->g, k[a]) - t[a];
+        wc[a][1] = occi_raygeo_center(&x->g, k[a] | 1u) - t[a];
+    }
     unsigned mask = 0;
     for (unsigned s = 0; s < 8u; s++) {
-        const uint32_t kv[3] = {k[0] | (s & 1u), k[1] | ((s >> 1) & 1u), k[2] | ((s >> 2) & 1u)};
-        mask |= voxel_free(x, kv) ? 1u << s : 0u;
+        const float w[3] = {wc[0][s & 1u], wc[1][(s >> 1) & 1u], wc[2][(s >> 2) & 1u]};
+        mask |= voxel_free(x, w) ? 1u << s : 0u;
     }
     if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
         emit_node(x, code, 1u);
