@@ -44,7 +44,7 @@ static double now_ms()
 static double pct(std::vector<double> v, double p)
 {
     std::sort(v.begin(), v.end());
-    size_t i = (size_t)std::ceil(p * (double)v.size()) - 1u;
+    const size_t i = p <= 0.0 ? 0u : (size_t)std::ceil(p * (double)v.size()) - 1u;
     return v[std::min(i, v.size() - 1u)];
 }
 
