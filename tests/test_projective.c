@@ -20,6 +20,7 @@
 #include "occmap/host/occ_scan.h"
 #include "support/iotest.h"
 #include "support/leak_check.h"
+#include "support/oracle_io.h"
 #include "support/projective_ref.h"
 
 #define PIONEER_DIR "../shared/data/depth/tum_fr2_pioneer_slam2"
@@ -227,6 +228,69 @@ static void test_end_points_never_free(void **state)
     free_frames(f, n);
 }
 
+/* Against OctoMap's insertPointCloud of the same frames (every valid pixel, the same max
+ * range): weighted by voxels, OctoMap's known space as seen here. Loose bounds: projection
+ * decides by voxel centres, so voxels crossed by a ray but whose centre's pixel reads nearer
+ * stay unknown here (bench/projective.cpp reports the full agreement). */
+typedef struct {
+    const occ_map_t *map;
+    double known, opposite, unknown_here;
+} vs_octo_t;
+
+static void vs_octo_leaf(void *ctx, const uint32_t key[3], unsigned level, float logodds)
+{
+    vs_octo_t *v = ctx;
+    const occ_key_t k = {{key[0], key[1], key[2]}};
+    const occ_state_t ours = occ_map_state_at(v->map, occ_map_key_center(v->map, k, level));
+    const occ_state_t theirs = logodds >= 0.0f ? OCC_STATE_OCCUPIED : OCC_STATE_FREE;
+    const double w = (double)((uint64_t)1 << (3u * level));
+    v->known += w;
+    v->unknown_here += ours == OCC_STATE_UNKNOWN ? w : 0.0;
+    v->opposite += ours != OCC_STATE_UNKNOWN && ours != theirs ? w : 0.0;
+}
+
+static void test_pioneer_vs_octomap(void **state)
+{
+    (void)state;
+    frame_t f[10];
+    const size_t n = pioneer_frames(f, 10u);
+    if (n == 0u) {
+        skip();
+    }
+    init_maps(0.1f, BIG_ARENA);
+    oracle_io_t *t = oracle_io_new(ORACLE_OCTREE, 0.1);
+    assert_non_null(t);
+    const occ_depth_camera_t cam = occ_depth_camera_tum_fr2();
+    const occ_depth_params_t dp = {{cam.fx, cam.fy, cam.cx, cam.cy}, 0.0f, 4.0f, 1u};
+    occ_insert_params_t ip = occ_insert_params_default();
+    ip.method = OCC_INSERT_PROJECTIVE;
+    for (size_t i = 0; i < n; i += 4u) {
+        const occ_depth_image_t im = tum_image(&f[i]);
+        occ_depth_result_t r;
+        assert_int_equal(occ_map_insert_depth(&map_a, &im, &dp, &f[i].pose, &ip, scratch,
+                                              BIG_SCRATCH, &r),
+                         OCC_OK);
+        const occ_proj_image_t pim = {f[i].pix, OCC_PROJ_U16, f[i].w, f[i].h, (size_t)f[i].w * 2u,
+                                      2u, 1.0f / 5000.0f};
+        const occ_proj_camera_t all = camera_of(&f[i].pose, cam.fx, cam.fy, cam.cx, cam.cy, 0.0f,
+                                                1e6f); /* every valid pixel, beyond max too */
+        occ_vec3_t *pts = NULL;
+        const size_t np = projref_end_points(&pim, &all, &pts);
+        const float o[3] = {f[i].pose.p.x, f[i].pose.p.y, f[i].pose.p.z};
+        oracle_io_insert_cloud(t, (const float *)(const void *)pts, np, o, 4.0, false);
+        free(pts);
+    }
+    vs_octo_t v = {&map_a, 0.0, 0.0, 0.0};
+    (void)oracle_io_for_each_leaf(t, vs_octo_leaf, &v);
+    oracle_io_free(t);
+    printf("  OctoMap's known voxels: %.0f; opposite state here %.3f%%, unknown here %.2f%%\n",
+           v.known, 100.0 * v.opposite / v.known, 100.0 * v.unknown_here / v.known);
+    assert_true(v.known > 2e4);
+    assert_true(v.opposite < 0.01 * v.known);
+    assert_true(v.unknown_here < 0.25 * v.known);
+    free_frames(f, n);
+}
+
 /* ---- an 8x8 time-of-flight array ------------------------------------------------------------- */
 /* VL53L5CX-like: f = 4 / tan(22.5 deg), cx = cy = 3.5, a wall 2 m ahead (camera looking along
  * map +x), one zone with no reading, one beyond max range. */
@@ -415,6 +479,7 @@ int main(void)
         cmocka_unit_test(test_full_pool),
         cmocka_unit_test(test_pioneer_equals_oracle),
         cmocka_unit_test(test_end_points_never_free),
+        cmocka_unit_test(test_pioneer_vs_octomap),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
