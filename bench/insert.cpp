@@ -256,6 +256,7 @@ static const char *method_name(occ_insert_method_t m)
     case OCC_INSERT_DISCRETE: return "discrete";
     case OCC_INSERT_FAST_DISCRETE: return "fast";
     case OCC_INSERT_SUPER_RAYS: return "superrays";
+    case OCC_INSERT_PROJECTIVE: return "projective";
     }
     return "?";
 }

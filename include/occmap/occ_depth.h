@@ -27,6 +27,18 @@
  * counter uses |c| and can differ from insert's rays_clipped by a pixel within float rounding
  * of max range.
  *
+ * OCC_INSERT_PROJECTIVE (insert->method): the frame is integrated by projection instead
+ * (occ_map_insert_projective(), occ_integrate.h, whose rule then decides the map, not
+ * insert_cloud's): the step grid is its image (its pixel (i, j) is this image's (i step, j step),
+ * the intrinsics divided by the step), the pose its rotation matrix (occ_pose_rotate of the
+ * axes) and position, insert->proj_noise_rel its depth noise; the counters as above (points =
+ * sampled - no reading - too close; scratch_points 0; insert: the projective call's). Scratch:
+ * occ_depth_scratch_bytes() with that method returns OCC_PROJ_SCRATCH_BYTES for the step grid
+ * with OCC_PROJ_OUT_DEFAULT slots. The default method stays occ_insert_params_default()'s SIMPLE
+ * (shared with occ_map_insert_cloud, which has no image); for depth images pass PROJECTIVE: the
+ * fastest here (make bench: bench/projective), at the price of centre-based decisions (see
+ * occ_integrate.h: a voxel free by projection, not by a crossing ray).
+ *
  * Memory: no heap. The back-projected points (12 bytes per valid pixel, after up to 3 bytes of
  * alignment) are written at the start of `scratch`; the rest of it is insert_cloud's scratch.
  * Work: (pixels on the step grid) x (voxels per ray, at most 3 (ceil(max_range / res) + 2) + 2)

@@ -99,7 +99,10 @@ typedef enum {
      * than a third as many super rays as rays. Pays off when a voxel holds many points of a
      * dense sensor (depth cameras at coarse resolution); needs the dense per-scan set (the
      * scan's box fits the scratch), else it runs as SIMPLE. */
-    OCC_INSERT_SUPER_RAYS = 3
+    OCC_INSERT_SUPER_RAYS = 3,
+    /* Depth images only (occ_map_insert_depth, occ_map_insert_projective below): free space by
+     * projecting octree nodes into the image, no rays. occ_map_insert_cloud refuses it. */
+    OCC_INSERT_PROJECTIVE = 4
 } occ_insert_method_t;
 
 typedef struct {
@@ -121,6 +124,7 @@ typedef struct {
      * met (the coarse pass is not chunked; what was evicted stays evicted). */
     const struct occ_evict_policy *auto_evict;  /* occ_evict_policy_t */
     struct occ_evict_out *auto_evict_state;     /* occ_evict_out_t */
+    float proj_noise_rel; /* PROJECTIVE: depth noise as a fraction of depth, [0, 0.5] (0) */
 } occ_insert_params_t;
 
 /* SIMPLE, unlimited range, n = 0, d = 2, k = 4, no automatic eviction. */
@@ -211,6 +215,123 @@ occ_err_t occ_ray_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end,
                        occ_key_t *keys, size_t cap, size_t *n_keys);
 /* Upper bound of the keys occ_ray_keys() returns between two points (0 if invalid). */
 size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end);
+
+/* ---- Depth images by projection (OCC_INSERT_PROJECTIVE) -----------------------------------
+ * D-Map style (Cai et al. 2023): no rays. A min/max pyramid of the image is built once in the
+ * scratch, then a virtual octree (no tree reads) is walked top-down from the root; each node's
+ * box is projected into the image and compared with the pyramid over its footprint.
+ *
+ * The rule, per voxel (exact; the walk only decides whole nodes where every voxel below would
+ * get the same answer, so the result equals applying it to every voxel of the map):
+ *  - pixel depth d (metres along z): U16 raw * depth_scale_m (raw 0: no reading); F32 as given
+ *    (0, NaN, negative, -Inf: no reading; +Inf or > 1024 max_range_m: d = 2 max_range_m). A
+ *    pixel (i, j) back-projects to c = ((i - cx) * d / fx, (j - cy) * d / fy, d) (float, left to
+ *    right); |c|^2 (float) not finite: no reading; |c| < min_range_m: no reading (blind zone);
+ *  - the voxel's centre C (OctoMap's float centre per axis) goes to the camera frame:
+ *    w = C - t, q_k = r[0][k] w_0 + r[1][k] w_1 + r[2][k] w_2 (float, left to right), and its
+ *    pixel is i = floor(fx * (q_0 / q_2) + cx + 0.5), j = floor(fy * (q_1 / q_2) + cy + 0.5);
+ *  - the voxel is FREE (cfg.miss) iff q_2 > 0, (i, j) is inside the image, that pixel has a
+ *    reading with depth d, q_2 < T(d) = (1 - noise_rel) * d - m0 (float) and
+ *    q_0^2 + q_1^2 + q_2^2 <= max_range_m^2 (float): strictly in front of the surface by the
+ *    margin m(d) = m0 + noise_rel * d, m0 = 0.8660254f * cfg.resolution_m (half the voxel diagonal: a pixel's own
+ *    end voxel is never free by that pixel), noise_rel the caller's depth noise (fraction of d);
+ *  - the voxel is OCCUPIED (cfg.hit) iff it holds the end point p = r c + t (float, left to right)
+ *    of some pixel with a reading and |c| <= max_range_m; hits win over FREE (OctoMap's rule);
+ *  - every other voxel is unchanged: behind or within the margin of its pixel's surface, at
+ *    "no reading" pixels (never free: unknown stays unknown), outside the image (the border is
+ *    the pixel grid: centre rounding to a pixel outside [0, width) x [0, height)), behind the
+ *    camera, beyond max range. At a depth discontinuity each voxel follows its own centre's
+ *    pixel: a voxel whose centre projects onto the far side is free even if a near pixel's end
+ *    point is next to it (unless it holds that end point: then it is hit).
+ *  A pixel beyond max range (|c| > max_range_m) marks no hit and frees up to max range.
+ * Differences to ray casting (OctoMap insertPointCloud): voxels are decided by their centres,
+ * not by the rays crossing them: a voxel crossed by a ray but whose centre's pixel reads nearer
+ * (grazing surfaces, discontinuities), and the voxels around the camera whose centres lie
+ * behind it or outside the image, stay unchanged; a voxel no ray crosses whose centre is in
+ * front of its pixel's surface is free.
+ *
+ * Writes: whole free nodes through the coarse applier (every voxel below gets cfg.miss once),
+ * voxels through occ_map_observe_codes: each voxel is updated at most once per call. The pool
+ * check covers both before anything is written (a bound as if no node on the paths existed, so
+ * it may refuse with OCC_ERR_NOMEM when a tight pool would have sufficed); any error: the map
+ * is unchanged.
+ *
+ * Scratch (caller's, any alignment): a fixed part (OCC_PROJ_FIXED_BYTES: alignment, an 8 KiB
+ * repeat filter for end points, the radix sort's histograms), 4 bytes per pixel (the depths),
+ * 8 bytes per pyramid cell (min and max, levels 1.. of halved sides: at most
+ * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells) and the output, in 8-byte slots: the end
+ * points' codes after the repeat filter (twice while they are sorted), then one per voxel
+ * update and two per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it for n_out
+ * slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers the TUM frames in
+ * `make bench` (measured at most 0.47 slots per pixel: the pioneer frames at 0.05 m, every pixel
+ * a hit; bench/projective.cpp prints what they used) and an 8x8 ToF array at 0.05 m to 3 m
+ * (tests/test_projective.c). For 640 x 480 the whole formula is 11.3 bytes per pixel. A frame that needs more slots is refused with OCC_ERR_SCRATCH
+ * (map unchanged): pass more. out->insert.scratch_used says what a call used.
+ *
+ * Work, bounded per call: O(pixels) for the pyramid; the walk tests a node in O(1) (8 corner
+ * projections, at most 4 pyramid cells) and descends only where its answer is mixed, so it
+ * visits at most 8 D + 8 (undecided nodes) nodes: in the worst case (a noisy surface filling
+ * the frustum) every voxel of the frustum within max range; each undecided level-1 node also
+ * scans the pixels of its footprint for end points. Typical: proportional to the surface's
+ * voxels, not pixels x ray length. Stack: O(D), no recursion. */
+#define OCC_PROJ_CELLS(w, h) \
+    ((size_t)(w) * (size_t)(h) / 3u + (size_t)(w) + (size_t)(h) + 20u)
+#define OCC_PROJ_FIXED_BYTES                                                               \
+    (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u)
+#define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                               \
+    (OCC_PROJ_FIXED_BYTES + 8u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
+     8u * (size_t)(n_out))
+#define OCC_PROJ_OUT_DEFAULT(w, h) ((size_t)(w) * (size_t)(h) / 2u + 16384u)
+
+typedef enum {
+    OCC_PROJ_U16 = 0, /* uint16_t, metres = raw * depth_scale_m, 0 = no reading */
+    OCC_PROJ_F32 = 1  /* float metres */
+} occ_proj_format_t;
+
+/* A depth image in the caller's memory (read only, any alignment, host byte order). Pixel
+ * (i, j) is at data + j * row_stride_bytes + i * pixel_stride_bytes (a subsampled view of a
+ * bigger image is a larger pixel stride). */
+typedef struct {
+    const void *data;
+    occ_proj_format_t format;
+    uint32_t width, height;    /* 1..65535 */
+    size_t row_stride_bytes;   /* >= width * pixel_stride_bytes */
+    size_t pixel_stride_bytes; /* >= 2 (U16) or 4 (F32) */
+    float depth_scale_m;       /* U16: finite > 0 */
+} occ_proj_image_t;
+
+/* The camera: pinhole intrinsics in pixels of this image (optical frame x right, y down,
+ * z forward), the rigid map_from_camera transform (r orthonormal within 1e-3, t the camera's
+ * position in the map frame, metres), min/max range and the depth noise. */
+typedef struct {
+    float fx, fy, cx, cy;       /* fx, fy finite > 0; cx, cy finite */
+    float r[3][3];              /* map_from_camera rotation: map = r * camera + t */
+    occ_vec3_t t;
+    float min_range_m;          /* finite >= 0 */
+    float max_range_m;          /* finite > min_range_m */
+    float noise_rel;            /* [0, 0.5]: margin m(d) = 0.866 res + noise_rel * d */
+} occ_proj_camera_t;
+
+typedef struct {
+    size_t pixels;            /* width * height */
+    size_t pixels_no_reading; /* no reading (incl. non-finite |c|) */
+    size_t pixels_too_close;  /* |c| < min_range_m */
+    size_t pixels_beyond_max; /* |c| > max_range_m: no hit */
+    size_t nodes_tested;      /* nodes the walk projected */
+    occ_insert_result_t insert; /* points_integrated: pixels with a hit inside the map;
+                                 * points_skipped: end points outside the map; rays_clipped:
+                                 * pixels_beyond_max; voxels_*: voxel-level updates;
+                                 * coarse_updated: whole free nodes; scratch_used */
+} occ_proj_result_t;
+
+/* Integrate one depth image by the rule above. `out` may be NULL; it gets the counters, also on
+ * error. Errors (the map unchanged for all): OCC_ERR_ARG (NULL map/image/camera/data, bad size,
+ * stride, format, scale, intrinsics, ranges, noise, a non-orthonormal r or non-finite t),
+ * OCC_ERR_RANGE (camera outside the map), OCC_ERR_SCRATCH (scratch NULL or short: oom_count not
+ * bumped), OCC_ERR_NOMEM (pools short: oom_count bumped). No automatic eviction. */
+occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *image,
+                                    const occ_proj_camera_t *camera, void *scratch,
+                                    size_t scratch_bytes, occ_proj_result_t *out);
 
 #ifdef __cplusplus
 }

@@ -308,6 +308,7 @@ static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const para
     }
     case OCC_INSERT_SUPER_RAYS:
         return occi_superray_run(x, points, n_points, params->super_k) ? 0 : -1;
+    case OCC_INSERT_PROJECTIVE: /* depth images only: refused by check_args */
     default:
         return -1;
     }

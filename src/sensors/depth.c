@@ -52,6 +52,13 @@ size_t occ_depth_scratch_bytes(const occ_map_t *map, const uint32_t width, const
         return 0u;
     }
     const size_t n = OCC_DEPTH_PIXELS(width, height, pixel_step);
+    if (insert->method == OCC_INSERT_PROJECTIVE) {
+        const size_t w = (width + pixel_step - 1u) / pixel_step, h = n / w;
+        if (n > (SIZE_MAX - OCC_PROJ_FIXED_BYTES - 8u * (w + h + 20u + 16384u) - 8u) / 24u) {
+            return SIZE_MAX; /* a 32-bit size_t: no scratch that big */
+        }
+        return OCC_PROJ_SCRATCH_BYTES(w, h, OCC_PROJ_OUT_DEFAULT(w, h));
+    }
     const size_t cloud = occ_insert_scratch_bytes(map, n, max_range_m, insert);
     if (n > (SIZE_MAX - 3u) / 12u) {
         return SIZE_MAX; /* a 32-bit size_t: no scratch that big */
@@ -140,6 +147,51 @@ static bool back_project(const occ_depth_image_t *im, const occ_depth_params_t *
     return out->points <= buf->cap;
 }
 
+/* OCC_INSERT_PROJECTIVE: the image as the projective integrator's view of the step grid (pixel
+ * (i, j) is the image's (i step, j step); intrinsics divided by the step) and the pose as a
+ * rotation matrix. */
+static occ_err_t insert_projective(occ_map_t *map, const occ_depth_image_t *im,
+                                   const occ_depth_params_t *dp, const occ_pose_t *pose,
+                                   const occ_insert_params_t *insert, void *scratch,
+                                   const size_t scratch_bytes, occ_depth_result_t *r)
+{
+    const uint32_t st = dp->pixel_step;
+    const float sf = (float)st;
+    const occ_proj_image_t pim = {im->data,
+                                  im->format == OCC_DEPTH_U16 ? OCC_PROJ_U16 : OCC_PROJ_F32,
+                                  (im->width + st - 1u) / st,
+                                  (im->height + st - 1u) / st,
+                                  im->height > st ? im->row_stride_bytes * st : im->row_stride_bytes,
+                                  im->width > st ? pixel_bytes(im->format) * st : pixel_bytes(im->format),
+                                  im->depth_scale_m};
+    occ_proj_camera_t cam;
+    memset(&cam, 0, sizeof cam);
+    cam.fx = dp->intrinsics.fx / sf;
+    cam.fy = dp->intrinsics.fy / sf;
+    cam.cx = dp->intrinsics.cx / sf;
+    cam.cy = dp->intrinsics.cy / sf;
+    const occ_vec3_t axes[3] = {{1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 1.0f}};
+    for (unsigned b = 0; b < 3u; b++) {
+        const occ_vec3_t col = occ_pose_rotate(pose, axes[b]);
+        cam.r[0][b] = col.x;
+        cam.r[1][b] = col.y;
+        cam.r[2][b] = col.z;
+    }
+    cam.t = pose->p;
+    cam.min_range_m = dp->min_range_m;
+    cam.max_range_m = dp->max_range_m;
+    cam.noise_rel = insert->proj_noise_rel;
+    occ_proj_result_t pr;
+    const occ_err_t e = occ_map_insert_projective(map, &pim, &cam, scratch, scratch_bytes, &pr);
+    r->pixels_sampled = pr.pixels;
+    r->pixels_no_reading = pr.pixels_no_reading;
+    r->pixels_too_close = pr.pixels_too_close;
+    r->pixels_beyond_max = pr.pixels_beyond_max;
+    r->points = pr.pixels - pr.pixels_no_reading - pr.pixels_too_close;
+    r->insert = pr.insert;
+    return e;
+}
+
 occ_err_t occ_map_insert_depth(occ_map_t *map, const occ_depth_image_t *image,
                                const occ_depth_params_t *depth,
                                const occ_pose_t *map_from_camera,
@@ -155,6 +207,14 @@ occ_err_t occ_map_insert_depth(occ_map_t *map, const occ_depth_image_t *image,
         insert == NULL || !image_ok(image) || !params_ok(depth) ||
         occ_pose_check(map_from_camera) != OCC_OK) {
         return OCC_ERR_ARG;
+    }
+    if (insert->method == OCC_INSERT_PROJECTIVE) {
+        const occ_err_t e =
+            insert_projective(map, image, depth, map_from_camera, insert, scratch, scratch_bytes, &r);
+        if (out != NULL) {
+            *out = r;
+        }
+        return e;
     }
     const point_buf_t buf = point_buf(scratch, scratch_bytes);
     if (!back_project(image, depth, map_from_camera, &buf, &r)) {

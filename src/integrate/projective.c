@@ -1,0 +1,208 @@
+/* projective.c - occ_map_insert_projective(): check the call, lay out the scratch, build the
+ * pyramid, walk, then the all-or-nothing pool check and the writes (whole free nodes through
+ * the coarse applier, voxels through the batch applier). */
+#include <math.h>
+#include <string.h>
+
+#include "projective_internal.h"
+#include "coarse_internal.h"
+
+/* The header's fixed term names the filter's 8 KiB. */
+typedef char proj_filter_matches_header[OCC_PROJ_FILTER_N * 8u == 8192u ? 1 : -1];
+
+static bool finite_pos(const float v)
+{
+    return isfinite(v) && v > 0.0f;
+}
+
+static bool image_ok(const occ_proj_image_t *im)
+{
+    if (im->data == NULL || (im->format != OCC_PROJ_U16 && im->format != OCC_PROJ_F32) ||
+        im->width == 0u || im->height == 0u || im->width > 65535u || im->height > 65535u) {
+        return false;
+    }
+    const size_t px = im->format == OCC_PROJ_U16 ? 2u : 4u;
+    if (im->pixel_stride_bytes < px || im->row_stride_bytes / im->pixel_stride_bytes < im->width) {
+        return false;
+    }
+    return im->format != OCC_PROJ_U16 || finite_pos(im->depth_scale_m);
+}
+
+/* r orthonormal within 1e-3 per entry of r r^T. */
+static bool rotation_ok(const float r[3][3])
+{
+    for (unsigned a = 0; a < 3u; a++) {
+        for (unsigned b = 0; b < 3u; b++) {
+            const float dot = r[a][0] * r[b][0] + r[a][1] * r[b][1] + r[a][2] * r[b][2];
+            if (!(fabsf(dot - (a == b ? 1.0f : 0.0f)) <= 1e-3f)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+static bool camera_ok(const occ_proj_camera_t *k)
+{
+    if (!finite_pos(k->fx) || !finite_pos(k->fy) || !isfinite(k->cx) || !isfinite(k->cy) ||
+        !isfinite(k->min_range_m) || k->min_range_m < 0.0f || !isfinite(k->max_range_m) ||
+        !(k->max_range_m > k->min_range_m) || !(k->noise_rel >= 0.0f && k->noise_rel <= 0.5f)) {
+        return false;
+    }
+    const occ_vec3_t t = k->t;
+    return isfinite(t.x) && isfinite(t.y) && isfinite(t.z) && rotation_ok(k->r);
+}
+
+/* Carve the scratch: the filter and the sort's histograms (8-byte aligned), the depths and
+ * the pyramid (floats), then the output (8-byte codes). false when it cannot hold all that and
+ * one output slot. */
+static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
+{
+    if (scratch == NULL) {
+        return false;
+    }
+    const uintptr_t a = (uintptr_t)scratch;
+    const size_t skip = (size_t)((8u - (a & 7u)) & 7u);
+    const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u;
+    const size_t px = (size_t)x->im->width * x->im->height;
+    const size_t floats = 4u * px + occi_proj_pyramid_bytes(x->im->width, x->im->height);
+    const size_t head = skip + fixed + ((floats + 7u) & ~(size_t)7u);
+    if (bytes < head + 8u) {
+        return false;
+    }
+    unsigned char *const base = (unsigned char *)scratch + skip;
+    x->filter = (occ_code_t *)(void *)base;
+    x->hist = (uint32_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u);
+    *mem = (float *)(void *)(base + fixed);
+    x->out = (occ_code_t *)(void *)((unsigned char *)scratch + head);
+    x->cap = (bytes - head) / 8u;
+    x->r->insert.scratch_used = head;
+    return true;
+}
+
+/* Group the whole free nodes by level into the free gap between the two output ends (each
+ * group stays in walk order: sorted). Returns the group array, or NULL when the gap is short. */
+static occ_code_t *group_nodes(occ_proj_t *x, size_t start[OCC_MAX_DEPTH + 2u])
+{
+    if (x->cap - x->nh - x->nv - x->nn < x->nn) {
+        return NULL;
+    }
+    occ_code_t *const g = x->out + x->nh + x->nv;
+    start[0] = 0;
+    for (unsigned l = 0; l <= OCC_MAX_DEPTH; l++) {
+        start[l + 1u] = start[l] + x->per_level[l];
+    }
+    size_t fill[OCC_MAX_DEPTH + 1u];
+    memcpy(fill, start, sizeof fill);
+    for (size_t n = 1; n <= x->nn; n++) {
+        const occ_code_t e = x->out[x->cap - n];
+        const unsigned l = ((unsigned)__builtin_ctzll(e) + 1u) / 3u; /* the marker bit */
+        g[fill[l]++] = e & ~(((occ_code_t)1 << (3u * l)) - 1u);
+    }
+    return g;
+}
+
+/* The pool check for every write of the call (bounds as if no node existed), then the writes. */
+static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OCC_MAX_DEPTH + 2u])
+{
+    occ_map_t *const m = x->map;
+    const unsigned depth = m->cfg.depth_levels;
+    uint64_t inner = 0, leaf = 0, i, f;
+    for (unsigned l = 1; l < depth; l++) {
+        occi_coarse_need(g + start[l], x->per_level[l], l, depth, &i, &f);
+        inner += i;
+        leaf += f;
+    }
+    occ_code_t *const fv = x->out + x->nh;
+    occi_coarse_need(fv, x->nv, 0u, depth, &i, &f);
+    inner += i;
+    leaf += f;
+    occi_coarse_need(x->out, x->nh, 0u, depth, &i, &f);
+    inner += i;
+    leaf += f;
+    if (inner > OCC_NONE || leaf > OCC_NONE ||
+        !occi_pool_can_supply(m, (uint32_t)inner, (uint32_t)leaf)) {
+        m->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    const occ_value_t miss = occ_value_from_logodds(m->cfg.miss);
+    for (unsigned l = depth - 1u; l >= 1u; l--) {
+        x->r->insert.coarse_updated +=
+            occi_coarse_apply(m, g + start[l], x->per_level[l], l, miss);
+    }
+    size_t changed = 0, changed_hits = 0;
+    occ_err_t e = occ_map_observe_codes(m, fv, x->nv, &changed);
+    if (e == OCC_OK) {
+        e = occ_map_observe_codes(m, x->out, x->nh, &changed_hits);
+    }
+    OCC_ASSERT(e == OCC_OK); /* the check above covers both */
+    x->r->insert.voxels_changed = changed + changed_hits;
+    return e;
+}
+
+/* Counters of the voxel output. */
+static void count_output(occ_proj_t *x)
+{
+    occ_insert_result_t *const r = &x->r->insert;
+    r->voxels_free = x->nv;
+    r->voxels_occupied = x->nh;
+    r->voxels_updated = x->nv + x->nh;
+    r->voxel_visits = x->r->nodes_tested;
+    r->rays_clipped = x->r->pixels_beyond_max;
+    r->points_integrated = x->r->pixels - x->r->pixels_no_reading - x->r->pixels_too_close -
+                           x->r->pixels_beyond_max - r->points_skipped;
+}
+
+occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *image,
+                                    const occ_proj_camera_t *camera, void *scratch,
+                                    const size_t scratch_bytes, occ_proj_result_t *out)
+{
+    occ_proj_result_t res;
+    memset(&res, 0, sizeof res);
+    if (out != NULL) {
+        *out = res;
+    }
+    if (map == NULL || image == NULL || camera == NULL || !image_ok(image) || !camera_ok(camera)) {
+        return OCC_ERR_ARG;
+    }
+    occ_proj_t x;
+    memset(&x, 0, sizeof x);
+    x.map = map;
+    x.im = image;
+    x.cam = camera;
+    x.r = &res;
+    occi_raygeo_init(&x.g, map);
+    const float t[3] = {camera->t.x, camera->t.y, camera->t.z};
+    uint32_t kt[3];
+    if (!occi_raygeo_key(&x.g, t, kt)) {
+        return OCC_ERR_RANGE;
+    }
+    x.max2 = camera->max_range_m * camera->max_range_m;
+    x.min2 = camera->min_range_m * camera->min_range_m;
+    x.far = 1024.0f * camera->max_range_m;
+    x.keep = 1.0f - camera->noise_rel;
+    x.m0 = 0.8660254f * map->cfg.resolution_m;
+    res.pixels = (size_t)image->width * image->height;
+    float *mem = NULL;
+    occ_err_t e = OCC_ERR_SCRATCH;
+    if (carve(&x, scratch, scratch_bytes, &mem)) {
+        occi_proj_build(&x, mem);
+        const bool hits_fit = occi_proj_hits(&x);
+        if (hits_fit) {
+            occi_proj_walk(&x);
+        }
+        size_t start[OCC_MAX_DEPTH + 2u];
+        const occ_code_t *const g = !hits_fit || x.overflow ? NULL : group_nodes(&x, start);
+        const size_t slots = x.nh + x.nv + 2u * x.nn;
+        res.insert.scratch_used += 8u * (slots > x.hwm ? slots : x.hwm);
+        if (g != NULL) {
+            x.nv = occi_proj_drop_hits(x.out + x.nh, x.nv, x.out, x.nh);
+            count_output(&x);
+            e = apply(&x, g, start);
+        }
+    }
+    if (out != NULL) {
+        *out = res;
+    }
+    return e;
+}

@@ -1,0 +1,79 @@
+/*
+ * projective_internal.h - what projective.c (entry, apply), projective_pyramid.c (depths and
+ * their min/max pyramid) and projective_walk.c (the virtual octree walk) share. src/integrate
+ * only; the rule they implement is in occ_integrate.h.
+ */
+#ifndef OCC_PROJECTIVE_INTERNAL_H_INCLUDED
+#define OCC_PROJECTIVE_INTERNAL_H_INCLUDED
+
+#include "integrate_internal.h"
+
+/* Pyramid levels: level 0 is the image, each next one halves both sides (ceil) down to 1x1;
+ * 65535 pixels per side need 17. */
+#define OCC_PROJ_MAX_LEVELS 18u
+/* Entries of the end points' repeat filter (direct mapped, 8 bytes each). */
+#define OCC_PROJ_FILTER_N 1024u
+
+typedef struct {
+    occ_map_t *map;
+    occ_raygeo_t g;
+    const occ_proj_image_t *im;
+    const occ_proj_camera_t *cam;
+    float max2, min2;       /* squared ranges */
+    float far;              /* F32 depths beyond this are "no return" (2 max range) */
+    float keep;             /* 1 - noise_rel */
+    float m0;               /* margin at depth 0: half the voxel diagonal */
+    float dmin, dmax;       /* smallest / largest depth with a reading (dmin > dmax: none) */
+    float *d0;              /* level 0: depth per pixel, -INFINITY = no reading */
+    float *mn[OCC_PROJ_MAX_LEVELS], *mx[OCC_PROJ_MAX_LEVELS]; /* levels >= 1 */
+    uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];
+    unsigned levels;
+    float pn[4][3], pr[4][3]; /* the walk's side planes and their products with the map axes */
+    occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
+    uint32_t *hist;         /* the radix sort's histograms */
+    /* The output: sorted hit codes (nh), then the walk's free voxel codes (nv) from out + nh,
+     * whole free nodes from the back (code with bit 3 level - 1 set: the level). */
+    occ_code_t *out;
+    size_t cap, nh, nv, nn, hwm;
+    size_t hit_cur;         /* the walk's cursor over the sorted hits */
+    size_t per_level[OCC_MAX_DEPTH + 1u];
+    bool overflow;
+    occ_proj_result_t *r;
+} occ_proj_t;
+
+/* The surface threshold of a depth: a voxel centre nearer than this is in front (monotone in d,
+ * so the pyramid's min and max bound it). */
+static inline float occ_proj_front(const occ_proj_t *x, const float d)
+{
+    return x->keep * d - x->m0;
+}
+
+/* Camera-frame back-projection of pixel (i, j) at depth d (the header's arithmetic). */
+static inline void occ_proj_back(const occ_proj_camera_t *k, const uint32_t i, const uint32_t j,
+                                 const float d, float c[3])
+{
+    c[0] = ((float)i - k->cx) * d / k->fx;
+    c[1] = ((float)j - k->cy) * d / k->fy;
+    c[2] = d;
+}
+
+/* Bytes the pyramid levels >= 1 take (min and max) and their layout for a w x h image. */
+size_t occi_proj_pyramid_bytes(uint32_t w, uint32_t h);
+/* Level 0 from the image (counters in x->r), then the pyramid; d0 and the level arrays are
+ * laid out from `mem` (4-byte aligned, w h + 2 cells floats). */
+void occi_proj_build(occ_proj_t *x, float *mem);
+/* Min and max depth over pixels [i0, i1] x [j0, j1] (inside the image, i0 <= i1, j0 <= j1),
+ * over-approximated by at most 2 x 2 cells of one level (so mn may be lower, mx higher). */
+void occi_proj_range(const occ_proj_t *x, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1,
+                     float *mn, float *mx);
+
+/* The end points' codes into out[0..nh) (sorted, unique, hit bit set); false when the output
+ * cannot hold them and the sort's temporary. */
+bool occi_proj_hits(occ_proj_t *x);
+/* Drop from free_codes[0..nv) (sorted) the codes in hits[0..nh); returns the new count. */
+size_t occi_proj_drop_hits(occ_code_t *free_codes, size_t nv, const occ_code_t *hits, size_t nh);
+
+/* The walk: fills x->out / nv / nn / per_level, or sets x->overflow. */
+void occi_proj_walk(occ_proj_t *x);
+
+#endif

@@ -1,0 +1,341 @@
+/* projective_walk.c - the top-down walk of a virtual octree over the camera frustum: each
+ * node's box is projected (8 corners) and compared with the pyramid over its footprint; whole
+ * free nodes and voxel updates are written to the output in Morton order. No tree reads. */
+#include <math.h>
+
+#include "projective_internal.h"
+
+/* Finite operands only (no NaN here): plain compares, no libm call. */
+static inline float lo_of(const float a, const float b)
+{
+    return b < a ? b : a;
+}
+
+static inline float hi_of(const float a, const float b)
+{
+    return b > a ? b : a;
+}
+
+enum { NODE_SKIP, NODE_FREE, NODE_MIXED };
+
+/* A node's projection: footprint pixels (clamped; valid when `proj`), camera depth range and
+ * the rounding slack used for it. */
+typedef struct {
+    uint32_t i0, i1, j0, j1;
+    bool proj;
+    float zmin, zmax, eps;
+} foot_t;
+
+/* Map-frame coordinate of key k's lower face. */
+static float key_low(const occ_raygeo_t *g, const uint32_t k)
+{
+    return (float)(((occ_rr_t)k - g->tmv_r) * g->res);
+}
+
+/* Camera frame of a map-frame offset w (the header's arithmetic). */
+static void to_cam(const occ_proj_camera_t *k, const float w[3], float q[3])
+{
+    for (unsigned a = 0; a < 3u; a++) {
+        q[a] = k->r[0][a] * w[0] + k->r[1][a] * w[1] + k->r[2][a] * w[2];
+    }
+}
+
+/* Squared distance from the camera to the node's box (map frame). */
+static float box_dist2(const occ_proj_camera_t *k, const float lo[3], const float s)
+{
+    const float t[3] = {k->t.x, k->t.y, k->t.z};
+    float d2 = 0.0f;
+    for (unsigned a = 0; a < 3u; a++) {
+        const float e = lo[a] - t[a] > 0.0f ? lo[a] - t[a] : (t[a] - (lo[a] + s) > 0.0f ? t[a] - (lo[a] + s) : 0.0f);
+        d2 += e * e;
+    }
+    return d2;
+}
+
+/* The four side planes of the pixel grid through the camera (camera frame; inside: >= 0 on
+ * all four) and their dot products with the map axes' camera-frame directions. */
+static void planes_init(occ_proj_t *x)
+{
+    const occ_proj_camera_t *const k = x->cam;
+    const float wf = (float)x->im->width, hf = (float)x->im->height;
+    const float n[4][3] = {{k->fx, 0.0f, k->cx + 0.5f},
+                           {-k->fx, 0.0f, wf - 0.5f - k->cx},
+                           {0.0f, k->fy, k->cy + 0.5f},
+                           {0.0f, -k->fy, hf - 0.5f - k->cy}};
+    for (unsigned p = 0; p < 4u; p++) {
+        for (unsigned a = 0; a < 3u; a++) {
+            x->pn[p][a] = n[p][a];
+            x->pr[p][a] = n[p][0] * k->r[a][0] + n[p][1] * k->r[a][1] + n[p][2] * k->r[a][2];
+        }
+    }
+}
+
+/* Does the box (camera-frame corner q0, edge s) lie wholly outside one of the side planes? */
+static bool outside_planes(const occ_proj_t *x, const float q0[3], const float s,
+                           const float peps)
+{
+    for (unsigned p = 0; p < 4u; p++) {
+        float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2];
+        for (unsigned a = 0; a < 3u; a++) {
+            m += x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
+        }
+        if (m < -peps) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* The box's image footprint: u, v bounds of its 8 corners (all in front of the camera). */
+typedef struct {
+    float umin, umax, vmin, vmax;
+} uv_t;
+
+static void footprint(const occ_proj_camera_t *k, const float q0[3], const float s, uv_t *f)
+{
+    f->umin = f->vmin = INFINITY;
+    f->umax = f->vmax = -INFINITY;
+    for (unsigned n = 0; n < 8u; n++) {
+        float q[3] = {q0[0], q0[1], q0[2]};
+        for (unsigned a = 0; a < 3u; a++) {
+            if ((n >> a) & 1u) {
+                q[0] += s * k->r[a][0];
+                q[1] += s * k->r[a][1];
+                q[2] += s * k->r[a][2];
+            }
+        }
+        const float iz = 1.0f / q[2];
+        const float u = k->fx * (q[0] * iz) + k->cx, v = k->fy * (q[1] * iz) + k->cy;
+        f->umin = lo_of(f->umin, u);
+        f->umax = hi_of(f->umax, u);
+        f->vmin = lo_of(f->vmin, v);
+        f->vmax = hi_of(f->vmax, v);
+    }
+}
+
+/* Squared distance from the camera to the box's farthest corner (map frame). */
+static float far_dist2(const occ_proj_camera_t *k, const float lo[3], const float s)
+{
+    const float t[3] = {k->t.x, k->t.y, k->t.z};
+    float d2 = 0.0f;
+    for (unsigned a = 0; a < 3u; a++) {
+        const float e0 = lo[a] - t[a], e1 = lo[a] + s - t[a];
+        d2 += hi_of(e0 * e0, e1 * e1);
+    }
+    return d2;
+}
+
+/* Pixel index range [lo, hi] of a footprint interval, padded by `pad` pixels; false when it
+ * misses [0, n). *inside: the padded range lies within the image. */
+static bool pix_range(const float a, const float b, const float pad, const uint32_t n,
+                      uint32_t *lo, uint32_t *hi, bool *inside)
+{
+    const float nf = (float)n;
+    /* clamped to [-1, n] first, so that +2 makes them positive and truncation is floor */
+    const float ca = lo_of(hi_of(a + 0.5f - pad, -1.0f), nf);
+    const float cb = lo_of(hi_of(b + 0.5f + pad, -1.0f), nf);
+    const int32_t fa = (int32_t)(ca + 2.0f) - 2, fb = (int32_t)(cb + 2.0f) - 2;
+    if (fb < 0 || fa >= (int32_t)n) {
+        return false;
+    }
+    *inside = *inside && fa >= 0 && fb < (int32_t)n;
+    *lo = fa < 0 ? 0u : (uint32_t)fa;
+    *hi = fb >= (int32_t)n ? n - 1u : (uint32_t)fb;
+    return true;
+}
+
+/* Classify the node at `level` whose first voxel has key k: SKIP (every voxel below unchanged
+ * and no end point in it), FREE (every voxel below free, no end point in it) or MIXED. */
+static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, foot_t *f)
+{
+    const occ_proj_camera_t *const cam = x->cam;
+    x->r->nodes_tested++;
+    const float s = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << level));
+    const float lo[3] = {key_low(&x->g, k[0]), key_low(&x->g, k[1]), key_low(&x->g, k[2])};
+    const float bd2 = box_dist2(cam, lo, s);
+    float mabs = fabsf(cam->t.x) + fabsf(cam->t.y) + fabsf(cam->t.z);
+    for (unsigned a = 0; a < 3u; a++) {
+        mabs += hi_of(fabsf(lo[a]), fabsf(lo[a] + s));
+    }
+    const float eps = 1e-5f * (1.0f + mabs);
+    if (bd2 > x->max2 + eps * (1.0f + cam->max_range_m)) {
+        return NODE_SKIP; /* beyond max range: no free voxel, no end point */
+    }
+    const float w[3] = {lo[0] - cam->t.x, lo[1] - cam->t.y, lo[2] - cam->t.z};
+    float q0[3];
+    to_cam(cam, w, q0);
+    float zmin = q0[2], zmax = q0[2];
+    for (unsigned a = 0; a < 3u; a++) {
+        const float dz = s * cam->r[a][2];
+        zmin += dz < 0.0f ? dz : 0.0f;
+        zmax += dz > 0.0f ? dz : 0.0f;
+    }
+    const float peps = 1e-5f * (cam->fx + cam->fy + fabsf(cam->cx) + fabsf(cam->cy) +
+                                (float)x->im->width + (float)x->im->height) * (1.0f + mabs);
+    if (zmax < -eps || zmin > x->dmax + eps || zmin > cam->max_range_m + eps ||
+        outside_planes(x, q0, s, peps)) {
+        return NODE_SKIP; /* outside the frustum, or behind every reading */
+    }
+    f->zmin = zmin;
+    f->zmax = zmax;
+    f->eps = eps;
+    f->proj = zmin > eps;
+    if (!f->proj) {
+        return NODE_MIXED; /* around the camera plane: no footprint */
+    }
+    uv_t c;
+    footprint(cam, q0, s, &c);
+    const float pad = 0.01f + (cam->fx + cam->fy) * eps / zmin;
+    bool inside = true;
+    if (!pix_range(c.umin, c.umax, pad, x->im->width, &f->i0, &f->i1, &inside) ||
+        !pix_range(c.vmin, c.vmax, pad, x->im->height, &f->j0, &f->j1, &inside)) {
+        return NODE_SKIP;
+    }
+    float mn, mx;
+    occi_proj_range(x, f->i0, f->i1, f->j0, f->j1, &mn, &mx);
+    if (zmin > mx + eps) {
+        return NODE_SKIP;
+    }
+    if (inside && zmax + eps < occ_proj_front(x, mn) &&
+        far_dist2(cam, lo, s) + eps * (1.0f + cam->max_range_m) <= x->max2) {
+        return NODE_FREE;
+    }
+    return NODE_MIXED;
+}
+
+/* The per-voxel rule (occ_integrate.h) for the voxel whose centre minus the camera position is
+ * w (map frame, per axis: OctoMap's float centre - t). */
+static bool voxel_free(const occ_proj_t *x, const float w[3])
+{
+    const occ_proj_camera_t *const cam = x->cam;
+    float q[3];
+    to_cam(cam, w, q);
+    if (!(q[2] > 0.0f)) {
+        return false;
+    }
+    const float u = cam->fx * (q[0] / q[2]) + cam->cx + 0.5f;
+    const float v = cam->fy * (q[1] / q[2]) + cam->cy + 0.5f;
+    if (!(u >= 0.0f && u < (float)x->im->width && v >= 0.0f && v < (float)x->im->height)) {
+        return false;
+    }
+    /* u, v >= 0: truncation is floor */
+    const float d = x->d0[(size_t)v * x->im->width + (size_t)u];
+    if (!(d > 0.0f) || !(q[2] < occ_proj_front(x, d))) {
+        return false;
+    }
+    return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= x->max2;
+}
+
+/* Is there an output slot left? (Else the call ends with OCC_ERR_SCRATCH.) */
+static bool room(occ_proj_t *x)
+{
+    if (x->nh + x->nv + x->nn >= x->cap) {
+        x->overflow = true;
+        return false;
+    }
+    return true;
+}
+
+/* Does the level-l node starting at `code` hold an end point? The walk asks in increasing code
+ * order, so one cursor over the sorted hits serves the whole walk. */
+static bool holds_hit(occ_proj_t *x, const occ_code_t code, const unsigned l)
+{
+    const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
+    while (x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < code) {
+        x->hit_cur++;
+    }
+    return x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < end;
+}
+
+/* Record a whole free node at level l >= 1 (from the back of the output). */
+static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
+{
+    if (room(x)) {
+        x->nn++;
+        x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
+        x->per_level[l]++;
+    }
+}
+
+/* The 8 voxels of a MIXED level-1 node, free or not by the rule (hits are occi_proj_hits');
+ * all 8 free: one whole level-1 node (the same updates, fewer slots). */
+static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
+                         const bool may_merge)
+{
+    const occ_proj_camera_t *const cam = x->cam;
+    const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
+    float wc[3][2]; /* per axis the two voxel centres' offsets from the camera */
+    for (unsigned a = 0; a < 3u; a++) {
+        wc[a][0] = occi_raygeo_center(&x->g, k[a]) - t[a];
+        wc[a][1] = occi_raygeo_center(&x->g, k[a] | 1u) - t[a];
+    }
+    unsigned mask = 0;
+    for (unsigned s = 0; s < 8u; s++) {
+        const float w[3] = {wc[0][s & 1u], wc[1][(s >> 1) & 1u], wc[2][(s >> 2) & 1u]};
+        mask |= voxel_free(x, w) ? 1u << s : 0u;
+    }
+    if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
+        emit_node(x, code, 1u);
+        return;
+    }
+    for (unsigned s = 0; s < 8u; s++) {
+        if (((mask >> s) & 1u) != 0u && room(x)) {
+            x->out[x->nh + x->nv++] = code | s;
+        }
+    }
+}
+
+void occi_proj_walk(occ_proj_t *const x)
+{
+    const unsigned depth = x->g.depth;
+    struct {
+        uint32_t k[3];
+        occ_code_t code;
+        uint8_t level, next;
+    } st[OCC_MAX_DEPTH + 1u];
+    foot_t f;
+    planes_init(x);
+    if (depth == 1u) {
+        const uint32_t k0[3] = {0u, 0u, 0u};
+        if (test_node(x, k0, 1u, &f) != NODE_SKIP) {
+            visit_voxels(x, k0, 0u, false); /* the root is no coarse node */
+        }
+        return;
+    }
+    unsigned sp = 1;
+    st[0].k[0] = st[0].k[1] = st[0].k[2] = 0u;
+    st[0].code = 0u;
+    st[0].level = (uint8_t)depth;
+    st[0].next = 0u;
+    while (sp > 0u && !x->overflow) {
+        const unsigned t = sp - 1u;
+        if (st[t].next == 8u) {
+            sp--;
+            continue;
+        }
+        const unsigned s = st[t].next++;
+        const unsigned l = st[t].level - 1u;
+        const uint32_t k[3] = {st[t].k[0] | ((s & 1u) << l), st[t].k[1] | (((s >> 1) & 1u) << l),
+                               st[t].k[2] | (((s >> 2) & 1u) << l)};
+        const occ_code_t code = st[t].code | ((occ_code_t)s << (3u * l));
+        int cls = test_node(x, k, l, &f);
+        if (cls == NODE_FREE && holds_hit(x, code, l)) {
+            cls = NODE_MIXED; /* hits win: not expected (a free node is in front of every end
+                               * point of its footprint), kept exact by descending */
+        }
+        if (cls == NODE_FREE) {
+            emit_node(x, code, l);
+        } else if (cls == NODE_MIXED && l == 1u) {
+            visit_voxels(x, k, code, true);
+        } else if (cls == NODE_MIXED) {
+            OCC_ASSERT(sp <= OCC_MAX_DEPTH);
+            st[sp].k[0] = k[0];
+            st[sp].k[1] = k[1];
+            st[sp].k[2] = k[2];
+            st[sp].code = code;
+            st[sp].level = (uint8_t)l;
+            st[sp].next = 0u;
+            sp++;
+        }
+    }
+}

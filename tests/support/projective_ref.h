@@ -1,0 +1,19 @@
+/* projective_ref.h - brute-force oracle of OCC_INSERT_PROJECTIVE's per-voxel rule
+ * (occ_integrate.h): no pyramid, no walk; every voxel of the cube of half-edge max range around
+ * the camera is classified by projecting its centre, every pixel's end point is a hit. */
+#ifndef OCC_PROJECTIVE_REF_H_INCLUDED
+#define OCC_PROJECTIVE_REF_H_INCLUDED
+
+#include "occmap/occmap.h"
+
+/* The frame's voxel updates, sorted by code, unique, hit bit set for hits (hits win), in a
+ * malloc'd array (*codes; the caller frees it). Returns the count. *n_hits: hit voxels. */
+size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
+                     const occ_proj_camera_t *cam, occ_code_t **codes, size_t *n_hits);
+
+/* The end points of the frame's pixels with a reading within [min, max] range (map frame, the
+ * header's arithmetic) in a malloc'd array. Returns the count. */
+size_t projref_end_points(const occ_proj_image_t *im, const occ_proj_camera_t *cam,
+                          occ_vec3_t **pts);
+
+#endif
