@@ -172,23 +172,34 @@ static void test_pose_filter(void **state)
     /* the foreign position sent meanwhile did not replace ours (next pose keeps 2, 1, 3) */
     f = pos_frame(2, 1, 1020, 50.0f, 50.0f, 50.0f, buf);
     assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
-    f = att_frame(1, 1, 1020, 0.0f, buf);
+    /* an attitude whose position is in the last pose already waits for its own position */
+    f = att_frame(1, 1, 1015, 0.0f, buf);
+    assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
+    f = pos_frame(1, 1, 1020, 1.0f, 2.0f, -3.0f, buf);
     assert_true(occ_mav_pose_rx_take(&rx, &f, &s));
     assert_true(s.t_us == 1020000u);
     assert_float_equal(s.pose.p.x, 2.0f, 1e-6f);
-    /* the same stamp again: not newer; an attitude 100 ms from the position: unpaired */
     f = att_frame(1, 1, 1020, 0.0f, buf);
+    assert_false(occ_mav_pose_rx_take(&rx, &f, &s)); /* its position is in that pose */
+    f = pos_frame(1, 1, 1030, 1.0f, 2.0f, -3.0f, buf);
     assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
-    f = att_frame(1, 1, 1100, 0.0f, buf);
+    f = att_frame(1, 1, 1030, 0.0f, buf);
+    assert_true(occ_mav_pose_rx_take(&rx, &f, &s));
+    assert_true(s.t_us == 1030000u);
+    assert_float_equal(s.pose.p.x, 2.0f, 1e-6f);
+    /* the same stamp again: not newer; an attitude 100 ms from the position: unpaired */
+    f = att_frame(1, 1, 1030, 0.0f, buf);
+    assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
+    f = att_frame(1, 1, 1130, 0.0f, buf);
     assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
     assert_int_equal(rx.counters.unpaired, 1u);
     /* a NaN position is refused and does not become the position */
-    f = pos_frame(1, 1, 1100, NAN, 0.0f, 0.0f, buf);
+    f = pos_frame(1, 1, 1130, NAN, 0.0f, 0.0f, buf);
     assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
     assert_int_equal(rx.counters.bad, 1u);
-    assert_int_equal(rx.counters.poses, 2u);
-    assert_int_equal(rx.counters.positions, 1u);
-    assert_int_equal(rx.counters.attitudes, 4u);
+    assert_int_equal(rx.counters.poses, 3u);
+    assert_int_equal(rx.counters.positions, 3u);
+    assert_int_equal(rx.counters.attitudes, 6u);
 }
 
 int main(void)

@@ -37,6 +37,7 @@ void run_args_usage(FILE *f)
         "  --depth-mount x,y,z,roll,pitch,yaw   body FLU <- camera mount, m and deg; 0,0,0,0,0,0:\n"
         "                          at the body origin looking forward (optical x right, y down, z fwd)\n"
         "  --depth-stride 1        every N-th pixel in u and v\n"
+        "  --depth-max-frames N    replay only the first N frames that have a PNG (default all)\n"
         "  --depth-min-m 0 --depth-max-m 4   range kept; beyond max clears to max (OctoMap's rule)\n"
         "  A frame is integrated with the pose interpolated at its time (gaps > 100 ms refused); a\n"
         "  frame with no pose for its time is dropped and counted by reason, never integrated.\n"
@@ -141,6 +142,8 @@ static int depth_option(run_opts_t *o, const char *a, const char *v)
         o->have_intrinsics = ok;
     } else if (strcmp(a, "--depth-mount") == 0) {
         ok = cli_parse_floats(v, o->mount, 6);
+    } else if (strcmp(a, "--depth-max-frames") == 0) {
+        ok = cli_parse_u32(v, 1, UINT32_MAX, &o->max_frames);
     } else if (strcmp(a, "--depth-stride") == 0) {
         ok = cli_parse_u32(v, 1, 64, &o->stride);
     } else if (strcmp(a, "--depth-min-m") == 0) {

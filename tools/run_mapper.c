@@ -57,12 +57,18 @@ static occ_err_t wait_pose(run_mapper_t *m, const run_frame_t *f, uint64_t relea
         const bool any = occ_pose_history_span(&m->st->hist, &oldest, &newest) == OCC_OK;
         const uint64_t last_rx = m->st->last_pose_local_us;
         const uint64_t since = m->opt->replay_speed == 0u && last_rx > released ? last_rx : released;
-        const bool give_up = m->st->stop || now - since > timeout;
+        /* fast replay waits for the first pose however long it takes (the streams start when
+         * the autopilot answers), then gives up after a timeout without a new pose */
+        const bool wait_first = m->opt->replay_speed == 0u && !any;
+        const bool give_up = m->st->stop || (!wait_first && now - since > timeout);
         occ_err_t e = OCC_ERR_TIME;
         if ((any && newest >= f->remote_us) || give_up) {
             e = occ_pose_history_at(&m->st->hist, f->remote_us, pose, why);
         }
         (void)pthread_mutex_unlock(&m->st->lock);
+        if (m->st->stop) {
+            return OCC_ERR_STATE; /* ending: the frame is neither integrated nor dropped */
+        }
         if ((any && newest >= f->remote_us) || give_up) {
             return e;
         }
@@ -253,15 +259,19 @@ static void do_frame(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
     }
     occ_pose_t map_from_body;
     occ_pose_refusal_t why = OCC_POSE_OK;
-    if (wait_pose(m, f, released, &map_from_body, &why) != OCC_OK) {
+    const occ_err_t pe = wait_pose(m, f, released, &map_from_body, &why);
+    if (pe == OCC_ERR_STATE) {
+        return;
+    }
+    if (pe != OCC_OK) {
         record(m, f, refusal_reason(why), false, 0, released);
         return;
     }
-    const uint64_t t0 = occ_port_clock_us();
     if (load(m, f, b) != OCC_OK) {
-        record(m, f, RUN_DROP_ERROR, false, 0, t0);
+        record(m, f, RUN_DROP_ERROR, false, 0, occ_port_clock_us());
         return;
     }
+    const uint64_t t0 = occ_port_clock_us(); /* integrate time: the write section, not the PNG */
     const occ_pose_t map_from_cam = occ_pose_compose(&map_from_body, &m->depth->body_from_camera);
     bool partial = false;
     size_t points = 0;
