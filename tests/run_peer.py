@@ -397,7 +397,49 @@ def test_jitter(o, frames, gt):
                    feed.get("period_ms"), j.get("p50"), j.get("p99"), j.get("max")))
 
 
-TESTS = {"requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
+def test_ranges(o, frames, gt):
+    """DISTANCE_SENSOR from another component (1/158, down, 1.50 m) with --mavlink-ranges and no
+    camera: the voxel 1.5 m under the vehicle is occupied, the column above it free (hand
+    placement: the vehicle holds the first ground-truth pose)."""
+    c = Check("ranges")
+    port = free_port()
+    first = (gt[0][0], gt[0][1], gt[0][2], (0.0, 0.0, 0.3))  # level, heading 0.3 rad
+    peer = Peer(port, [first], hold_last=True)
+    sensor = mavutil.mavlink.MAVLink(None, srcSystem=1, srcComponent=158)
+    omap = os.path.join(o.out, "ranges.occ")
+    st = os.path.join(o.out, "ranges_stats.json")
+    p = subprocess.Popen([o.occmap, "run", "--udp", "127.0.0.1:%d" % port, "--mavlink-ranges",
+                          "--duration", "2.5", "-o", omap, "--stats", st],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    nxt = 0.0
+    while p.poll() is None:
+        peer.step()
+        if peer.conn.clients and time.monotonic() > nxt and peer.sent_us:
+            nxt = time.monotonic() + 0.1
+            peer.conn.write(sensor.distance_sensor_encode(peer.boot_us() // 1000, 20, 400, 150, 0,
+                                                          7, 25, 0).pack(sensor))
+    _, err = p.communicate()
+    peer.conn.close()
+    c.that(p.returncode == 0, "exit %s: %s" % (p.returncode, err[-300:]))
+    fin = stats_lines(st)[-1]["final"] if os.path.exists(st) else {}
+    r = fin.get("ranges", {})
+    c.that(r.get("integrated", 0) > 0, "ranges %s" % r)
+    x, y, z = first[1]
+
+    def q(*a):
+        out = subprocess.run([o.occmap, "query", omap] + list(a) + ["--json"], capture_output=True,
+                             text=True)
+        return json.loads(out.stdout) if out.stdout.strip() else {}
+    hit = q("--sphere", "%f,%f,%f,0.08" % (x, y, z - 1.5))
+    c.that(hit.get("occupied_voxels", 0) > 0, "nothing occupied 1.5 m down: %s" % hit)
+    for dz in (0.3, 0.7, 1.1, 1.3):  # points on the beam: free (unknown counts as unsafe)
+        mid = q("--sphere", "%f,%f,%f,0.001" % (x, y, z - dz))
+        c.that(mid.get("collides") is False, "%.1f m down not free: %s" % (dz, mid))
+    return c.done("%s readings integrated from 1/158: hit 1.5 m down, free above" %
+                  r.get("integrated"))
+
+
+TESTS = {"ranges": test_ranges, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
 
 
 def main():

@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "run.h"
+#include "run_ranges.h"
 #include "occmap/occ_port.h"
 #include "occmap/host/occ_file.h"
 
@@ -39,8 +40,9 @@ static uint64_t wait_release(run_mapper_t *m, const run_frame_t *f)
         if (known && (int64_t)now >= release) {
             return now;
         }
+        run_ranges_service(m);
         const int64_t wait = known ? release - (int64_t)now : 10000;
-        sleep_us(wait > 10000 ? 10000u : (uint64_t)wait);
+        sleep_us(wait > 10000 ? 10000u : wait < 0 ? 0u : (uint64_t)wait);
     }
 }
 
@@ -72,6 +74,7 @@ static occ_err_t wait_pose(run_mapper_t *m, const run_frame_t *f, uint64_t relea
         if ((any && newest >= f->remote_us) || give_up) {
             return e;
         }
+        run_ranges_service(m);
         sleep_us(2000);
     }
 }
@@ -319,18 +322,20 @@ void *run_mapper_main(void *arg)
     uint64_t next_save = occ_port_clock_us() + (uint64_t)(m->opt->save_every_s * 1e6f);
     for (size_t i = 0; m->depth != NULL && i < m->depth->n && !m->st->stop; i++) {
         do_frame(m, &m->depth->frames[i], &b);
+        run_ranges_service(m);
         maybe_save(m, &next_save);
     }
-    while (m->depth == NULL && !m->st->stop) { /* no sensor of ours: saves only */
+    (void)pthread_mutex_lock(&m->st->lock);
+    m->st->mc.done = true; /* the depth directory is replayed (--exit-after-depth) */
+    (void)pthread_mutex_unlock(&m->st->lock);
+    while (!m->st->stop) { /* range messages and saves until the end */
+        run_ranges_service(m);
         maybe_save(m, &next_save);
-        sleep_us(50000);
+        sleep_us(5000);
     }
     free(b.px);
     free(b.part);
     free(b.tmp);
     free(b.scratch);
-    (void)pthread_mutex_lock(&m->st->lock);
-    m->st->mc.done = true;
-    (void)pthread_mutex_unlock(&m->st->lock);
     return NULL;
 }
