@@ -355,7 +355,7 @@ def test_stale(o, frames, gt):
     rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--depth-dir", o.data,
                                 "--replay-speed", "0", "--depth-stride", "32",
                                 "--depth-max-frames", "60",
-                                "--sensor-timeout-ms", "600", "--duration", "5", "-o", omap,
+                                "--sensor-timeout-ms", "600", "--duration", "6", "-o", omap,
                                 "--stats", st], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     silence(c, peer, "sensors stale")
@@ -363,7 +363,7 @@ def test_stale(o, frames, gt):
     # the pose: a prior map (-o of the run above), poses for 1.5 s, then none
     port = free_port()
     peer = Peer(port, gt, stop_at_us=1500000)
-    rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--map", omap, "--duration", "3.5",
+    rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--map", omap, "--duration", "4.5",
                                 "--stats", os.path.join(o.out, "stale2_stats.json")], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     silence(c, peer, "pose stale")
@@ -378,7 +378,7 @@ def test_jitter(o, frames, gt):
     peer = Peer(port, gt, speed=1.0)
     st, fl = os.path.join(o.out, "jitter_stats.json"), os.path.join(o.out, "jitter_feed.json")
     rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--depth-dir", o.data,
-                                "--replay-speed", "0", "--depth-stride", "1", "--duration", "5",
+                                "--replay-speed", "0", "--depth-stride", "1", "--duration", "4",
                                 "--stats", st, "--feed-log", fl], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     fin = stats_lines(st)[-1].get("final", {}) if os.path.exists(st) else {}

@@ -225,6 +225,7 @@ static void poll_feed(run_link_t *l, uint64_t now, bool map_ok)
     }
     run_view_t view;
     run_read_begin(l->guard, RUN_READER_FEED, &view);
+    now = occ_port_clock_us(); /* after a wait for the writer: the time it really goes out */
     for (;;) {
         uint8_t out[OCC_MAV_FRAME_MAX];
         const uint32_t before = l->feed->counters.obstacle_tx;

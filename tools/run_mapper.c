@@ -20,7 +20,8 @@ static void sleep_us(uint64_t us)
 }
 
 /* Recorded timing: wait until the autopilot clock (local + offset) reaches the frame's stamp.
- * Returns the local release time; 0 when asked to stop. */
+ * Returns the local time the frame was due (earlier than now when the mapping is behind); fast
+ * replay: now. 0 when asked to stop. */
 static uint64_t wait_release(run_mapper_t *m, const run_frame_t *f)
 {
     for (;;) {
@@ -38,7 +39,7 @@ static uint64_t wait_release(run_mapper_t *m, const run_frame_t *f)
         (void)pthread_mutex_unlock(&m->st->lock);
         const int64_t release = (int64_t)f->remote_us - off;
         if (known && (int64_t)now >= release) {
-            return now;
+            return release > 0 ? (uint64_t)release : now;
         }
         run_ranges_service(m);
         const int64_t wait = known ? release - (int64_t)now : 10000;
@@ -258,6 +259,10 @@ static void do_frame(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
 {
     const uint64_t released = wait_release(m, f);
     if (released == 0u) {
+        return;
+    }
+    if (occ_port_clock_us() - released > (uint64_t)m->opt->max_lag_ms * 1000u) {
+        record(m, f, RUN_DROP_LATE, false, 0, released); /* behind the camera: newer frames wait */
         return;
     }
     occ_pose_t map_from_body;
