@@ -76,6 +76,7 @@ enum { RUN_DROP_EMPTY, RUN_DROP_TOO_OLD, RUN_DROP_TOO_NEW, RUN_DROP_GAP, RUN_DRO
 typedef struct {
     size_t *idx;
     uint32_t *version;               /* integrated: the version that holds it; dropped: unused */
+    occ_pose_t *pose;                /* integrated: map_from_camera used; dropped: identity */
     size_t n, cap;
 } run_list_t;
 
@@ -114,7 +115,7 @@ typedef struct {
 bool run_state_offset(const run_state_t *st, int64_t *offset_us, const char **source);
 
 /* Append (realloc'd; false when out of memory). */
-bool run_list_push(run_list_t *l, size_t idx, uint32_t version);
+bool run_list_push(run_list_t *l, size_t idx, uint32_t version, const occ_pose_t *pose);
 void run_list_free(run_list_t *l);
 
 /* ---- the mapping thread (run_mapper.c) --------------------------------------------------------- */

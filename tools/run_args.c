@@ -72,6 +72,7 @@ void run_args_usage(FILE *f)
         "                          {\"config\": ...}, the last {\"final\": ...} with map_check\n"
         "  --feed-log FILE         one JSON line per OBSTACLE_DISTANCE sent: time_usec, seq, version,\n"
         "                          frames / frames_dropped (depth.txt indices since the last line),\n"
+        "                          frame_poses (map <- camera each frame was integrated with),\n"
         "                          pose [x y z qw qx qy qz] (map ENU, body FLU), distances, ...\n"
         "  --duration S            end after S seconds (0: until SIGINT/SIGTERM)\n"
         "  --exit-after-depth      end once every frame is integrated or dropped and one more\n"
