@@ -316,7 +316,7 @@ def test_requests(o, frames, gt):
     peer = Peer(port, gt, speed=4.0, ignore=2, foreign=True)
     st, fl = os.path.join(o.out, "req_stats.json"), os.path.join(o.out, "req_feed.json")
     rc, out, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--depth-dir", o.data,
-                                  "--replay-speed", "0", "--depth-stride", "16", "--duration", "5",
+                                  "--replay-speed", "0", "--depth-stride", "16", "--duration", "4",
                                   "--stats", st, "--feed-log", fl], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-500:]))
     c.that(peer.requests.get(32, 0) >= 3 and peer.requests.get(30, 0) >= 3,
@@ -443,7 +443,7 @@ def test_jitter(o, frames, gt):
     peer = Peer(port, gt, speed=1.0)
     st, fl = os.path.join(o.out, "jitter_stats.json"), os.path.join(o.out, "jitter_feed.json")
     rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--depth-dir", o.data,
-                                "--replay-speed", "0", "--depth-stride", "1", "--duration", "4",
+                                "--replay-speed", "0", "--depth-stride", "1", "--duration", "3",
                                 "--stats", st, "--feed-log", fl], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     fin = stats_lines(st)[-1].get("final", {}) if os.path.exists(st) else {}
@@ -474,7 +474,7 @@ def test_ranges(o, frames, gt):
     omap = os.path.join(o.out, "ranges.occ")
     st = os.path.join(o.out, "ranges_stats.json")
     p = subprocess.Popen([o.occmap, "run", "--udp", "127.0.0.1:%d" % port, "--mavlink-ranges",
-                          "--duration", "2.5", "-o", omap, "--stats", st],
+                          "--duration", "2", "-o", omap, "--stats", st],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     nxt = 0.0
     while p.poll() is None:
