@@ -5,6 +5,7 @@
  * assumed) and refuses with OCC_ERR_NOMEM before touching anything when the pools cannot supply
  * them. Pruning only ever frees, so the count is an upper bound.
  */
+#include "shared_internal.h"
 #include "tree_internal.h"
 
 /* ---- node helpers --------------------------------------------------------------------------- */
@@ -434,6 +435,7 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
     if (n_changed != NULL) {
         *n_changed = changed;
     }
+    occi_shared_written(m);
     return OCC_OK;
 }
 
@@ -569,6 +571,7 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
             break;
         }
     }
+    occi_shared_written(m);
     return OCC_OK;
 }
 

@@ -4,6 +4,7 @@
  * with children are updated through their subtree and refreshed bottom-up (iterative).
  */
 #include "coarse_internal.h"
+#include "../core/shared_internal.h"
 
 void occi_coarse_need(const occ_code_t *const codes, const size_t n, const unsigned level,
                       const unsigned depth, uint64_t *const inner, uint64_t *const leaf)
@@ -142,6 +143,7 @@ size_t occi_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, cons
     }
     if (n > 0u) {
         refresh_path(m, blk, prev, level + 1u, depth, depth);
+        occi_shared_written(m);
     }
     return n;
 }

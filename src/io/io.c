@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "io_internal.h"
+#include "../core/shared_internal.h"
 
 #define OM_DEPTH 16u
 
@@ -253,11 +254,19 @@ occ_err_t occ_io_read(occ_map_t *const map, const void *const buf, const size_t 
         inf->error = "resolution or depth differs from the map's";
         return OCC_ERR_ARG;
     }
+    /* A shared map: the clear and the build are one version, published at the end. */
+    const bool shared = map->priv.shared != NULL;
+    if (shared) {
+        (void)occ_map_write_begin(map);
+    }
     occ_map_t tmp = *map;
     occ_map_clear(&tmp);
     e = build(&tmp, buf, len, inf);
     if (e == OCC_OK || e != OCC_ERR_NOMEM) {
-        *map = tmp;
+        occi_map_replace(map, &tmp);
+    }
+    if (shared) {
+        (void)occ_map_write_end(map);
     }
     return e;
 }

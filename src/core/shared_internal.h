@@ -1,0 +1,56 @@
+/*
+ * shared_internal.h - the hooks every write path calls for the single-writer / many-reader mode
+ * (occ_shared.h), and the atomics port: the only place the library touches atomics.
+ */
+#ifndef OCC_SHARED_INTERNAL_H_INCLUDED
+#define OCC_SHARED_INTERNAL_H_INCLUDED
+
+#include "occmap/occ_shared.h"
+
+/* Atomics: 32-bit loads and stores only (no read-modify-write, so no libatomic and nothing an
+ * ARMv6-M core lacks). seq_cst, because the reader's store-then-load of its slot and the
+ * published index must not be reordered (store-load ordering needs a full fence). */
+#if !defined(OCC_SHARED_SINGLE_CORE)
+#if defined(__GNUC__) || defined(__clang__)
+#define OCC_SHARED_SINGLE_CORE 0
+#else
+#define OCC_SHARED_SINGLE_CORE 1
+#endif
+#endif
+
+#if OCC_SHARED_SINGLE_CORE
+/* One core: an interrupt sees the writer's stores in program order; only the compiler may
+ * reorder, and the barrier stops it. */
+#define OCC_BARRIER() __asm__ __volatile__("" ::: "memory")
+#define OCC_ATOMIC_LOAD(p) (OCC_BARRIER(), *(volatile const uint32_t *)(p))
+#define OCC_ATOMIC_STORE(p, v)                                                                   \
+    do {                                                                                         \
+        OCC_BARRIER();                                                                           \
+        *(volatile uint32_t *)(p) = (v);                                                         \
+        OCC_BARRIER();                                                                           \
+    } while (0)
+#else
+#define OCC_ATOMIC_LOAD(p) __atomic_load_n((p), __ATOMIC_SEQ_CST)
+#define OCC_ATOMIC_STORE(p, v) __atomic_store_n((p), (v), __ATOMIC_SEQ_CST)
+#endif
+
+/* A write call changed the writer's content (call after success only): publish it as a version
+ * unless a write section is open. The test is all a map that is not shared pays. */
+void occi_shared_commit(occ_map_t *m);
+
+static inline void occi_shared_written(occ_map_t *const m)
+{
+#if OCC_SHARED
+    if (m->priv.shared != NULL) {
+        occi_shared_commit(m);
+    }
+#else
+    (void)m;
+#endif
+}
+
+/* Replace the writer's map by `src` (a map built on the side: the loaders) without writing the
+ * field readers read concurrently (priv.shared); keeps `dst` shared. */
+void occi_map_replace(occ_map_t *dst, const occ_map_t *src);
+
+#endif /* OCC_SHARED_INTERNAL_H_INCLUDED */
