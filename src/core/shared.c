@@ -177,23 +177,26 @@ static void view_close(occ_view_t *const view)
     view->reader = OCC_SHARED_MAX_READERS;
 }
 
+/* A refused view: a valid map with no arena (default geometry), unobserved everywhere. */
+static void view_refused(occ_view_t *const view)
+{
+    const occ_map_config_t cfg = occ_map_config_default();
+    const occ_err_t e = occ_map_init(&view->map, &cfg, NULL, 0u);
+    OCC_ASSERT(e == OCC_OK);
+    (void)e;
+    view->version = 0u;
+    view->reader = OCC_SHARED_MAX_READERS;
+}
+
 occ_err_t occ_read_begin(occ_map_t *const map, const unsigned reader, occ_view_t *const view)
 {
     if (view == NULL) {
         return OCC_ERR_ARG;
     }
-    if (map == NULL) {
-        memset(view, 0, sizeof *view);
-        view_close(view);
-        return OCC_ERR_ARG;
-    }
-    shared_t *const sh = shared_of(map);
+    shared_t *const sh = map != NULL ? shared_of(map) : NULL;
     if (sh == NULL || reader >= sh->n_readers) {
-        /* A closed view on the caller's map geometry: its header fields never change while
-         * readers run, but only the shared one is read here to stay race-free. */
-        memset(view, 0, sizeof *view);
-        view_close(view);
-        return sh == NULL ? OCC_ERR_STATE : OCC_ERR_ARG;
+        view_refused(view);
+        return map == NULL || sh != NULL ? OCC_ERR_ARG : OCC_ERR_STATE;
     }
     if (OCC_ATOMIC_LOAD(&sh->slot[reader]) != SLOT_IDLE) {
         return OCC_ERR_STATE; /* the open view keeps its slot; `view` is not touched */
