@@ -58,7 +58,7 @@
 #ifndef OCC_SHARED_H_INCLUDED
 #define OCC_SHARED_H_INCLUDED
 
-#include "occ_core.h"
+#include "occmap/occ_core.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -122,10 +122,12 @@ static void make_scan(unsigned k, occ_vec3_t *origin)
 
 static unsigned write_versions(void)
 {
-    occ_insert_params_t ip = occ_insert_params_default();
-    occ_evict_policy_t pol = occ_evict_policy_default();
+    static occ_insert_params_t ip; /* static: the writer's frame stays small */
+    static occ_evict_policy_t pol;
+    static occ_evict_out_t ev;
+    ip = occ_insert_params_default();
+    pol = occ_evict_policy_default();
     pol.keep_radius_m = 2.0f;
-    occ_evict_out_t ev;
     occ_evict_out_init(&ev);
     ip.auto_evict = &pol;
     ip.auto_evict_state = &ev;
@@ -166,7 +168,7 @@ int main(void)
     const unsigned wfail = write_versions();
     SYST_CSR = 0u;
     const unsigned check_fail = occ_map_check(&map) != OCC_OK ? 1u : 0u;
-    occ_shared_info_t info;
+    static occ_shared_info_t info;
     (void)occ_shared_info(&map, &info);
     printf("shared-isr: %u versions, %lu interrupts (reader), %lu version changes seen, %lu "
            "mismatches or refused views, %lu publishes, %lu deferred, writer failures %u, "

@@ -75,10 +75,10 @@ static void copy_into(shared_t *const sh, const occ_map_t *const m, const unsign
 /* Publish the writer's latest version into a snapshot neither published nor pinned. */
 static bool try_publish(shared_t *const sh, const occ_map_t *const m)
 {
-    const uint32_t cur = OCC_ATOMIC_LOAD(&sh->pub);
+    const uint32_t cur = occi_atomic_load(&sh->pub);
     bool pinned[OCC_SHARED_SNAPSHOTS] = {false};
     for (unsigned r = 0; r < sh->n_readers; r++) {
-        const uint32_t s = OCC_ATOMIC_LOAD(&sh->slot[r]);
+        const uint32_t s = occi_atomic_load(&sh->slot[r]);
         if (s == SLOT_ENTERING) {
             sh->deferred++; /* it may pin any snapshot: publish at the next chance */
             return false;
@@ -90,7 +90,7 @@ static bool try_publish(shared_t *const sh, const occ_map_t *const m)
     for (unsigned b = 0; b < OCC_SHARED_SNAPSHOTS; b++) {
         if (b != cur && !pinned[b]) {
             copy_into(sh, m, b);
-            OCC_ATOMIC_STORE(&sh->pub, (uint32_t)b);
+            occi_atomic_store(&sh->pub, (uint32_t)b);
             sh->published_version = sh->version;
             sh->publishes++;
             sh->pending = false;
@@ -198,13 +198,13 @@ occ_err_t occ_read_begin(occ_map_t *const map, const unsigned reader, occ_view_t
         view_refused(view);
         return map == NULL || sh != NULL ? OCC_ERR_ARG : OCC_ERR_STATE;
     }
-    if (OCC_ATOMIC_LOAD(&sh->slot[reader]) != SLOT_IDLE) {
+    if (occi_atomic_load(&sh->slot[reader]) != SLOT_IDLE) {
         return OCC_ERR_STATE; /* the open view keeps its slot; `view` is not touched */
     }
-    OCC_ATOMIC_STORE(&sh->slot[reader], SLOT_ENTERING);
-    const uint32_t b = OCC_ATOMIC_LOAD(&sh->pub);
+    occi_atomic_store(&sh->slot[reader], SLOT_ENTERING);
+    const uint32_t b = occi_atomic_load(&sh->pub);
     OCC_ASSERT(b < OCC_SHARED_SNAPSHOTS);
-    OCC_ATOMIC_STORE(&sh->slot[reader], SLOT_HOLDS(b));
+    occi_atomic_store(&sh->slot[reader], SLOT_HOLDS(b));
     view->map = sh->head[b];
     view->map.priv.arena = sh->snap[b];
     view->map.priv.shared = NULL;
@@ -229,7 +229,7 @@ void occ_read_end(occ_map_t *const map, occ_view_t *const view)
     }
     const unsigned r = view->reader;
     view_close(view); /* no read of the snapshot after the slot lets it go */
-    OCC_ATOMIC_STORE(&sh->slot[r], SLOT_IDLE);
+    occi_atomic_store(&sh->slot[r], SLOT_IDLE);
 }
 
 occ_err_t occ_map_write_begin(occ_map_t *const map)
@@ -293,7 +293,7 @@ occ_err_t occ_shared_info(const occ_map_t *const map, occ_shared_info_t *const o
     out->copied_bytes_last = sh->copied_last;
     out->open_views = 0u;
     for (unsigned r = 0; r < sh->n_readers; r++) {
-        out->open_views += OCC_ATOMIC_LOAD(&sh->slot[r]) != SLOT_IDLE ? 1u : 0u;
+        out->open_views += occi_atomic_load(&sh->slot[r]) != SLOT_IDLE ? 1u : 0u;
     }
     return OCC_OK;
 }

@@ -18,21 +18,30 @@
 #endif
 #endif
 
+static inline uint32_t occi_atomic_load(const uint32_t *const p)
+{
 #if OCC_SHARED_SINGLE_CORE
-/* One core: an interrupt sees the writer's stores in program order; only the compiler may
- * reorder, and the barrier stops it. */
-#define OCC_BARRIER() __asm__ __volatile__("" ::: "memory")
-#define OCC_ATOMIC_LOAD(p) (OCC_BARRIER(), *(volatile const uint32_t *)(p))
-#define OCC_ATOMIC_STORE(p, v)                                                                   \
-    do {                                                                                         \
-        OCC_BARRIER();                                                                           \
-        *(volatile uint32_t *)(p) = (v);                                                         \
-        OCC_BARRIER();                                                                           \
-    } while (0)
+    /* One core: an interrupt sees the writer's stores in program order; only the compiler may
+     * reorder them, and the barriers stop it. */
+    __asm__ __volatile__("" ::: "memory");
+    const uint32_t v = *(const volatile uint32_t *)p;
+    __asm__ __volatile__("" ::: "memory");
+    return v;
 #else
-#define OCC_ATOMIC_LOAD(p) __atomic_load_n((p), __ATOMIC_SEQ_CST)
-#define OCC_ATOMIC_STORE(p, v) __atomic_store_n((p), (v), __ATOMIC_SEQ_CST)
+    return __atomic_load_n(p, __ATOMIC_SEQ_CST);
 #endif
+}
+
+static inline void occi_atomic_store(uint32_t *const p, const uint32_t v)
+{
+#if OCC_SHARED_SINGLE_CORE
+    __asm__ __volatile__("" ::: "memory");
+    *(volatile uint32_t *)p = v;
+    __asm__ __volatile__("" ::: "memory");
+#else
+    __atomic_store_n(p, v, __ATOMIC_SEQ_CST);
+#endif
+}
 
 /* A write call changed the writer's content (call after success only): publish it as a version
  * unless a write section is open. The test is all a map that is not shared pays. */
