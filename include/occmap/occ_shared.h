@@ -30,7 +30,7 @@
  * its cost is bounded and easy to state: one memcpy of the carved bytes per published version.
  * The price: memory (two arena copies) and that copy time; batch small writes with a section.
  *
- * Reader protocol (wait-free, 3 atomic accesses, no loop): slot := ENTERING; s := published;
+ * Reader protocol (wait-free, 4 atomic 32-bit accesses, no loop): slot := ENTERING; s := published;
  * slot := s. The writer picks a snapshot that is neither published nor named by a slot and, if a
  * slot reads ENTERING, picks none this time. When no snapshot is free (both pinned: a reader
  * still holds the one before last), the version is not published now but at the writer's next
@@ -51,9 +51,17 @@
  * Time: each published version copies used bytes = 16 * leaf.hwm + 56 * inner.hwm (hwm: blocks
  * ever carved, see occ_pool_t); a view costs one copy of the map header (~200 bytes).
  *
+ * What publishes (each a version when it succeeds and changed something; a refused call,
+ * OCC_ERR_NOMEM included, publishes nothing): occ_map_update/observe/set/forget(_key),
+ * occ_map_observe_codes, occ_map_insert_cloud / insert_rays (with their automatic evictions and
+ * coarse pass: one version per call, also when it fails), occ_map_evict / evict_for (when
+ * anything was evicted), occ_map_clear, occ_io_read (clear + build: one version). Keeping the
+ * copy cheap on a big map: publish at the readers' rate, e.g. a section around several scans.
+ *
  * Not allowed: writing through occ_view_map() (it aliases a snapshot readers share); calling
- * occ_map_init() on a shared map while readers run (it unshares the struct); two threads using
- * one reader slot at once; a reader slot used from an interrupt that preempts the same slot.
+ * occ_map_init() or occ_io_load() on a shared map while readers run (they re-initialize the
+ * struct, which unshares it: use occ_io_read()); two threads using one reader slot at once; a
+ * reader slot used from an interrupt that preempts the same slot.
  */
 #ifndef OCC_SHARED_H_INCLUDED
 #define OCC_SHARED_H_INCLUDED
@@ -104,8 +112,8 @@ size_t occ_shared_bytes(const occ_map_t *map, unsigned n_readers);
 occ_err_t occ_map_share(occ_map_t *map, void *mem, size_t mem_bytes, unsigned n_readers);
 
 /* Open a view of the latest published version for reader slot `reader` (< n_readers; one
- * thread or interrupt uses a slot at a time). Wait-free, O(1) (no loop; three atomic accesses
- * and a header copy). OCC_ERR_ARG for NULL or a bad slot, OCC_ERR_STATE when `map` is not
+ * thread or interrupt uses a slot at a time). Wait-free, O(1) (no loop; four atomic 32-bit
+ * accesses and a header copy). OCC_ERR_ARG for NULL or a bad slot, OCC_ERR_STATE when `map` is not
  * shared or the slot is already open. On error `view` reads as a closed view (an empty,
  * unobserved map: every query answers UNKNOWN, fail closed) and holds no slot. */
 occ_err_t occ_read_begin(occ_map_t *map, unsigned reader, occ_view_t *view);
