@@ -11,6 +11,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <string.h>
 
 #include "occmap/occmap.h"
@@ -214,12 +215,23 @@ static void test_section(void **state)
     assert_int_equal(v.version, 0u);
     assert_int_equal(state_in(&v, a), OCC_STATE_UNKNOWN);
     occ_read_end(&map, &v);
+    assert_int_equal(occ_map_version(&map), 1u); /* what the section will publish as */
     assert_int_equal(occ_map_write_end(&map), OCC_OK);
     assert_int_equal(occ_read_begin(&map, 0u, &v), OCC_OK);
     assert_int_equal(v.version, 1u);
     assert_int_equal(state_in(&v, a), OCC_STATE_OCCUPIED);
     assert_int_equal(state_in(&v, b), OCC_STATE_OCCUPIED);
     occ_read_end(&map, &v);
+    /* A section that changed nothing (a refused write) publishes nothing. */
+    occ_shared_info_t info;
+    assert_int_equal(occ_shared_info(&map, &info), OCC_OK);
+    assert_int_equal(occ_map_write_begin(&map), OCC_OK);
+    assert_int_equal(occ_map_update(&map, b, NAN), OCC_ERR_ARG);
+    assert_int_equal(occ_map_write_end(&map), OCC_OK);
+    occ_shared_info_t after;
+    assert_int_equal(occ_shared_info(&map, &after), OCC_OK);
+    assert_int_equal(after.version, 1u);
+    assert_int_equal(after.publishes, info.publishes);
 }
 
 static void view_matches_after(void (*write)(void))

@@ -54,7 +54,8 @@
  * What publishes (each a version when it succeeds and changed something; a refused call,
  * OCC_ERR_NOMEM included, publishes nothing): occ_map_update/observe/set/forget(_key),
  * occ_map_observe_codes, occ_map_insert_cloud / insert_rays (with their automatic evictions and
- * coarse pass: one version per call, also when it fails), occ_map_evict / evict_for (when
+ * coarse pass: one version per call; a failed insert publishes only the evictions it made),
+ * occ_map_evict / evict_for (when
  * anything was evicted), occ_map_clear, occ_io_read (clear + build: one version). Keeping the
  * copy cheap on a big map: publish at the readers' rate, e.g. a section around several scans.
  *
@@ -131,7 +132,8 @@ void occ_read_end(occ_map_t *map, occ_view_t *view);
 /* Write section: every write between begin and the matching end is one version, published at
  * the outermost end (nests; an integrator's evict + coarse + batch calls become one version,
  * so readers never see half a scan). Outside a section each successful write call is a version
- * of its own. End always completes one version (also when no write succeeded: same content).
+ * of its own. The outermost end completes one version when a write inside it changed the map,
+ * else it publishes nothing.
  * OCC_ERR_ARG for NULL, OCC_ERR_STATE when not shared or (end) no section is open. O(1) /
  * end: one publish, O(carved bytes). */
 occ_err_t occ_map_write_begin(occ_map_t *map);
@@ -142,8 +144,10 @@ occ_err_t occ_map_write_end(occ_map_t *map);
  * map is not shared, or a section is open. O(carved bytes) when it copies, else O(readers). */
 bool occ_map_publish(occ_map_t *map);
 
-/* Latest completed version of the writer's content (a section in progress becomes this + 1 at
- * its end). 0 for NULL or a map that is not shared. O(1). */
+/* The version number of the writer's content: the latest completed version, or inside a section
+ * whose writes changed the map, the version its end will publish (so a writer can record what
+ * readers of that version must see before it goes out). 0 for NULL or a map that is not shared.
+ * O(1). */
 uint32_t occ_map_version(const occ_map_t *map);
 
 typedef struct {

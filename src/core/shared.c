@@ -20,6 +20,7 @@ typedef struct {
     uint32_t version;           /* latest completed version of the writer's content */
     uint32_t published_version;
     uint32_t hold;              /* open write sections */
+    bool dirty;                 /* a write succeeded inside the open section */
     bool pending;               /* `version` is newer than what is published */
     uint32_t publishes, deferred;
     size_t copied_last;
@@ -114,6 +115,8 @@ void occi_shared_commit(occ_map_t *const m)
     shared_t *const sh = shared_of(m);
     if (sh->hold == 0u) {
         complete(sh, m);
+    } else {
+        sh->dirty = true;
     }
 }
 
@@ -255,7 +258,8 @@ occ_err_t occ_map_write_end(occ_map_t *const map)
         return OCC_ERR_STATE;
     }
     sh->hold--;
-    if (sh->hold == 0u) {
+    if (sh->hold == 0u && sh->dirty) {
+        sh->dirty = false;
         complete(sh, map);
     }
     return OCC_OK;
@@ -273,7 +277,10 @@ bool occ_map_publish(occ_map_t *const map)
 uint32_t occ_map_version(const occ_map_t *const map)
 {
     const shared_t *const sh = map != NULL ? shared_of(map) : NULL;
-    return sh == NULL ? 0u : sh->version;
+    if (sh == NULL) {
+        return 0u;
+    }
+    return sh->version + (sh->hold > 0u && sh->dirty ? 1u : 0u);
 }
 
 occ_err_t occ_shared_info(const occ_map_t *const map, occ_shared_info_t *const out)
