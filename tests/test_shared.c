@@ -196,6 +196,20 @@ static void test_nomem(void **state)
                      OCC_STATE_UNKNOWN);
     assert_view_equals(&v, &m);
     occ_read_end(&m, &v);
+    /* A file too big for the small arena: occ_io_read refuses and publishes nothing. */
+    for (float y = -2.0f; y < 2.0f; y += 0.7f) {
+        assert_int_equal(occ_map_update(&map, v3(3.0f, y, -y), 1.0f), OCC_OK);
+    }
+    const size_t n = serialize(&map, buf_b, sizeof buf_b);
+    occ_shared_info_t info, after;
+    assert_int_equal(occ_shared_info(&m, &info), OCC_OK);
+    assert_int_equal(occ_io_read(&m, buf_b, n, NULL), OCC_ERR_NOMEM);
+    assert_int_equal(occ_shared_info(&m, &after), OCC_OK);
+    assert_int_equal(after.publishes, info.publishes);
+    assert_int_equal(after.version, info.version);
+    assert_int_equal(occ_read_begin(&m, 0u, &v), OCC_OK);
+    assert_view_equals(&v, &m);
+    occ_read_end(&m, &v);
 }
 
 /* A section is one version: a view in the middle sees none of it. */

@@ -35,7 +35,9 @@
  * slot reads ENTERING, picks none this time. When no snapshot is free (both pinned: a reader
  * still holds the one before last), the version is not published now but at the writer's next
  * write call, occ_map_write_end() or occ_map_publish(): readers then see the previous version a
- * little longer (deferred in occ_shared_info_t counts it). The writer never waits.
+ * little longer (deferred in occ_shared_info_t counts it). The writer never waits. A reader
+ * task preempted inside occ_read_begin() (between its first and last store: a few instructions)
+ * makes the writer defer until it runs again; an interrupt reader never does (it completes).
  *
  * Platforms (compile-time knobs, one block below): GCC/Clang __atomic builtins by default (hosts,
  * multi-core Linux: seq_cst 32-bit loads and stores only, no read-modify-write, so no libatomic;
@@ -115,8 +117,9 @@ occ_err_t occ_map_share(occ_map_t *map, void *mem, size_t mem_bytes, unsigned n_
 /* Open a view of the latest published version for reader slot `reader` (< n_readers; one
  * thread or interrupt uses a slot at a time). Wait-free, O(1) (no loop; four atomic 32-bit
  * accesses and a header copy). OCC_ERR_ARG for NULL or a bad slot, OCC_ERR_STATE when `map` is not
- * shared or the slot is already open. On error `view` reads as a closed view (an empty,
- * unobserved map: every query answers UNKNOWN, fail closed) and holds no slot. */
+ * shared or the slot is already open. On error `view` (when non-NULL) reads as a closed view (an
+ * empty, unobserved map: every query answers UNKNOWN, fail closed) and holds no slot, except for
+ * a slot already open: `view` is then left as it is (it may be the open view itself). */
 occ_err_t occ_read_begin(occ_map_t *map, unsigned reader, occ_view_t *view);
 
 /* The read-only map of an open view (NULL for NULL). */

@@ -254,19 +254,15 @@ occ_err_t occ_io_read(occ_map_t *const map, const void *const buf, const size_t 
         inf->error = "resolution or depth differs from the map's";
         return OCC_ERR_ARG;
     }
-    /* A shared map: the clear and the build are one version, published at the end. */
-    const bool shared = map->priv.shared != NULL;
-    if (shared) {
-        (void)occ_map_write_begin(map);
-    }
+    /* The clear and the build happen on a copy that is not shared; a shared map publishes the
+     * result once, as one version (occ_shared.h), and nothing on NOMEM. */
     occ_map_t tmp = *map;
+    tmp.priv.shared = NULL;
     occ_map_clear(&tmp);
     e = build(&tmp, buf, len, inf);
     if (e == OCC_OK || e != OCC_ERR_NOMEM) {
         occi_map_replace(map, &tmp);
-    }
-    if (shared) {
-        (void)occ_map_write_end(map);
+        occi_shared_written(map);
     }
     return e;
 }
