@@ -75,6 +75,8 @@ static void test_errors(void **state)
     assert_int_equal(occ_shared_bytes(&map, OCC_SHARED_MAX_READERS + 1u), 0u);
     const size_t need = occ_shared_bytes(&map, 2u);
     assert_true(need >= OCC_SHARED_SNAPSHOTS * map.arena_bytes);
+    assert_true(need <= OCC_SHARED_BYTES(sizeof arena)); /* the static bound holds */
+    assert_int_equal(occ_shared_bytes(&map, OCC_SHARED_MAX_READERS), need); /* slots are fixed */
     occ_view_t v;
     assert_int_equal(occ_read_begin(&map, 0u, &v), OCC_ERR_STATE); /* not shared yet */
     assert_int_equal(occ_map_state_at(occ_view_map(&v), v3(0, 0, 0)), OCC_STATE_UNKNOWN);

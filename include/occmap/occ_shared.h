@@ -46,8 +46,9 @@
  * preempting the writer. OCC_SHARED=0 removes the mode (occ_map_share() then answers
  * OCC_ERR_UNSUPPORTED) and the one NULL test per write call.
  *
- * Memory (exact): occ_shared_bytes() = sizeof of the internal state (a few hundred bytes plus
- * one header per snapshot) + 8 alignment + OCC_SHARED_SNAPSHOTS * map->arena_bytes. The map's
+ * Memory (exact): occ_shared_bytes() = the internal state (slots, counters and one map header
+ * per snapshot: under 1 KB, rounded to 8) + 8 alignment + OCC_SHARED_SNAPSHOTS *
+ * map->arena_bytes; OCC_SHARED_BYTES(arena bytes) bounds it at compile time. The map's
  * own arena needs no headroom: a write call needs exactly the blocks it needs unshared, and
  * OCC_ERR_NOMEM leaves the map and every view unchanged (nothing is published).
  * Time: each published version copies used bytes = 16 * leaf.hwm + 56 * inner.hwm (hwm: blocks
@@ -89,6 +90,14 @@ extern "C" {
 
 /* Most reader slots one shared map has. */
 #define OCC_SHARED_MAX_READERS 16u
+
+/* Compile-time bound of occ_shared_bytes() for a map initialized on `arena_bytes` bytes (any
+ * reader count), for a static buffer: OCC_SHARED_SNAPSHOTS arena copies plus
+ * OCC_SHARED_STATE_BYTES, a bound of the internal state (slots, counters, one map header per
+ * snapshot, alignment) that the library checks at compile time. */
+#define OCC_SHARED_STATE_BYTES 2048u
+#define OCC_SHARED_BYTES(arena_bytes) \
+    ((size_t)OCC_SHARED_SNAPSHOTS * (size_t)(arena_bytes) + (size_t)OCC_SHARED_STATE_BYTES)
 
 /* A reader's snapshot of one published version. Caller-owned (stack is fine); valid from
  * occ_read_begin() to occ_read_end(). Its map is a read-only handle: pass occ_view_map(view) to

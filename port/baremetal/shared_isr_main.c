@@ -31,7 +31,7 @@ typedef struct {
 } answers_t;
 
 static uint8_t arena[OCC_ARENA_BYTES(1500, 6000)];
-static uint8_t shmem[2u * sizeof arena + 4096u];
+static uint8_t shmem[OCC_SHARED_BYTES(sizeof arena)];
 static occ_map_t map;
 static answers_t record[MAX_VERSIONS + 1u];
 static occ_vec3_t cloud[N_POINTS];
