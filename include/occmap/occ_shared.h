@@ -4,7 +4,8 @@
  * Model: the thread that calls the write functions of occ_core.h / occ_integrate.h / occ_evict.h /
  * occ_io.h on `map` is the only writer. Each write call is one version (a write section,
  * occ_map_write_begin() .. occ_map_write_end(), makes several calls one version): it is either
- * applied as a whole and published at its end, or (on any error) not at all. A reader opens a
+ * applied as a whole and published at its end, or (on an error) not at all, except what the
+ * call documents it keeps (an insert's automatic evictions). A reader opens a
  * view of the last published version, runs any number of read-only queries on
  * occ_view_map(view), and closes it. Readers never block and never retry; the writer never
  * waits for readers.
@@ -30,14 +31,15 @@
  * its cost is bounded and easy to state: one memcpy of the carved bytes per published version.
  * The price: memory (two arena copies) and that copy time; batch small writes with a section.
  *
- * Reader protocol (wait-free, 4 atomic 32-bit accesses, no loop): slot := ENTERING; s := published;
- * slot := s. The writer picks a snapshot that is neither published nor named by a slot and, if a
- * slot reads ENTERING, picks none this time. When no snapshot is free (both pinned: a reader
- * still holds the one before last), the version is not published now but at the writer's next
- * write call, occ_map_write_end() or occ_map_publish(): readers then see the previous version a
- * little longer (deferred in occ_shared_info_t counts it). The writer never waits. A reader
- * task preempted inside occ_read_begin() (between its first and last store: a few instructions)
- * makes the writer defer until it runs again; an interrupt reader never does (it completes).
+ * Reader protocol (wait-free, no loop; 4 atomic 32-bit accesses with the open-slot check):
+ * slot := ENTERING; s := published; slot := s. The writer picks a snapshot that is neither
+ * published nor named by a slot and, if a slot reads ENTERING, picks none this time. When no
+ * snapshot is free (both pinned: a reader still holds the one before last), the version is not
+ * published now but at the writer's next write call, occ_map_write_end() or occ_map_publish():
+ * readers then see the previous version a little longer (deferred in occ_shared_info_t counts
+ * it). The writer never waits. A reader task preempted inside occ_read_begin() (between its
+ * first and last store: a few instructions) makes the writer defer until it runs again; an
+ * interrupt reader never does (it completes).
  *
  * Platforms (compile-time knobs, one block below): GCC/Clang __atomic builtins by default (hosts,
  * multi-core Linux: seq_cst 32-bit loads and stores only, no read-modify-write, so no libatomic;
@@ -51,16 +53,16 @@
  * map->arena_bytes; OCC_SHARED_BYTES(arena bytes) bounds it at compile time. The map's
  * own arena needs no headroom: a write call needs exactly the blocks it needs unshared, and
  * OCC_ERR_NOMEM leaves the map and every view unchanged (nothing is published).
- * Time: each published version copies used bytes = 16 * leaf.hwm + 56 * inner.hwm (hwm: blocks
- * ever carved, see occ_pool_t); a view costs one copy of the map header (~200 bytes).
+ * Time: each published version copies OCC_LEAF_BLOCK_BYTES * leaf.hwm + OCC_INNER_BLOCK_BYTES *
+ * inner.hwm bytes (hwm: blocks ever carved, see occ_pool_t); a view copies one map header.
  *
  * What publishes (each a version when it succeeds and changed something; a refused call,
  * OCC_ERR_NOMEM included, publishes nothing): occ_map_update/observe/set/forget(_key),
  * occ_map_observe_codes, occ_map_insert_cloud / insert_rays (with their automatic evictions and
  * coarse pass: one version per call; a failed insert publishes only the evictions it made),
- * occ_map_evict / evict_for (when
- * anything was evicted), occ_map_clear, occ_io_read (clear + build: one version). Keeping the
- * copy cheap on a big map: publish at the readers' rate, e.g. a section around several scans.
+ * occ_map_evict / evict_for (when anything was evicted), occ_map_clear, occ_io_read (clear +
+ * build: one version). Keeping the copy cheap on a big map: publish at the readers' rate, e.g.
+ * a section around several scans.
  *
  * Not allowed: writing through occ_view_map() (it aliases a snapshot readers share); calling
  * occ_map_init() or occ_io_load() on a shared map while readers run (they re-initialize the
@@ -139,7 +141,7 @@ const occ_map_t *occ_view_map(const occ_view_t *view);
  * OCC_ERR_STATE). O(1). Nothing for NULL, a map that is not shared or a view already closed. */
 void occ_read_end(occ_map_t *map, occ_view_t *view);
 
-/* ---- Writer side (the writer's thread only) ---------------------------------------------------- */
+/* ---- Writer side (the writer's thread only) ------------------------------------------------ */
 
 /* Write section: every write between begin and the matching end is one version, published at
  * the outermost end (nests; an integrator's evict + coarse + batch calls become one version,

@@ -184,7 +184,7 @@ int main(void)
     return total > 99u ? 99 : (int)total;
 }
 
-/* ---- reset and vectors (this image's own: SysTick is the reader) ------------------------------- */
+/* ---- reset and vectors (this image's own: SysTick is the reader) --------------------------- */
 extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _estack;
 extern void initialise_monitor_handles(void);
 void shared_isr_reset(void);

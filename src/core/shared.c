@@ -32,7 +32,9 @@ typedef struct {
 } shared_t;
 
 /* OCC_SHARED_BYTES() promises the state fits OCC_SHARED_STATE_BYTES (with both alignments). */
-typedef char occ_shared_state_fits[sizeof(shared_t) + 2u * OCC_ARENA_ALIGN <= OCC_SHARED_STATE_BYTES ? 1 : -1];
+typedef char occ_shared_state_fits[sizeof(shared_t) + 2u * OCC_ARENA_ALIGN <= OCC_SHARED_STATE_BYTES
+                                       ? 1
+                                       : -1];
 
 /* The state rounded up to 8 bytes, so the copies after it are aligned like the arena (i386
  * aligns doubles to 4 inside structs). */

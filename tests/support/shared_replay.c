@@ -123,7 +123,8 @@ static occ_vec3_t probe_at(unsigned i, unsigned n)
 
 static uint8_t collide_code(occ_err_t e, const occ_collision_t *c)
 {
-    return (uint8_t)((e != OCC_OK ? 1u : 0u) + 4u * ((c->safe ? 1u : 0u) + 2u * (c->outside ? 1u : 0u)));
+    const unsigned answer = (c->safe ? 1u : 0u) + 2u * (c->outside ? 1u : 0u);
+    return (uint8_t)((e != OCC_OK ? 1u : 0u) + 4u * answer);
 }
 
 static void answer_collide(const occ_map_t *map, sr_answers_t *out)
