@@ -6,13 +6,13 @@
  *   shared  - the same map shared, no reader running (the publish copy per scan is the cost)
  *   readers - shared, with 4 reader threads each opening a view, answering the probe set
  *             (states, sphere and capsule checks, ray casts, sectors) and closing it, at
- *             100 Hz each (2-10x an avoidance loop's 10-50 Hz; a reader spinning flat out
+ *             50 Hz each (the top of an avoidance loop's 10-50 Hz; a reader spinning flat out
  *             measures only how many cores the machine has: readers never block the writer,
- *             but on a 2-core box they take its CPU)
+ *             but on a shared 2-core box they take its CPU)
  * and prints the writer's median time per scan (median over rounds, with min-max of the round
  * medians), the ratios against plain (target <= 1.20), and the readers' latency while the
  * writer runs: occ_read_begin alone and a whole view (begin + probes + end), median, p99, max.
- * Usage: shared [rounds (5)] [scans per run (60)] [arena MiB (8)]
+ * Usage: shared [rounds (5)] [scans per run (100)] [arena MiB (8)] [reader Hz (50)]
  */
 #include <pthread.h>
 #include <stdio.h>
@@ -58,12 +58,13 @@ typedef struct {
 } reader_t;
 
 static unsigned stop_flag;
+static long reader_period_ns = 20000000; /* 50 Hz per reader: an avoidance loop's top rate */
 
 static void *reader_main(void *arg)
 {
     reader_t *const r = arg;
     sr_answers_t a;
-    const struct timespec pause = {0, 10000000}; /* 100 Hz per reader */
+    const struct timespec pause = {0, reader_period_ns};
     while (__atomic_load_n(&stop_flag, __ATOMIC_ACQUIRE) == 0u) {
         occ_view_t v;
         const double t0 = now_s();
@@ -140,8 +141,11 @@ static double run(int conf, size_t scans, size_t arena_bytes, reader_t *rd, size
 int main(int argc, char **argv)
 {
     const unsigned rounds = argc > 1 ? (unsigned)atoi(argv[1]) : 5u;
-    const size_t scans = argc > 2 ? (size_t)atoi(argv[2]) : 60u;
+    const size_t scans = argc > 2 ? (size_t)atoi(argv[2]) : 100u;
     const size_t arena_bytes = (argc > 3 ? (size_t)atoi(argv[3]) : 8u) << 20;
+    if (argc > 4 && atoi(argv[4]) > 0) {
+        reader_period_ns = 1000000000L / atoi(argv[4]);
+    }
     static reader_t rd[N_READERS];
     for (unsigned i = 0; i < N_READERS; i++) {
         rd[i].begin_s = malloc(MAX_SAMPLES * sizeof(double));
@@ -156,8 +160,8 @@ int main(int argc, char **argv)
         }
     }
     printf("shared bench: writer, %zu TUM/scan.dat scans per run in %zu MiB with eviction, %u "
-           "interleaved rounds (median of round medians, [min-max])\n",
-           scans, arena_bytes >> 20, rounds);
+           "interleaved rounds (median of round medians, [min-max]); readers at %ld Hz each\n",
+           scans, arena_bytes >> 20, rounds, 1000000000L / reader_period_ns);
     double m[N_CONF];
     for (int c = 0; c < N_CONF; c++) {
         double v[64];
