@@ -98,8 +98,9 @@ extern "C" {
  * OCC_SHARED_STATE_BYTES, a bound of the internal state (slots, counters, one map header per
  * snapshot, alignment) that the library checks at compile time. */
 #define OCC_SHARED_STATE_BYTES 2048u
-#define OCC_SHARED_BYTES(arena_bytes) \
-    ((size_t)OCC_SHARED_SNAPSHOTS * (size_t)(arena_bytes) + (size_t)OCC_SHARED_STATE_BYTES)
+#define OCC_SHARED_BYTES(arena_bytes)                                                         \
+    ((size_t)OCC_SHARED_SNAPSHOTS * (size_t)(arena_bytes) + (size_t)(arena_bytes) / 64u + 32u + \
+     (size_t)OCC_SHARED_STATE_BYTES)
 
 /* A reader's snapshot of one published version. Caller-owned (stack is fine); valid from
  * occ_read_begin() to occ_read_end(). Its map is a read-only handle: pass occ_view_map(view) to

@@ -24,6 +24,11 @@ typedef struct {
     bool pending;               /* `version` is newer than what is published */
     uint32_t publishes, deferred;
     size_t copied_last;
+    /* Granules (16 bytes of the arena) written since the last publish (cur) and between the two
+     * before (prev): a snapshot, refreshed every second publish, needs both. */
+    uint64_t *dirty_cur, *dirty_prev;
+    size_t dirty_words;
+    unsigned full;              /* publishes still to copy every carved byte (share, loads) */
     uint8_t *snap[OCC_SHARED_SNAPSHOTS];   /* arena-sized copies */
     occ_map_t head[OCC_SHARED_SNAPSHOTS];  /* the header of the version each holds */
     uint32_t head_version[OCC_SHARED_SNAPSHOTS];
@@ -50,32 +55,97 @@ static shared_t *shared_of(const occ_map_t *const m)
     return sh;
 }
 
+#define GRANULE 16u
+
+/* 64-bit words of one dirty bitmap for an arena of `arena_bytes`. */
+static size_t bitmap_words(const size_t arena_bytes)
+{
+    const size_t granules = arena_bytes / GRANULE + 1u;
+    return granules / 64u + 1u;
+}
+
 size_t occ_shared_bytes(const occ_map_t *const map, const unsigned n_readers)
 {
     if (map == NULL || n_readers == 0u || n_readers > OCC_SHARED_MAX_READERS) {
         return 0u;
     }
     const size_t copies = occ_sat_mul(OCC_SHARED_SNAPSHOTS, map->arena_bytes);
+    const size_t maps = occ_sat_mul(2u * sizeof(uint64_t), bitmap_words(map->arena_bytes));
     const size_t fixed = head_bytes() + OCC_ARENA_ALIGN;
-    return copies > SIZE_MAX - fixed ? 0u : copies + fixed;
+    const size_t total = occ_sat_add(occ_sat_add(copies, maps), fixed);
+    return total == SIZE_MAX ? 0u : total;
 }
 
-/* Copy the writer's content into snapshot b: the carved ends of both pools and the header. */
+void occi_shared_mark(occ_map_t *const m, const void *const p, const size_t bytes)
+{
+    shared_t *const sh = shared_of(m);
+    const uint8_t *const q = (const uint8_t *)p;
+    if (sh == NULL || bytes == 0u || q < m->priv.arena || q >= m->priv.arena + m->arena_bytes) {
+        return; /* the root's fields live in the map struct: the header copy carries them */
+    }
+    const size_t off = (size_t)(q - m->priv.arena);
+    const size_t last = (off + bytes - 1u) / GRANULE;
+    for (size_t g = off / GRANULE; g <= last; g++) {
+        sh->dirty_cur[g / 64u] |= (uint64_t)1 << (g % 64u);
+    }
+}
+
+/* Copy granule g of the arena into snapshot b when it holds carved bytes. */
+static size_t copy_granule(shared_t *const sh, const occ_map_t *const m, const unsigned b,
+                           const size_t g, const size_t leaf_end, const size_t inner_start)
+{
+    const size_t off = g * GRANULE;
+    if (off >= m->arena_bytes || (off >= leaf_end && off + GRANULE <= inner_start)) {
+        return 0u; /* in the gap between the pools: nothing reachable */
+    }
+    const size_t n = m->arena_bytes - off < GRANULE ? m->arena_bytes - off : GRANULE;
+    memcpy(sh->snap[b] + off, m->priv.arena + off, n);
+    return n;
+}
+
+/* The granules written since snapshot b was last refreshed (the last two publish intervals). */
+static size_t copy_dirty(shared_t *const sh, const occ_map_t *const m, const unsigned b,
+                         const size_t leaf_end, const size_t inner_start)
+{
+    size_t copied = 0u;
+    for (size_t w = 0; w < sh->dirty_words; w++) {
+        uint64_t bits = sh->dirty_cur[w] | sh->dirty_prev[w];
+        while (bits != 0u) {
+            const unsigned i = (unsigned)__builtin_ctzll(bits);
+            bits &= bits - 1u;
+            copied += copy_granule(sh, m, b, w * 64u + i, leaf_end, inner_start);
+        }
+    }
+    return copied;
+}
+
+/* Bring snapshot b to the writer's content: every carved byte (after share or a load), else the
+ * granules written since b was last refreshed; then the header. */
 static void copy_into(shared_t *const sh, const occ_map_t *const m, const unsigned b)
 {
     const size_t leaf_bytes = (size_t)m->leaf.hwm * sizeof(occ_leaf_block_t);
     const size_t inner_bytes = (size_t)m->inner.hwm * sizeof(occ_inner_block_t);
     OCC_ASSERT(leaf_bytes + inner_bytes <= m->arena_bytes);
-    if (leaf_bytes > 0u) {
-        memcpy(sh->snap[b], m->priv.arena, leaf_bytes);
+    const size_t top = m->arena_bytes - inner_bytes;
+    if (sh->full > 0u) {
+        if (leaf_bytes > 0u) {
+            memcpy(sh->snap[b], m->priv.arena, leaf_bytes);
+        }
+        if (inner_bytes > 0u) {
+            memcpy(sh->snap[b] + top, m->priv.arena + top, inner_bytes);
+        }
+        sh->copied_last = leaf_bytes + inner_bytes;
+        sh->full--;
+    } else {
+        sh->copied_last = copy_dirty(sh, m, b, leaf_bytes, top);
     }
-    if (inner_bytes > 0u) {
-        const size_t top = m->arena_bytes - inner_bytes;
-        memcpy(sh->snap[b] + top, m->priv.arena + top, inner_bytes);
-    }
+    /* The other snapshot now lags by the interval just ended: it becomes `prev`. */
+    uint64_t *const t = sh->dirty_prev;
+    sh->dirty_prev = sh->dirty_cur;
+    sh->dirty_cur = t;
+    memset(sh->dirty_cur, 0, sh->dirty_words * sizeof(uint64_t));
     sh->head[b] = *m;
     sh->head_version[b] = sh->version;
-    sh->copied_last = leaf_bytes + inner_bytes;
 }
 
 /* Publish the writer's latest version into a snapshot neither published nor pinned. */
@@ -125,6 +195,13 @@ void occi_shared_commit(occ_map_t *const m)
     }
 }
 
+void occi_shared_rebuilt(occ_map_t *const m)
+{
+    shared_t *const sh = shared_of(m);
+    sh->full = OCC_SHARED_SNAPSHOTS;
+    occi_shared_commit(m);
+}
+
 void occi_map_replace(occ_map_t *const dst, const occ_map_t *const src)
 {
     /* priv.shared is the struct's last field: everything before it is the map. */
@@ -157,8 +234,14 @@ occ_err_t occ_map_share(occ_map_t *const map, void *const mem, const size_t mem_
     memset(sh, 0, sizeof *sh);
     sh->magic = SHARED_MAGIC;
     sh->n_readers = n_readers;
+    sh->dirty_words = bitmap_words(map->arena_bytes);
+    sh->dirty_cur = (uint64_t *)(void *)(base + head_bytes());
+    sh->dirty_prev = sh->dirty_cur + sh->dirty_words;
+    memset(sh->dirty_cur, 0, 2u * sh->dirty_words * sizeof(uint64_t));
+    sh->full = OCC_SHARED_SNAPSHOTS; /* both snapshots start from a whole copy */
+    uint8_t *const snaps = (uint8_t *)(sh->dirty_prev + sh->dirty_words);
     for (unsigned b = 0; b < OCC_SHARED_SNAPSHOTS; b++) {
-        sh->snap[b] = base + head_bytes() + (size_t)b * map->arena_bytes;
+        sh->snap[b] = snaps + (size_t)b * map->arena_bytes;
     }
     sh->pub = OCC_SHARED_SNAPSHOTS - 1u; /* so the first publish takes snapshot 0 */
     for (unsigned r = 0; r < OCC_SHARED_MAX_READERS; r++) {

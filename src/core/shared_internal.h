@@ -58,6 +58,27 @@ static inline void occi_shared_written(occ_map_t *const m)
 #endif
 }
 
+/* The writer wrote `bytes` at `p` (inside a block; pointers outside the arena, the root's
+ * fields, are ignored): the snapshots get those 16-byte granules at their next publish. */
+void occi_shared_mark(occ_map_t *m, const void *p, size_t bytes);
+
+static inline void occi_shared_touch(occ_map_t *const m, const void *const p, const size_t bytes)
+{
+#if OCC_SHARED
+    if (m->priv.shared != NULL) {
+        occi_shared_mark(m, p, bytes);
+    }
+#else
+    (void)m;
+    (void)p;
+    (void)bytes;
+#endif
+}
+
+/* The content was rebuilt without marks (a loader built it on an unshared copy): the next
+ * publish of each snapshot copies every carved block. Then publishes like occi_shared_written. */
+void occi_shared_rebuilt(occ_map_t *m);
+
 /* Replace the writer's map by `src` (a map built on the side: the loaders) without writing the
  * field readers read concurrently (priv.shared); keeps `dst` shared. */
 void occi_map_replace(occ_map_t *dst, const occ_map_t *src);

@@ -190,6 +190,7 @@ static void collapse(ctx_t *const x, const occ_nodep_t n, const unsigned level)
     occi_tree_release_children(m, n, level);
     *n.value = v;
     *n.flags = occ_value_flags(m, v);
+    occ_touch_node(m, n);
     x->evictions++;
 }
 

@@ -41,6 +41,7 @@ static void apply_uniform(occ_map_t *const m, const occ_nodep_t node, const occ_
 {
     *node.value = occ_value_apply_delta(m, *node.value, delta);
     *node.flags = occ_value_flags(m, *node.value);
+    occ_touch_node(m, node);
 }
 
 /* A node by where it lives: slot `slot` of inner block `block`, or the root (block OCC_NONE). */
@@ -76,6 +77,7 @@ static void apply_subtree(occ_map_t *const m, const uint32_t block, const unsign
             for (unsigned i = 0; i < 8u; i++) {
                 b->value[i] = occ_value_apply_delta(m, b->value[i], delta);
             }
+            occi_shared_touch(m, b, sizeof *b);
             (void)occi_tree_refresh(m, nd, 1u);
             sp--;
             continue;

@@ -262,7 +262,9 @@ occ_err_t occ_io_read(occ_map_t *const map, const void *const buf, const size_t 
     e = build(&tmp, buf, len, inf);
     if (e == OCC_OK || e != OCC_ERR_NOMEM) {
         occi_map_replace(map, &tmp);
-        occi_shared_written(map);
+        if (map->priv.shared != NULL) {
+            occi_shared_rebuilt(map); /* built unmarked: every snapshot copies it whole */
+        }
     }
     return e;
 }
