@@ -16,8 +16,10 @@
  * The view stays that version until occ_read_end(). occ_map_check() holds on every view.
  *
  * Design (why): published SNAPSHOTS. Shared memory holds OCC_SHARED_SNAPSHOTS (2) copies of the
- * arena; a version is published by copying the carved blocks (both pools' high-water regions,
- * not the whole arena) and the map header into a snapshot no reader holds, then storing that
+ * arena; a version is published by bringing a snapshot no reader holds up to date (copying the
+ * 16-byte granules of the arena written since that snapshot was last refreshed, which every
+ * block write marks in a bitmap; the whole carved region after occ_map_share() and loads) with
+ * the map header, then storing that
  * snapshot's index (ONE 32-bit word, so a Cortex-M0+ without LDREX loads it atomically) with a
  * sequentially consistent store. A reader pins the published snapshot in its slot and copies its
  * header: every existing query (they all take `const occ_map_t *`) runs on the view unchanged,
@@ -28,8 +30,8 @@
  * free list to the hot update loop; the snapshot leaves every algorithm and the pools as they
  * are (a plain or never-shared map pays one NULL test per write call), cannot let a reader see
  * a block the writer is changing (no free-list link, no uninitialised carve, no torn root), and
- * its cost is bounded and easy to state: one memcpy of the carved bytes per published version.
- * The price: memory (two arena copies) and that copy time; batch small writes with a section.
+ * its cost is bounded and easy to state: per published version, a copy of what the last two
+ * versions wrote (at most the carved bytes). The price: memory (two arena copies).
  *
  * Reader protocol (wait-free, no loop; 4 atomic 32-bit accesses with the open-slot check):
  * slot := ENTERING; s := published; slot := s. The writer picks a snapshot that is neither
@@ -49,20 +51,23 @@
  * OCC_ERR_UNSUPPORTED) and the one NULL test per write call.
  *
  * Memory (exact): occ_shared_bytes() = the internal state (slots, counters and one map header
- * per snapshot: under 1 KB, rounded to 8) + 8 alignment + OCC_SHARED_SNAPSHOTS *
- * map->arena_bytes; OCC_SHARED_BYTES(arena bytes) bounds it at compile time. The map's
+ * per snapshot: under 1 KB, rounded to 8) + 8 alignment + two dirty bitmaps of
+ * 8 * (floor((arena_bytes / 16 + 1) / 64) + 1) bytes each (~arena_bytes / 64 together) +
+ * OCC_SHARED_SNAPSHOTS * map->arena_bytes; OCC_SHARED_BYTES(arena bytes) bounds it at compile
+ * time. The map's
  * own arena needs no headroom: a write call needs exactly the blocks it needs unshared, and
  * OCC_ERR_NOMEM leaves the map and every view unchanged (nothing is published).
- * Time: each published version copies OCC_LEAF_BLOCK_BYTES * leaf.hwm + OCC_INNER_BLOCK_BYTES *
- * inner.hwm bytes (hwm: blocks ever carved, see occ_pool_t); a view copies one map header.
+ * Time: a publish scans the bitmaps (arena_bytes / 1024 words) and copies the granules written
+ * in the last two versions, at most OCC_LEAF_BLOCK_BYTES * leaf.hwm + OCC_INNER_BLOCK_BYTES *
+ * inner.hwm (hwm: blocks ever carved, see occ_pool_t); after a share or a load, twice that whole.
+ * Each block write on a shared map sets a bit; a view copies one map header.
  *
  * What publishes (each a version when it succeeds and changed something; a refused call,
  * OCC_ERR_NOMEM included, publishes nothing): occ_map_update/observe/set/forget(_key),
  * occ_map_observe_codes, occ_map_insert_cloud / insert_rays (with their automatic evictions and
  * coarse pass: one version per call; a failed insert publishes only the evictions it made),
  * occ_map_evict / evict_for (when anything was evicted), occ_map_clear, occ_io_read (clear +
- * build: one version). Keeping the copy cheap on a big map: publish at the readers' rate, e.g.
- * a section around several scans.
+ * build: one version).
  *
  * Not allowed: writing through occ_view_map() (it aliases a snapshot readers share); calling
  * occ_map_init() or occ_io_load() on a shared map while readers run (they re-initialize the
@@ -95,8 +100,9 @@ extern "C" {
 
 /* Compile-time bound of occ_shared_bytes() for a map initialized on `arena_bytes` bytes (any
  * reader count), for a static buffer: OCC_SHARED_SNAPSHOTS arena copies plus
- * OCC_SHARED_STATE_BYTES, a bound of the internal state (slots, counters, one map header per
- * snapshot, alignment) that the library checks at compile time. */
+ * arena_bytes / 64 + 32 for the dirty bitmaps plus OCC_SHARED_STATE_BYTES, a bound of the
+ * internal state (slots, counters, one map header per snapshot, alignment) that the library
+ * checks at compile time. */
 #define OCC_SHARED_STATE_BYTES 2048u
 #define OCC_SHARED_BYTES(arena_bytes)                                                         \
     ((size_t)OCC_SHARED_SNAPSHOTS * (size_t)(arena_bytes) + (size_t)(arena_bytes) / 64u + 32u + \
@@ -112,9 +118,9 @@ typedef struct {
 } occ_view_t;
 
 /* Bytes of the shared state occ_map_share() needs for `n_readers` reader slots on `map`
- * (exact formula at the top of this header: OCC_SHARED_SNAPSHOTS copies of map->arena_bytes plus
- * a fixed header). 0 for NULL, n_readers 0 or > OCC_SHARED_MAX_READERS, or a size that
- * overflows size_t. O(1). */
+ * (exact formula at the top of this header: OCC_SHARED_SNAPSHOTS copies of map->arena_bytes, two
+ * dirty bitmaps and a fixed header). 0 for NULL, n_readers 0 or > OCC_SHARED_MAX_READERS, or
+ * a size that overflows size_t. O(1). */
 size_t occ_shared_bytes(const occ_map_t *map, unsigned n_readers);
 
 /* Turn `map` (initialized, possibly holding content) into a single-writer / many-reader map
