@@ -178,7 +178,7 @@ def selftest(root):
     return ok
 
 
-CHAPTERS = ["occ_core.h", "occ_integrate.h", "occ_query.h", "occ_io.h", "occ_evict.h"]
+CHAPTERS = ["occ_core.h", "occ_integrate.h", "occ_query.h", "occ_io.h", "occ_evict.h", "occ_shared.h"]
 # A portable header (include/occmap/*.h, what firmware sees) includes only freestanding C headers
 # and declares nothing of an OS: no FILE, file descriptors, sockets, threads or libccd. The
 # firmware compile of every portable header alone (make fw-headers) is the other half.

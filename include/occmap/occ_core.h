@@ -27,7 +27,8 @@
  * Every allocation and free is O(1). Running out of blocks is normal: the call returns
  * OCC_ERR_NOMEM, bumps oom_count, and the map is exactly as before the call.
  *
- * Threads: a map is not thread-safe; serialize access per map. Distinct maps are independent.
+ * Threads: a map is not thread-safe unless shared (occ_shared.h: one writer, many wait-free
+ * readers on views); otherwise serialize access per map. Distinct maps are independent.
  * Recursion: none; every walk uses a fixed stack of at most OCC_MAX_DEPTH entries.
  */
 #ifndef OCC_OCC_CORE_H_INCLUDED
@@ -209,6 +210,7 @@ typedef struct {
         uint32_t root_child;
         occ_value_t root_value;
         uint8_t root_flags;
+        void *shared;             /* occ_shared.h state once occ_map_share() ran, else NULL */
     } priv;                   /* internal: do not touch, layout may change */
 } occ_map_t;
 

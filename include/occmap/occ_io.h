@@ -118,14 +118,16 @@ occ_err_t occ_io_probe(const void *buf, size_t len, const occ_map_config_t *base
  * already lived on this arena is still valid. Errors: those of occ_io_probe, OCC_ERR_ARG
  * (NULL map/arena, or the stored config is rejected by occ_map_init -> reported as
  * OCC_ERR_FORMAT for snapshots), OCC_ERR_NOMEM (the tree does not fit `arena_bytes`; see
- * info->arena_bytes_needed). `info` may be NULL. O(len). */
+ * info->arena_bytes_needed). `info` may be NULL. O(len). An init: a shared map (occ_shared.h)
+ * comes back unshared, so load a shared map with occ_io_read(). */
 occ_err_t occ_io_load(occ_map_t *map, const occ_map_config_t *base_cfg, void *arena,
                       size_t arena_bytes, const void *buf, size_t len, occ_io_info_t *info);
 
 /* Replace the content of an initialized `map` with the bytes, keeping its config and arena.
  * The file's resolution must equal map->cfg.resolution_m (as floats) and its depth the map's,
  * else OCC_ERR_ARG. .bt leaves get the map's clamp bounds. Errors as occ_io_load; on error the
- * map is unchanged. `info` may be NULL. O(len). */
+ * map is unchanged. `info` may be NULL. O(len). A shared map (occ_shared.h) publishes the
+ * new content as one version (never the cleared map in between). */
 occ_err_t occ_io_read(occ_map_t *map, const void *buf, size_t len, occ_io_info_t *info);
 
 /* Byte sink of the writers: consume `len` bytes (len > 0). Return OCC_OK, or an error that the

@@ -9,6 +9,7 @@
  *   occ_query.h      volumes, iterator, lookup, nearest obstacle, collision, castRay, info gain
  *   occ_io.h         OctoMap .bt/.ot and snapshot readers and writers, byte sinks
  *   occ_evict.h      eviction around the vehicle
+ *   occ_shared.h     one writer, many wait-free readers on views of published versions
  *
  * Front ends have their own headers (occ_sectors.h, occ_mavlink.h, occ_dronecan.h); occ_port.h
  * holds the platform hooks (clock, UART). Host-only APIs (files, scan readers, libccd, POSIX links,
@@ -22,5 +23,6 @@
 #include "occmap/occ_query.h"
 #include "occmap/occ_io.h"
 #include "occmap/occ_evict.h"
+#include "occmap/occ_shared.h"
 
 #endif /* OCC_OCCMAP_H_INCLUDED */

@@ -1,4 +1,5 @@
 /* map.c - configuration, init/clear, and the public coordinate <-> key calls (geom_internal.h). */
+#include "shared_internal.h"
 #include "tree_internal.h"
 
 occ_map_config_t occ_map_config_default(void)
@@ -58,6 +59,7 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
     map->arena_bytes = bytes - bytes % OCC_ARENA_ALIGN;
     map->priv.block_budget = (uint32_t)(map->arena_bytes / OCC_LEAF_BLOCK_BYTES);
     map->write_gen = 0u; /* occ_map_clear() makes it 1 */
+    map->priv.shared = NULL; /* a fresh map is not shared (occ_shared.h) */
     occ_map_clear(map);
     return OCC_OK;
 }
@@ -75,6 +77,7 @@ void occ_map_clear(occ_map_t *const map)
     map->priv.root_value = OCC_VALUE_UNOBSERVED;
     map->priv.root_flags = (uint8_t)OCC_NODE_HAS_UNKNOWN;
     map->write_gen++; /* every handle on the old content is stale */
+    occi_shared_written(map);
 }
 
 occ_err_t occ_map_key(const occ_map_t *const map, const occ_vec3_t p, occ_key_t *const key)

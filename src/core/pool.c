@@ -62,6 +62,7 @@ uint32_t occi_pool_alloc_inner(occ_map_t *const m)
         return OCC_NONE;
     }
     occ_inner_at(m, idx)->flags[7] = 0u;
+    occi_shared_touch(m, occ_inner_at(m, idx), sizeof(occ_inner_block_t)); /* the caller fills it */
     note_alloc(&m->inner);
     return idx;
 }
@@ -80,6 +81,7 @@ uint32_t occi_pool_alloc_leaf(occ_map_t *const m)
     } else {
         return OCC_NONE;
     }
+    occi_shared_touch(m, occ_leaf_at(m, idx), sizeof(occ_leaf_block_t)); /* the caller fills it */
     note_alloc(&m->leaf);
     return idx;
 }
@@ -95,6 +97,7 @@ bool occi_pool_free_inner(occ_map_t *const m, const uint32_t idx)
     }
     b->flags[7] = OCC_INNER_FREE_MARK;
     b->child[0] = m->inner.priv.free_head;
+    occi_shared_touch(m, b, sizeof *b);
     m->inner.priv.free_head = idx;
     m->inner.free_count++;
     m->inner.used--;
@@ -116,6 +119,7 @@ bool occi_pool_free_leaf(occ_map_t *const m, const uint32_t idx)
     }
 #endif
     memcpy(occ_leaf_at(m, idx)->value, &m->leaf.priv.free_head, sizeof(uint32_t));
+    occi_shared_touch(m, occ_leaf_at(m, idx), sizeof(occ_leaf_block_t));
     m->leaf.priv.free_head = idx;
     m->leaf.free_count++;
     m->leaf.used--;

@@ -5,6 +5,7 @@
  * assumed) and refuses with OCC_ERR_NOMEM before touching anything when the pools cannot supply
  * them. Pruning only ever frees, so the count is an upper bound.
  */
+#include "shared_internal.h"
 #include "tree_internal.h"
 
 /* ---- node helpers --------------------------------------------------------------------------- */
@@ -39,6 +40,7 @@ void occi_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned
             b->value[i] = v;
         }
         *node.child = idx;
+        occi_shared_touch(m, node.child, sizeof *node.child);
     } else {
         const uint32_t idx = occi_pool_alloc_inner(m);
         OCC_ASSERT(idx != OCC_NONE);
@@ -50,6 +52,7 @@ void occi_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned
             b->flags[i] = f;
         }
         *node.child = idx;
+        occi_shared_touch(m, node.child, sizeof *node.child);
     }
 }
 
@@ -94,6 +97,9 @@ bool occi_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigne
     const bool changed = prunable || !occ_value_eq(nv, *node.value) || nf != *node.flags;
     *node.value = nv;
     *node.flags = nf;
+    if (changed) {
+        occ_touch_node(m, node);
+    }
     return changed;
 }
 
@@ -107,6 +113,7 @@ void occi_tree_release_children(occ_map_t *const m, const occ_nodep_t node, cons
         const bool freed = occi_pool_free_leaf(m, *node.child);
         OCC_ASSERT(freed);
         *node.child = OCC_NONE;
+        occi_shared_touch(m, node.child, sizeof *node.child);
         return;
     }
     /* Iterative post-order over inner blocks; frame i holds the block whose children sit at
@@ -119,6 +126,7 @@ void occi_tree_release_children(occ_map_t *const m, const occ_nodep_t node, cons
     lvl[0] = (uint8_t)(level - 1u); /* level of the nodes inside blk[0] */
     next[0] = 0u;
     *node.child = OCC_NONE;
+    occi_shared_touch(m, node.child, sizeof *node.child);
     for (;;) {
         occ_inner_block_t *const b = occ_inner_at(m, blk[sp]);
         if (next[sp] < 8u) {
@@ -426,7 +434,9 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
             }
         }
         p.low = 1u;
-        occ_leaf_at(m, *p.node[1].child)->value[occ_code_slot(c, 1u)] = nv;
+        occ_value_t *const slot_v = &occ_leaf_at(m, *p.node[1].child)->value[occ_code_slot(c, 1u)];
+        *slot_v = nv;
+        occi_shared_touch(m, slot_v, sizeof *slot_v);
         p.dirty[1] = true;
         changed++;
     }
@@ -434,6 +444,7 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
     if (n_changed != NULL) {
         *n_changed = changed;
     }
+    occi_shared_written(m);
     return OCC_OK;
 }
 
@@ -557,11 +568,13 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
     unsigned first_dirty;
     if (level == 0u) {
         leaf->value[occ_code_slot(code, 1u)] = v;
+        occi_shared_touch(m, &leaf->value[occ_code_slot(code, 1u)], sizeof v);
         first_dirty = 1u;
     } else {
         occi_tree_release_children(m, p.node[level], level);
         *p.node[level].value = v;
         *p.node[level].flags = occ_value_flags(m, v);
+        occ_touch_node(m, p.node[level]);
         first_dirty = level + 1u;
     }
     for (unsigned k = first_dirty; k <= depth; k++) {
@@ -569,6 +582,7 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
             break;
         }
     }
+    occi_shared_written(m);
     return OCC_OK;
 }
 

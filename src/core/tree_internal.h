@@ -14,6 +14,7 @@
 
 #include "occmap/occmap.h"
 #include "../geom/geom_internal.h"
+#include "shared_internal.h"
 
 typedef struct {
     uint32_t child[8];
@@ -47,6 +48,15 @@ typedef struct {
     occ_value_t *value;
     uint8_t *flags;
 } occ_nodep_t;
+
+/* A shared map's snapshots need every block write (occ_shared.h): a node's three fields sit in
+ * three arrays of its block, so each is marked. Nothing but a NULL test when not shared. */
+static inline void occ_touch_node(occ_map_t *const m, const occ_nodep_t n)
+{
+    occi_shared_touch(m, n.child, sizeof *n.child);
+    occi_shared_touch(m, n.value, sizeof *n.value);
+    occi_shared_touch(m, n.flags, sizeof *n.flags);
+}
 
 /* A hint that a cache line will be read soon; nothing where the compiler has no such hint. */
 #if defined(__GNUC__)

@@ -15,6 +15,7 @@
 #include <float.h>
 #include <string.h>
 
+#include "../core/shared_internal.h"
 #include "../core/tree_internal.h"
 
 #define EVICT_SHRINK 0.75f    /* threshold factor per pass */
@@ -189,6 +190,7 @@ static void collapse(ctx_t *const x, const occ_nodep_t n, const unsigned level)
     occi_tree_release_children(m, n, level);
     *n.value = v;
     *n.flags = occ_value_flags(m, v);
+    occ_touch_node(m, n);
     x->evictions++;
 }
 
@@ -544,6 +546,7 @@ static occ_err_t evict(occ_map_t *const map, const occ_vec3_t *const center,
     }
     if (x.evictions != 0u) {
         map->write_gen++; /* collapses are this path's only writes: handles on the map are stale */
+        occi_shared_written(map);
     }
     out->priv.phase = sweep_on ? PHASE_RESUME : PHASE_IDLE;
     report(&x, end, sweep_on, inner_before, leaf_before, out);

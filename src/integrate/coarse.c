@@ -4,6 +4,7 @@
  * with children are updated through their subtree and refreshed bottom-up (iterative).
  */
 #include "coarse_internal.h"
+#include "../core/shared_internal.h"
 
 void occi_coarse_need(const occ_code_t *const codes, const size_t n, const unsigned level,
                       const unsigned depth, uint64_t *const inner, uint64_t *const leaf)
@@ -40,6 +41,7 @@ static void apply_uniform(occ_map_t *const m, const occ_nodep_t node, const occ_
 {
     *node.value = occ_value_apply_delta(m, *node.value, delta);
     *node.flags = occ_value_flags(m, *node.value);
+    occ_touch_node(m, node);
 }
 
 /* A node by where it lives: slot `slot` of inner block `block`, or the root (block OCC_NONE). */
@@ -75,6 +77,7 @@ static void apply_subtree(occ_map_t *const m, const uint32_t block, const unsign
             for (unsigned i = 0; i < 8u; i++) {
                 b->value[i] = occ_value_apply_delta(m, b->value[i], delta);
             }
+            occi_shared_touch(m, b, sizeof *b);
             (void)occi_tree_refresh(m, nd, 1u);
             sp--;
             continue;
@@ -142,6 +145,7 @@ size_t occi_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, cons
     }
     if (n > 0u) {
         refresh_path(m, blk, prev, level + 1u, depth, depth);
+        occi_shared_written(m);
     }
     return n;
 }

@@ -741,9 +741,14 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
     bool dense = false;
     const int rc = trace_scan(&x, params, points, n_points, &c, &bs, bricks, cbricks, &dense);
     occ_ictx_note(&x, x.n, 0);
+    /* A shared map publishes the scan's evictions, coarse and voxel updates as one version. */
+    const bool shared = map->priv.shared != NULL && occ_map_write_begin(map) == OCC_OK;
     e = rc < 0 || (x.cbs != NULL && cbs.overflow)
             ? OCC_ERR_SCRATCH
             : collapse_and_apply(&x, params, origin, dense, &bs, &cbs);
+    if (shared) {
+        (void)occ_map_write_end(map);
+    }
     r->scratch_used = touched_bytes(&x, params, dense ? bricks : 0u, cbricks);
     return e;
 }

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "io_internal.h"
+#include "../core/shared_internal.h"
 
 #define OM_DEPTH 16u
 
@@ -253,11 +254,17 @@ occ_err_t occ_io_read(occ_map_t *const map, const void *const buf, const size_t 
         inf->error = "resolution or depth differs from the map's";
         return OCC_ERR_ARG;
     }
+    /* The clear and the build happen on a copy that is not shared; a shared map publishes the
+     * result once, as one version (occ_shared.h), and nothing on NOMEM. */
     occ_map_t tmp = *map;
+    tmp.priv.shared = NULL;
     occ_map_clear(&tmp);
     e = build(&tmp, buf, len, inf);
     if (e == OCC_OK || e != OCC_ERR_NOMEM) {
-        *map = tmp;
+        occi_map_replace(map, &tmp);
+        if (map->priv.shared != NULL) {
+            occi_shared_rebuilt(map); /* built unmarked: every snapshot copies it whole */
+        }
     }
     return e;
 }
