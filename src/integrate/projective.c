@@ -126,6 +126,8 @@ static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OC
         return OCC_ERR_NOMEM;
     }
     const occ_value_t miss = occ_value_from_logodds(m->cfg.miss);
+    /* A shared map publishes the frame's coarse and voxel updates as one version. */
+    const bool shared = m->priv.shared != NULL && occ_map_write_begin(m) == OCC_OK;
     for (unsigned l = depth - 1u; l >= 1u; l--) {
         x->r->insert.coarse_updated +=
             occi_coarse_apply(m, g + start[l], x->per_level[l], l, miss);
@@ -136,6 +138,9 @@ static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OC
         e = occ_map_observe_codes(m, x->out, x->nh, &changed_hits);
     }
     OCC_ASSERT(e == OCC_OK); /* the check above covers both */
+    if (shared) {
+        (void)occ_map_write_end(m);
+    }
     x->r->insert.voxels_changed = changed + changed_hits;
     return e;
 }
