@@ -50,6 +50,7 @@ void run_args_usage(FILE *f)
         "Map and memory:\n"
         "  --res 0.1               voxel edge, metres (ignored with --map: the file's)\n"
         "  --arena-bytes 128M      the whole map's arena (K/M/G), allocated once\n"
+        "                          (plus two snapshot copies for the lock-free readers: 3x in all)\n"
         "  --keep-radius 3         when the arena is full, evict (robot-centric) outside this ball\n"
         "                          around the camera and retry; a frame that still does not fit is\n"
         "                          integrated in part (nearest pixels first: 1/2, 1/4, 1/8, 1/16 of\n"

@@ -131,7 +131,7 @@ void run_stats_line(run_link_t *l, uint64_t now, const char *key, bool map_check
     const char *const status = !l->ever_sent ? "boot" : l->stale ? "stale" : "active";
     fprintf(f, "{%s%s%s\"t_s\": %.3f, \"status\": \"%s\", \"version\": %u, ",
             key != NULL ? "\"" : "", key != NULL ? key : "", key != NULL ? "\": {" : "",
-            (double)(now - l->t0) / 1e6, status, l->guard->version);
+            (double)(now - l->t0) / 1e6, status, run_read_version(l->guard));
     (void)pthread_mutex_lock(&l->st->lock);
     print_mapping(f, l->st);
     print_clock(f, l, now);
