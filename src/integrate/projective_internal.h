@@ -29,6 +29,13 @@ typedef struct {
     uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];
     unsigned levels;
     float pn[4][3], pr[4][3]; /* the walk's side planes and their products with the map axes */
+    /* Per node level, the walk's constants (the same products test_node used to form per node):
+     * the edge vectors s r[a] (camera frame) and the side planes' positive parts s pr[p][a]. */
+    float side[OCC_MAX_DEPTH + 1u]; /* node edge length (m) */
+    float edge[OCC_MAX_DEPTH + 1u][3][3];
+    float plane_pos[OCC_MAX_DEPTH + 1u][4][3];
+    float tabs;             /* |t.x| + |t.y| + |t.z| */
+    float peps0;            /* 1e-5 (fx + fy + |cx| + |cy| + w + h) */
     occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
     uint32_t *hist;         /* the radix sort's histograms */
     /* The output: sorted hit codes (nh), then the walk's free voxel codes (nv) from out + nh,

@@ -68,17 +68,31 @@ static void planes_init(occ_proj_t *x)
             x->pr[p][a] = n[p][0] * k->r[a][0] + n[p][1] * k->r[a][1] + n[p][2] * k->r[a][2];
         }
     }
+    for (unsigned l = 0; l <= x->g.depth && l <= OCC_MAX_DEPTH; l++) {
+        const float s = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << l));
+        x->side[l] = s;
+        for (unsigned a = 0; a < 3u; a++) {
+            for (unsigned b = 0; b < 3u; b++) {
+                x->edge[l][a][b] = s * k->r[a][b];
+            }
+            for (unsigned p = 0; p < 4u; p++) {
+                x->plane_pos[l][p][a] = x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
+            }
+        }
+    }
+    x->tabs = fabsf(k->t.x) + fabsf(k->t.y) + fabsf(k->t.z);
+    x->peps0 = 1e-5f * (k->fx + k->fy + fabsf(k->cx) + fabsf(k->cy) + wf + hf);
 }
 
-/* Does the box (camera-frame corner q0, edge s) lie wholly outside one of the side planes? */
-static bool outside_planes(const occ_proj_t *x, const float q0[3], const float s,
+/* Does the box (camera-frame corner q0, level l) lie wholly outside one of the side planes?
+ * (The corner's plane value plus the positive edge parts, added in axis order.) */
+static bool outside_planes(const occ_proj_t *x, const float q0[3], const unsigned l,
                            const float peps)
 {
     for (unsigned p = 0; p < 4u; p++) {
-        float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2];
-        for (unsigned a = 0; a < 3u; a++) {
-            m += x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
-        }
+        const float *const c = x->plane_pos[l][p];
+        const float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2] + c[0] +
+                        c[1] + c[2];
         if (m < -peps) {
             return true;
         }
@@ -91,25 +105,36 @@ typedef struct {
     float umin, umax, vmin, vmax;
 } uv_t;
 
-static void footprint(const occ_proj_camera_t *k, const float q0[3], const float s, uv_t *f)
+static void corner_uv(const occ_proj_camera_t *k, const float q[3], uv_t *f)
 {
+    const float iz = 1.0f / q[2];
+    const float u = k->fx * (q[0] * iz) + k->cx, v = k->fy * (q[1] * iz) + k->cy;
+    f->umin = lo_of(f->umin, u);
+    f->umax = hi_of(f->umax, u);
+    f->vmin = lo_of(f->vmin, v);
+    f->vmax = hi_of(f->vmax, v);
+}
+
+/* Corner n is q0 + edge 0 (bit 0) + edge 1 (bit 1) + edge 2 (bit 2), summed in that order;
+ * shared partial sums, the same values as summing per corner. */
+static void footprint(const occ_proj_t *x, const float q0[3], const unsigned l, uv_t *f)
+{
+    const float(*const e)[3] = x->edge[l];
+    float c[8][3];
+    for (unsigned b = 0; b < 3u; b++) {
+        c[0][b] = q0[b];
+        c[1][b] = q0[b] + e[0][b];
+        c[2][b] = q0[b] + e[1][b];
+        c[3][b] = c[1][b] + e[1][b];
+        c[4][b] = q0[b] + e[2][b];
+        c[5][b] = c[1][b] + e[2][b];
+        c[6][b] = c[2][b] + e[2][b];
+        c[7][b] = c[3][b] + e[2][b];
+    }
     f->umin = f->vmin = INFINITY;
     f->umax = f->vmax = -INFINITY;
     for (unsigned n = 0; n < 8u; n++) {
-        float q[3] = {q0[0], q0[1], q0[2]};
-        for (unsigned a = 0; a < 3u; a++) {
-            if ((n >> a) & 1u) {
-                q[0] += s * k->r[a][0];
-                q[1] += s * k->r[a][1];
-                q[2] += s * k->r[a][2];
-            }
-        }
-        const float iz = 1.0f / q[2];
-        const float u = k->fx * (q[0] * iz) + k->cx, v = k->fy * (q[1] * iz) + k->cy;
-        f->umin = lo_of(f->umin, u);
-        f->umax = hi_of(f->umax, u);
-        f->vmin = lo_of(f->vmin, v);
-        f->vmax = hi_of(f->vmax, v);
+        corner_uv(x->cam, c[n], f);
     }
 }
 
@@ -150,10 +175,10 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
 {
     const occ_proj_camera_t *const cam = x->cam;
     x->r->nodes_tested++;
-    const float s = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << level));
+    const float s = x->side[level];
     const float lo[3] = {key_low(&x->g, k[0]), key_low(&x->g, k[1]), key_low(&x->g, k[2])};
     const float bd2 = box_dist2(cam, lo, s);
-    float mabs = fabsf(cam->t.x) + fabsf(cam->t.y) + fabsf(cam->t.z);
+    float mabs = x->tabs;
     for (unsigned a = 0; a < 3u; a++) {
         mabs += hi_of(fabsf(lo[a]), fabsf(lo[a] + s));
     }
@@ -166,14 +191,13 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     to_cam(cam, w, q0);
     float zmin = q0[2], zmax = q0[2];
     for (unsigned a = 0; a < 3u; a++) {
-        const float dz = s * cam->r[a][2];
+        const float dz = x->edge[level][a][2];
         zmin += dz < 0.0f ? dz : 0.0f;
         zmax += dz > 0.0f ? dz : 0.0f;
     }
-    const float peps = 1e-5f * (cam->fx + cam->fy + fabsf(cam->cx) + fabsf(cam->cy) +
-                                (float)x->im->width + (float)x->im->height) * (1.0f + mabs);
+    const float peps = x->peps0 * (1.0f + mabs);
     if (zmax < -eps || zmin > x->dmax + eps || zmin > cam->max_range_m + eps ||
-        outside_planes(x, q0, s, peps)) {
+        outside_planes(x, q0, level, peps)) {
         return NODE_SKIP; /* outside the frustum, or behind every reading */
     }
     f->zmin = zmin;
@@ -184,7 +208,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
         return NODE_MIXED; /* around the camera plane: no footprint */
     }
     uv_t c;
-    footprint(cam, q0, s, &c);
+    footprint(x, q0, level, &c);
     const float pad = 0.01f + (cam->fx + cam->fy) * eps / zmin;
     bool inside = true;
     if (!pix_range(c.umin, c.umax, pad, x->im->width, &f->i0, &f->i1, &inside) ||
@@ -203,13 +227,11 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     return NODE_MIXED;
 }
 
-/* The per-voxel rule (occ_integrate.h) for the voxel whose centre minus the camera position is
- * w (map frame, per axis: OctoMap's float centre - t). */
-static bool voxel_free(const occ_proj_t *x, const float w[3])
+/* The per-voxel rule (occ_integrate.h) for the voxel whose centre is q in the camera frame
+ * (q = R^T w, w its centre minus the camera position, map frame: OctoMap's float centre - t). */
+static bool voxel_free(const occ_proj_t *x, const float q[3])
 {
     const occ_proj_camera_t *const cam = x->cam;
-    float q[3];
-    to_cam(cam, w, q);
     if (!(q[2] > 0.0f)) {
         return false;
     }
@@ -269,10 +291,26 @@ static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t co
         wc[a][0] = occi_raygeo_center(&x->g, k[a]) - t[a];
         wc[a][1] = occi_raygeo_center(&x->g, k[a] | 1u) - t[a];
     }
+    /* q[b] = r[0][b] w[0] + r[1][b] w[1] + r[2][b] w[2] (to_cam's sum order), from the
+     * per-axis products and the shared partial sums of the first two */
+    float pr[3][2][3], p01[4][3];
+    for (unsigned a = 0; a < 3u; a++) {
+        for (unsigned c = 0; c < 2u; c++) {
+            for (unsigned b = 0; b < 3u; b++) {
+                pr[a][c][b] = cam->r[a][b] * wc[a][c];
+            }
+        }
+    }
+    for (unsigned s = 0; s < 4u; s++) {
+        for (unsigned b = 0; b < 3u; b++) {
+            p01[s][b] = pr[0][s & 1u][b] + pr[1][s >> 1][b];
+        }
+    }
     unsigned mask = 0;
     for (unsigned s = 0; s < 8u; s++) {
-        const float w[3] = {wc[0][s & 1u], wc[1][(s >> 1) & 1u], wc[2][(s >> 2) & 1u]};
-        mask |= voxel_free(x, w) ? 1u << s : 0u;
+        const float *const a01 = p01[s & 3u], *const a2 = pr[2][s >> 2];
+        const float q[3] = {a01[0] + a2[0], a01[1] + a2[1], a01[2] + a2[2]};
+        mask |= voxel_free(x, q) ? 1u << s : 0u;
     }
     if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
         emit_node(x, code, 1u);
