@@ -45,7 +45,7 @@ static bool end_point(const occ_proj_t *x, const uint32_t i, const uint32_t j, c
     const occ_proj_camera_t *const k = x->cam;
     float c[3];
     occ_proj_back(k, i, j, d, c);
-    if (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > x->max2) {
+    if (!(d * d < x->far2) && c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > x->max2) {
         return false; /* beyond max range: frees up to it, marks nothing */
     }
     p[0] = k->r[0][0] * c[0] + k->r[0][1] * c[1] + k->r[0][2] * c[2] + k->t.x;

@@ -24,6 +24,9 @@ typedef struct {
     float keep;             /* 1 - noise_rel */
     float m0;               /* margin at depth 0: half the voxel diagonal */
     float dmin, dmax;       /* smallest / largest depth with a reading (dmin > dmax: none) */
+    /* A depth d with near2 < d d < far2 back-projects (any pixel) to a squared range within
+     * [min2, max2] whatever the rounding: the exact range test can be skipped (the same answer). */
+    float near2, far2;
     float *d0;              /* level 0: depth per pixel, -INFINITY = no reading */
     float *mn[OCC_PROJ_MAX_LEVELS], *mx[OCC_PROJ_MAX_LEVELS]; /* levels >= 1 */
     uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];
