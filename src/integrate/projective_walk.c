@@ -204,8 +204,10 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     f->zmax = zmax;
     f->eps = eps;
     f->proj = zmin > eps;
-    if (!f->proj) {
-        return NODE_MIXED; /* around the camera plane: no footprint */
+    if (!f->proj || level == 1u) {
+        /* around the camera plane: no footprint. Level 1: its 8 voxel decisions cost less than
+         * the footprint and pyramid query (all 8 free: the same whole node, none: nothing) */
+        return NODE_MIXED;
     }
     uv_t c;
     footprint(x, q0, level, &c);
