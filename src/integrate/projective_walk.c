@@ -19,11 +19,12 @@ static inline float hi_of(const float a, const float b)
 enum { NODE_SKIP, NODE_FREE, NODE_MIXED };
 
 /* A node's projection: footprint pixels (clamped; valid when `proj`), camera depth range and
- * the rounding slack used for it. */
+ * the rounding slack used for it; cap: no pixel any voxel of the node projects to has a depth
+ * above it (the pyramid's max over the footprint, else the parent's cap). */
 typedef struct {
     uint32_t i0, i1, j0, j1;
     bool proj;
-    float zmin, zmax, eps;
+    float zmin, zmax, eps, cap;
 } foot_t;
 
 /* Map-frame coordinate of key k's lower face. */
@@ -170,8 +171,10 @@ static bool pix_range(const float a, const float b, const float pad, const uint3
 }
 
 /* Classify the node at `level` whose first voxel has key k: SKIP (every voxel below unchanged
- * and no end point in it), FREE (every voxel below free, no end point in it) or MIXED. */
-static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, foot_t *f)
+ * and no end point in it), FREE (every voxel below free, no end point in it) or MIXED. cap:
+ * the parent's (its footprint holds this node's: a node nearer than it is behind it all). */
+static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, const float cap,
+                     foot_t *f)
 {
     const occ_proj_camera_t *const cam = x->cam;
     x->r->nodes_tested++;
@@ -196,7 +199,8 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
         zmax += dz > 0.0f ? dz : 0.0f;
     }
     const float peps = x->peps0 * (1.0f + mabs);
-    if (zmax < -eps || zmin > x->dmax + eps || zmin > cam->max_range_m + eps ||
+    f->cap = cap;
+    if (zmax < -eps || zmin > cap + eps || zmin > cam->max_range_m + eps ||
         outside_planes(x, q0, level, peps)) {
         return NODE_SKIP; /* outside the frustum, or behind every reading */
     }
@@ -222,6 +226,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     if (zmin > mx + eps) {
         return NODE_SKIP;
     }
+    f->cap = lo_of(mx, cap);
     if (inside && zmax + eps < occ_proj_front(x, mn) &&
         far_dist2(cam, lo, s) + eps * (1.0f + cam->max_range_m) <= x->max2) {
         return NODE_FREE;
@@ -231,11 +236,11 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
 
 /* The per-voxel rule (occ_integrate.h) for the voxel whose centre is q in the camera frame
  * (q = R^T w, w its centre minus the camera position, map frame: OctoMap's float centre - t). */
-static bool voxel_free(const occ_proj_t *x, const float q[3])
+static bool voxel_free(const occ_proj_t *x, const float q[3], const float zcap)
 {
     const occ_proj_camera_t *const cam = x->cam;
-    if (!(q[2] > 0.0f)) {
-        return false;
+    if (!(q[2] > 0.0f) || !(q[2] < zcap)) {
+        return false; /* behind the camera, or not in front of any depth it can project to */
     }
     const float u = cam->fx * (q[0] / q[2]) + cam->cx + 0.5f;
     const float v = cam->fy * (q[1] / q[2]) + cam->cy + 0.5f;
@@ -282,10 +287,11 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
 }
 
 /* The 8 voxels of a MIXED level-1 node, free or not by the rule (hits are occi_proj_hits');
- * all 8 free: one whole level-1 node (the same updates, fewer slots). */
+ * all 8 free: one whole level-1 node (the same updates, fewer slots). cap: foot_t's. */
 static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
-                         const bool may_merge)
+                         const bool may_merge, const float cap)
 {
+    const float zcap = occ_proj_front(x, cap); /* front() is monotone in the depth */
     const occ_proj_camera_t *const cam = x->cam;
     const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
     float wc[3][2]; /* per axis the two voxel centres' offsets from the camera */
@@ -312,7 +318,7 @@ static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t co
     for (unsigned s = 0; s < 8u; s++) {
         const float *const a01 = p01[s & 3u], *const a2 = pr[2][s >> 2];
         const float q[3] = {a01[0] + a2[0], a01[1] + a2[1], a01[2] + a2[2]};
-        mask |= voxel_free(x, q) ? 1u << s : 0u;
+        mask |= voxel_free(x, q, zcap) ? 1u << s : 0u;
     }
     if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
         emit_node(x, code, 1u);
@@ -331,20 +337,22 @@ void occi_proj_walk(occ_proj_t *const x)
     struct {
         uint32_t k[3];
         occ_code_t code;
+        float cap;
         uint8_t level, next;
     } st[OCC_MAX_DEPTH + 1u];
     foot_t f;
     planes_init(x);
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
-        if (test_node(x, k0, 1u, &f) != NODE_SKIP) {
-            visit_voxels(x, k0, 0u, false); /* the root is no coarse node */
+        if (test_node(x, k0, 1u, x->dmax, &f) != NODE_SKIP) {
+            visit_voxels(x, k0, 0u, false, f.cap); /* the root is no coarse node */
         }
         return;
     }
     unsigned sp = 1;
     st[0].k[0] = st[0].k[1] = st[0].k[2] = 0u;
     st[0].code = 0u;
+    st[0].cap = x->dmax;
     st[0].level = (uint8_t)depth;
     st[0].next = 0u;
     while (sp > 0u && !x->overflow) {
@@ -358,7 +366,7 @@ void occi_proj_walk(occ_proj_t *const x)
         const uint32_t k[3] = {st[t].k[0] | ((s & 1u) << l), st[t].k[1] | (((s >> 1) & 1u) << l),
                                st[t].k[2] | (((s >> 2) & 1u) << l)};
         const occ_code_t code = st[t].code | ((occ_code_t)s << (3u * l));
-        int cls = test_node(x, k, l, &f);
+        int cls = test_node(x, k, l, st[t].cap, &f);
         if (cls == NODE_FREE && holds_hit(x, code, l)) {
             cls = NODE_MIXED; /* hits win: not expected (a free node is in front of every end
                                * point of its footprint), kept exact by descending */
@@ -366,13 +374,14 @@ void occi_proj_walk(occ_proj_t *const x)
         if (cls == NODE_FREE) {
             emit_node(x, code, l);
         } else if (cls == NODE_MIXED && l == 1u) {
-            visit_voxels(x, k, code, true);
+            visit_voxels(x, k, code, true, f.cap);
         } else if (cls == NODE_MIXED) {
             OCC_ASSERT(sp <= OCC_MAX_DEPTH);
             st[sp].k[0] = k[0];
             st[sp].k[1] = k[1];
             st[sp].k[2] = k[2];
             st[sp].code = code;
+            st[sp].cap = f.cap;
             st[sp].level = (uint8_t)l;
             st[sp].next = 0u;
             sp++;
