@@ -38,6 +38,7 @@ typedef struct {
     float edge[OCC_MAX_DEPTH + 1u][3][3];
     float plane_pos[OCC_MAX_DEPTH + 1u][4][3];
     float tabs;             /* |t.x| + |t.y| + |t.z| */
+    float wf, hf;           /* image width and height as floats (exact) */
     float peps0;            /* 1e-5 (fx + fy + |cx| + |cy| + w + h) */
     occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
     uint32_t *hist;         /* the radix sort's histograms */

@@ -82,6 +82,8 @@ static void planes_init(occ_proj_t *x)
         }
     }
     x->tabs = fabsf(k->t.x) + fabsf(k->t.y) + fabsf(k->t.z);
+    x->wf = wf;
+    x->hf = hf;
     x->peps0 = 1e-5f * (k->fx + k->fy + fabsf(k->cx) + fabsf(k->cy) + wf + hf);
 }
 
@@ -244,7 +246,7 @@ static bool voxel_free(const occ_proj_t *x, const float q[3], const float zcap)
     }
     const float u = cam->fx * (q[0] / q[2]) + cam->cx + 0.5f;
     const float v = cam->fy * (q[1] / q[2]) + cam->cy + 0.5f;
-    if (!(u >= 0.0f && u < (float)x->im->width && v >= 0.0f && v < (float)x->im->height)) {
+    if (!(u >= 0.0f && u < x->wf && v >= 0.0f && v < x->hf)) {
         return false;
     }
     /* u, v >= 0: truncation is floor */
