@@ -15,9 +15,38 @@ static size_t filter_slot(const occ_code_t c)
  * strictly inside has that key whatever the key arithmetic's rounding). */
 typedef struct {
     occ_code_t code;
+    uint32_t k[3];
     float lo[3], hi[3];
     bool valid;
 } last_voxel_t;
+
+/* Morton code bits of axis 0 (axis a: shifted by a). */
+#define MORTON_AXIS0 0x1249249249249249ull
+
+/* The code of key k (with the hit bit): from the last voxel's code when each axis moved by at
+ * most one (masked add / subtract on that axis' bits, the same code), else the full encode. */
+static occ_code_t code_of(const last_voxel_t *v, const uint32_t k[3])
+{
+    if (v->valid) {
+        occ_code_t c = v->code;
+        unsigned a = 0;
+        for (; a < 3u; a++) {
+            const occ_code_t m = (occ_code_t)MORTON_AXIS0 << a, one = (occ_code_t)1 << a;
+            if (k[a] == v->k[a] + 1u) {
+                c = (((c | ~m) + one) & m) | (c & ~m);
+            } else if (k[a] + 1u == v->k[a]) {
+                c = (((c & m) - one) & m) | (c & ~m);
+            } else if (k[a] != v->k[a]) {
+                break;
+            }
+        }
+        if (a == 3u) {
+            return c;
+        }
+    }
+    const occ_key_t key = {{k[0], k[1], k[2]}};
+    return occ_morton_encode(key) | OCC_CODE_HIT_BIT;
+}
 
 static bool in_last(const last_voxel_t *v, const float p[3])
 {
@@ -35,6 +64,9 @@ static void set_last(const occ_proj_t *x, const uint32_t k[3], const occ_code_t 
         v->hi[a] = lo + (float)x->g.res - m;
     }
     v->code = code;
+    v->k[0] = k[0];
+    v->k[1] = k[1];
+    v->k[2] = k[2];
     v->valid = true;
 }
 
@@ -45,7 +77,7 @@ static bool end_point(const occ_proj_t *x, const uint32_t i, const uint32_t j, c
     const occ_proj_camera_t *const k = x->cam;
     float c[3];
     occ_proj_back(k, i, j, d, c);
-    if (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > x->max2) {
+    if (!(d * d < x->far2) && c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > x->max2) {
         return false; /* beyond max range: frees up to it, marks nothing */
     }
     p[0] = k->r[0][0] * c[0] + k->r[0][1] * c[1] + k->r[0][2] * c[2] + k->t.x;
@@ -61,7 +93,7 @@ bool occi_proj_hits(occ_proj_t *const x)
     for (size_t i = 0; i < OCC_PROJ_FILTER_N; i++) {
         filt[i] = 0u; /* a hit code always has bit 63: 0 is never one */
     }
-    last_voxel_t last = {0u, {0}, {0}, false};
+    last_voxel_t last = {0u, {0}, {0}, {0}, false};
     size_t n = 0;
     for (uint32_t j = 0; j < h; j++) {
         const float *const row = x->d0 + (size_t)j * w;
@@ -75,8 +107,9 @@ bool occi_proj_hits(occ_proj_t *const x)
                 x->r->insert.points_skipped++; /* outside the map */
                 continue;
             }
-            const occ_key_t key = {{kk[0], kk[1], kk[2]}};
-            const occ_code_t code = occ_morton_encode(key) | OCC_CODE_HIT_BIT;
+            const occ_code_t code = code_of(&last, kk);
+            const occ_key_t key = {{kk[0], kk[1], kk[2]}}; /* the check's only (tests) */
+            OCC_ASSERT(code == (occ_morton_encode(key) | OCC_CODE_HIT_BIT));
             set_last(x, kk, code, &last);
             const size_t s = filter_slot(code);
             if (filt[s] == code) {

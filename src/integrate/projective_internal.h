@@ -24,11 +24,22 @@ typedef struct {
     float keep;             /* 1 - noise_rel */
     float m0;               /* margin at depth 0: half the voxel diagonal */
     float dmin, dmax;       /* smallest / largest depth with a reading (dmin > dmax: none) */
+    /* A depth d with near2 < d d < far2 back-projects (any pixel) to a squared range within
+     * [min2, max2] whatever the rounding: the exact range test can be skipped (the same answer). */
+    float near2, far2;
     float *d0;              /* level 0: depth per pixel, -INFINITY = no reading */
     float *mn[OCC_PROJ_MAX_LEVELS], *mx[OCC_PROJ_MAX_LEVELS]; /* levels >= 1 */
     uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];
     unsigned levels;
     float pn[4][3], pr[4][3]; /* the walk's side planes and their products with the map axes */
+    /* Per node level, the walk's constants (the same products test_node used to form per node):
+     * the edge vectors s r[a] (camera frame) and the side planes' positive parts s pr[p][a]. */
+    float side[OCC_MAX_DEPTH + 1u]; /* node edge length (m) */
+    float edge[OCC_MAX_DEPTH + 1u][3][3];
+    float plane_pos[OCC_MAX_DEPTH + 1u][4][3];
+    float tabs;             /* |t.x| + |t.y| + |t.z| */
+    float wf, hf;           /* image width and height as floats (exact) */
+    float peps0;            /* 1e-5 (fx + fy + |cx| + |cy| + w + h) */
     occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
     uint32_t *hist;         /* the radix sort's histograms */
     /* The output: sorted hit codes (nh), then the walk's free voxel codes (nv) from out + nh,

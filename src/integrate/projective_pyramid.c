@@ -53,6 +53,20 @@ static float raw_depth(const occ_proj_t *x, const uint32_t i, const uint32_t j)
     return d;
 }
 
+/* near2, far2: |c|^2 <= d^2 (1 + (A / fx)^2 + (B / fy)^2) with A, B the largest pixel offsets
+ * from the principal point, and |c|^2 >= d^2 (c[2] = d); a 1 % margin covers every rounding
+ * (relative 1e-6 here). Non-finite bounds only make the tests fail: the exact path then. */
+static void sure_range(occ_proj_t *x)
+{
+    const occ_proj_camera_t *const k = x->cam;
+    const float a0 = fabsf(k->cx), a1 = fabsf((float)(x->im->width - 1u) - k->cx);
+    const float b0 = fabsf(k->cy), b1 = fabsf((float)(x->im->height - 1u) - k->cy);
+    const float a = hi_of(a0, a1) / k->fx, b = hi_of(b0, b1) / k->fy;
+    const float kk = (1.0f + a * a + b * b) * 1.01f;
+    x->far2 = 0.99f * (x->max2 / kk);
+    x->near2 = 1.01f * x->min2;
+}
+
 /* Level 0: the depth of every pixel with a usable reading, -inf otherwise; counters. */
 static void fill_level0(occ_proj_t *x)
 {
@@ -67,6 +81,13 @@ static void fill_level0(occ_proj_t *x)
             *slot = -INFINITY;
             if (!(d > 0.0f)) {
                 r->pixels_no_reading++;
+                continue;
+            }
+            const float dd = d * d;
+            if (dd > x->near2 && dd < x->far2) {
+                *slot = d; /* within range for sure: no back-projection */
+                x->dmin = d < x->dmin ? d : x->dmin;
+                x->dmax = d > x->dmax ? d : x->dmax;
                 continue;
             }
             float c[3];
@@ -110,6 +131,7 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
 {
     const uint32_t w = x->im->width, h = x->im->height;
     x->d0 = mem;
+    sure_range(x);
     fill_level0(x);
     x->mn[0] = x->d0;
     x->mx[0] = x->d0;

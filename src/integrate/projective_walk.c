@@ -19,11 +19,12 @@ static inline float hi_of(const float a, const float b)
 enum { NODE_SKIP, NODE_FREE, NODE_MIXED };
 
 /* A node's projection: footprint pixels (clamped; valid when `proj`), camera depth range and
- * the rounding slack used for it. */
+ * the rounding slack used for it; cap: no pixel any voxel of the node projects to has a depth
+ * above it (the pyramid's max over the footprint, else the parent's cap). */
 typedef struct {
     uint32_t i0, i1, j0, j1;
     bool proj;
-    float zmin, zmax, eps;
+    float zmin, zmax, eps, cap;
 } foot_t;
 
 /* Map-frame coordinate of key k's lower face. */
@@ -68,17 +69,33 @@ static void planes_init(occ_proj_t *x)
             x->pr[p][a] = n[p][0] * k->r[a][0] + n[p][1] * k->r[a][1] + n[p][2] * k->r[a][2];
         }
     }
+    for (unsigned l = 0; l <= x->g.depth && l <= OCC_MAX_DEPTH; l++) {
+        const float s = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << l));
+        x->side[l] = s;
+        for (unsigned a = 0; a < 3u; a++) {
+            for (unsigned b = 0; b < 3u; b++) {
+                x->edge[l][a][b] = s * k->r[a][b];
+            }
+            for (unsigned p = 0; p < 4u; p++) {
+                x->plane_pos[l][p][a] = x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
+            }
+        }
+    }
+    x->tabs = fabsf(k->t.x) + fabsf(k->t.y) + fabsf(k->t.z);
+    x->wf = wf;
+    x->hf = hf;
+    x->peps0 = 1e-5f * (k->fx + k->fy + fabsf(k->cx) + fabsf(k->cy) + wf + hf);
 }
 
-/* Does the box (camera-frame corner q0, edge s) lie wholly outside one of the side planes? */
-static bool outside_planes(const occ_proj_t *x, const float q0[3], const float s,
+/* Does the box (camera-frame corner q0, level l) lie wholly outside one of the side planes?
+ * (The corner's plane value plus the positive edge parts, added in axis order.) */
+static bool outside_planes(const occ_proj_t *x, const float q0[3], const unsigned l,
                            const float peps)
 {
     for (unsigned p = 0; p < 4u; p++) {
-        float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2];
-        for (unsigned a = 0; a < 3u; a++) {
-            m += x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
-        }
+        const float *const c = x->plane_pos[l][p];
+        const float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2] + c[0] +
+                        c[1] + c[2];
         if (m < -peps) {
             return true;
         }
@@ -91,25 +108,36 @@ typedef struct {
     float umin, umax, vmin, vmax;
 } uv_t;
 
-static void footprint(const occ_proj_camera_t *k, const float q0[3], const float s, uv_t *f)
+static void corner_uv(const occ_proj_camera_t *k, const float q[3], uv_t *f)
 {
+    const float iz = 1.0f / q[2];
+    const float u = k->fx * (q[0] * iz) + k->cx, v = k->fy * (q[1] * iz) + k->cy;
+    f->umin = lo_of(f->umin, u);
+    f->umax = hi_of(f->umax, u);
+    f->vmin = lo_of(f->vmin, v);
+    f->vmax = hi_of(f->vmax, v);
+}
+
+/* Corner n is q0 + edge 0 (bit 0) + edge 1 (bit 1) + edge 2 (bit 2), summed in that order;
+ * shared partial sums, the same values as summing per corner. */
+static void footprint(const occ_proj_t *x, const float q0[3], const unsigned l, uv_t *f)
+{
+    const float(*const e)[3] = x->edge[l];
+    float c[8][3];
+    for (unsigned b = 0; b < 3u; b++) {
+        c[0][b] = q0[b];
+        c[1][b] = q0[b] + e[0][b];
+        c[2][b] = q0[b] + e[1][b];
+        c[3][b] = c[1][b] + e[1][b];
+        c[4][b] = q0[b] + e[2][b];
+        c[5][b] = c[1][b] + e[2][b];
+        c[6][b] = c[2][b] + e[2][b];
+        c[7][b] = c[3][b] + e[2][b];
+    }
     f->umin = f->vmin = INFINITY;
     f->umax = f->vmax = -INFINITY;
     for (unsigned n = 0; n < 8u; n++) {
-        float q[3] = {q0[0], q0[1], q0[2]};
-        for (unsigned a = 0; a < 3u; a++) {
-            if ((n >> a) & 1u) {
-                q[0] += s * k->r[a][0];
-                q[1] += s * k->r[a][1];
-                q[2] += s * k->r[a][2];
-            }
-        }
-        const float iz = 1.0f / q[2];
-        const float u = k->fx * (q[0] * iz) + k->cx, v = k->fy * (q[1] * iz) + k->cy;
-        f->umin = lo_of(f->umin, u);
-        f->umax = hi_of(f->umax, u);
-        f->vmin = lo_of(f->vmin, v);
-        f->vmax = hi_of(f->vmax, v);
+        corner_uv(x->cam, c[n], f);
     }
 }
 
@@ -145,15 +173,17 @@ static bool pix_range(const float a, const float b, const float pad, const uint3
 }
 
 /* Classify the node at `level` whose first voxel has key k: SKIP (every voxel below unchanged
- * and no end point in it), FREE (every voxel below free, no end point in it) or MIXED. */
-static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, foot_t *f)
+ * and no end point in it), FREE (every voxel below free, no end point in it) or MIXED. cap:
+ * the parent's (its footprint holds this node's: a node nearer than it is behind it all). */
+static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, const float cap,
+                     foot_t *f)
 {
     const occ_proj_camera_t *const cam = x->cam;
     x->r->nodes_tested++;
-    const float s = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << level));
+    const float s = x->side[level];
     const float lo[3] = {key_low(&x->g, k[0]), key_low(&x->g, k[1]), key_low(&x->g, k[2])};
     const float bd2 = box_dist2(cam, lo, s);
-    float mabs = fabsf(cam->t.x) + fabsf(cam->t.y) + fabsf(cam->t.z);
+    float mabs = x->tabs;
     for (unsigned a = 0; a < 3u; a++) {
         mabs += hi_of(fabsf(lo[a]), fabsf(lo[a] + s));
     }
@@ -166,25 +196,27 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     to_cam(cam, w, q0);
     float zmin = q0[2], zmax = q0[2];
     for (unsigned a = 0; a < 3u; a++) {
-        const float dz = s * cam->r[a][2];
+        const float dz = x->edge[level][a][2];
         zmin += dz < 0.0f ? dz : 0.0f;
         zmax += dz > 0.0f ? dz : 0.0f;
     }
-    const float peps = 1e-5f * (cam->fx + cam->fy + fabsf(cam->cx) + fabsf(cam->cy) +
-                                (float)x->im->width + (float)x->im->height) * (1.0f + mabs);
-    if (zmax < -eps || zmin > x->dmax + eps || zmin > cam->max_range_m + eps ||
-        outside_planes(x, q0, s, peps)) {
+    const float peps = x->peps0 * (1.0f + mabs);
+    f->cap = cap;
+    if (zmax < -eps || zmin > cap + eps || zmin > cam->max_range_m + eps ||
+        outside_planes(x, q0, level, peps)) {
         return NODE_SKIP; /* outside the frustum, or behind every reading */
     }
     f->zmin = zmin;
     f->zmax = zmax;
     f->eps = eps;
     f->proj = zmin > eps;
-    if (!f->proj) {
-        return NODE_MIXED; /* around the camera plane: no footprint */
+    if (!f->proj || level == 1u) {
+        /* around the camera plane: no footprint. Level 1: its 8 voxel decisions cost less than
+         * the footprint and pyramid query (all 8 free: the same whole node, none: nothing) */
+        return NODE_MIXED;
     }
     uv_t c;
-    footprint(cam, q0, s, &c);
+    footprint(x, q0, level, &c);
     const float pad = 0.01f + (cam->fx + cam->fy) * eps / zmin;
     bool inside = true;
     if (!pix_range(c.umin, c.umax, pad, x->im->width, &f->i0, &f->i1, &inside) ||
@@ -196,6 +228,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     if (zmin > mx + eps) {
         return NODE_SKIP;
     }
+    f->cap = lo_of(mx, cap);
     if (inside && zmax + eps < occ_proj_front(x, mn) &&
         far_dist2(cam, lo, s) + eps * (1.0f + cam->max_range_m) <= x->max2) {
         return NODE_FREE;
@@ -203,19 +236,17 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, f
     return NODE_MIXED;
 }
 
-/* The per-voxel rule (occ_integrate.h) for the voxel whose centre minus the camera position is
- * w (map frame, per axis: OctoMap's float centre - t). */
-static bool voxel_free(const occ_proj_t *x, const float w[3])
+/* The per-voxel rule (occ_integrate.h) for the voxel whose centre is q in the camera frame
+ * (q = R^T w, w its centre minus the camera position, map frame: OctoMap's float centre - t). */
+static bool voxel_free(const occ_proj_t *x, const float q[3], const float zcap)
 {
     const occ_proj_camera_t *const cam = x->cam;
-    float q[3];
-    to_cam(cam, w, q);
-    if (!(q[2] > 0.0f)) {
-        return false;
+    if (!(q[2] > 0.0f) || !(q[2] < zcap)) {
+        return false; /* behind the camera, or not in front of any depth it can project to */
     }
     const float u = cam->fx * (q[0] / q[2]) + cam->cx + 0.5f;
     const float v = cam->fy * (q[1] / q[2]) + cam->cy + 0.5f;
-    if (!(u >= 0.0f && u < (float)x->im->width && v >= 0.0f && v < (float)x->im->height)) {
+    if (!(u >= 0.0f && u < x->wf && v >= 0.0f && v < x->hf)) {
         return false;
     }
     /* u, v >= 0: truncation is floor */
@@ -258,10 +289,11 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
 }
 
 /* The 8 voxels of a MIXED level-1 node, free or not by the rule (hits are occi_proj_hits');
- * all 8 free: one whole level-1 node (the same updates, fewer slots). */
+ * all 8 free: one whole level-1 node (the same updates, fewer slots). cap: foot_t's. */
 static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
-                         const bool may_merge)
+                         const bool may_merge, const float cap)
 {
+    const float zcap = occ_proj_front(x, cap); /* front() is monotone in the depth */
     const occ_proj_camera_t *const cam = x->cam;
     const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
     float wc[3][2]; /* per axis the two voxel centres' offsets from the camera */
@@ -269,10 +301,26 @@ static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t co
         wc[a][0] = occi_raygeo_center(&x->g, k[a]) - t[a];
         wc[a][1] = occi_raygeo_center(&x->g, k[a] | 1u) - t[a];
     }
+    /* q[b] = r[0][b] w[0] + r[1][b] w[1] + r[2][b] w[2] (to_cam's sum order), from the
+     * per-axis products and the shared partial sums of the first two */
+    float pr[3][2][3], p01[4][3];
+    for (unsigned a = 0; a < 3u; a++) {
+        for (unsigned c = 0; c < 2u; c++) {
+            for (unsigned b = 0; b < 3u; b++) {
+                pr[a][c][b] = cam->r[a][b] * wc[a][c];
+            }
+        }
+    }
+    for (unsigned s = 0; s < 4u; s++) {
+        for (unsigned b = 0; b < 3u; b++) {
+            p01[s][b] = pr[0][s & 1u][b] + pr[1][s >> 1][b];
+        }
+    }
     unsigned mask = 0;
     for (unsigned s = 0; s < 8u; s++) {
-        const float w[3] = {wc[0][s & 1u], wc[1][(s >> 1) & 1u], wc[2][(s >> 2) & 1u]};
-        mask |= voxel_free(x, w) ? 1u << s : 0u;
+        const float *const a01 = p01[s & 3u], *const a2 = pr[2][s >> 2];
+        const float q[3] = {a01[0] + a2[0], a01[1] + a2[1], a01[2] + a2[2]};
+        mask |= voxel_free(x, q, zcap) ? 1u << s : 0u;
     }
     if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
         emit_node(x, code, 1u);
@@ -291,20 +339,22 @@ void occi_proj_walk(occ_proj_t *const x)
     struct {
         uint32_t k[3];
         occ_code_t code;
+        float cap;
         uint8_t level, next;
     } st[OCC_MAX_DEPTH + 1u];
     foot_t f;
     planes_init(x);
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
-        if (test_node(x, k0, 1u, &f) != NODE_SKIP) {
-            visit_voxels(x, k0, 0u, false); /* the root is no coarse node */
+        if (test_node(x, k0, 1u, x->dmax, &f) != NODE_SKIP) {
+            visit_voxels(x, k0, 0u, false, f.cap); /* the root is no coarse node */
         }
         return;
     }
     unsigned sp = 1;
     st[0].k[0] = st[0].k[1] = st[0].k[2] = 0u;
     st[0].code = 0u;
+    st[0].cap = x->dmax;
     st[0].level = (uint8_t)depth;
     st[0].next = 0u;
     while (sp > 0u && !x->overflow) {
@@ -318,7 +368,7 @@ void occi_proj_walk(occ_proj_t *const x)
         const uint32_t k[3] = {st[t].k[0] | ((s & 1u) << l), st[t].k[1] | (((s >> 1) & 1u) << l),
                                st[t].k[2] | (((s >> 2) & 1u) << l)};
         const occ_code_t code = st[t].code | ((occ_code_t)s << (3u * l));
-        int cls = test_node(x, k, l, &f);
+        int cls = test_node(x, k, l, st[t].cap, &f);
         if (cls == NODE_FREE && holds_hit(x, code, l)) {
             cls = NODE_MIXED; /* hits win: not expected (a free node is in front of every end
                                * point of its footprint), kept exact by descending */
@@ -326,13 +376,14 @@ void occi_proj_walk(occ_proj_t *const x)
         if (cls == NODE_FREE) {
             emit_node(x, code, l);
         } else if (cls == NODE_MIXED && l == 1u) {
-            visit_voxels(x, k, code, true);
+            visit_voxels(x, k, code, true, f.cap);
         } else if (cls == NODE_MIXED) {
             OCC_ASSERT(sp <= OCC_MAX_DEPTH);
             st[sp].k[0] = k[0];
             st[sp].k[1] = k[1];
             st[sp].k[2] = k[2];
             st[sp].code = code;
+            st[sp].cap = f.cap;
             st[sp].level = (uint8_t)l;
             st[sp].next = 0u;
             sp++;
