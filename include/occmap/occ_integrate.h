@@ -257,16 +257,17 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * is unchanged.
  *
  * Scratch (caller's, any alignment): a fixed part (OCC_PROJ_FIXED_BYTES: alignment, an 8 KiB
- * repeat filter for end points, the radix sort's histograms), 4 bytes per pixel (the depths),
- * 8 bytes per pyramid cell (min and max, levels 1.. of halved sides: at most
- * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells) and the output, in 8-byte slots: the end
+ * repeat filter for end points, the radix sort's histograms, 2 KiB of per-level constants of
+ * the walk, kept off the stack), 4 bytes per pixel (the depths), 8 bytes per pyramid cell
+ * (min and max, levels 1.. of halved sides: at most OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells) and the output, in 8-byte slots: the end
  * points' codes after the repeat filter (twice while they are sorted), then one per voxel
  * update and two per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it for n_out
  * slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers the TUM frames in
  * `make bench` (measured at most 0.47 slots per pixel: the pioneer frames at 0.05 m, every pixel
  * a hit; bench/projective.cpp prints what they used) and an 8x8 ToF array at 0.05 m to 3 m
- * (tests/test_projective.c). For 640 x 480 the whole formula is 11.3 bytes per pixel. A frame that needs more slots is refused with OCC_ERR_SCRATCH
- * (map unchanged): pass more. out->insert.scratch_used says what a call used.
+ * (tests/test_projective.c). For 640 x 480 the whole formula is 11.3 bytes per
+ * pixel. A frame that needs more slots is refused with OCC_ERR_SCRATCH (map unchanged): pass
+ * more. out->insert.scratch_used says what a call used.
  *
  * Work, bounded per call: O(pixels) for the pyramid; the walk tests a node in O(1) (8 corner
  * projections, at most 4 pyramid cells) and descends only where its answer is mixed, so it
@@ -276,8 +277,10 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * voxels, not pixels x ray length. Stack: O(D), no recursion. */
 #define OCC_PROJ_CELLS(w, h) \
     ((size_t)(w) * (size_t)(h) / 3u + (size_t)(w) + (size_t)(h) + 20u)
+#define OCC_PROJ_LEVELS_BYTES 2048u /* the walk's per-level constants (kept off the stack) */
 #define OCC_PROJ_FIXED_BYTES                                                               \
-    (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u)
+    (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u + \
+     OCC_PROJ_LEVELS_BYTES)
 #define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                               \
     (OCC_PROJ_FIXED_BYTES + 8u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
      8u * (size_t)(n_out))

@@ -53,6 +53,10 @@ static bool camera_ok(const occ_proj_camera_t *k)
     return isfinite(t.x) && isfinite(t.y) && isfinite(t.z) && rotation_ok(k->r);
 }
 
+/* The per-level tables live in the scratch's fixed part (OCC_PROJ_FIXED_BYTES counts
+ * OCC_PROJ_LEVELS_BYTES for them): a C99 static assertion that they fit. */
+typedef char occ_proj_levels_fit[sizeof(occ_proj_levels_t) <= OCC_PROJ_LEVELS_BYTES ? 1 : -1];
+
 /* Carve the scratch: the filter and the sort's histograms (8-byte aligned), the depths and
  * the pyramid (floats), then the output (8-byte codes). false when it cannot hold all that and
  * one output slot. */
@@ -63,7 +67,7 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     }
     const uintptr_t a = (uintptr_t)scratch;
     const size_t skip = (size_t)((8u - (a & 7u)) & 7u);
-    const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u;
+    const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u + OCC_PROJ_LEVELS_BYTES;
     const size_t px = (size_t)x->im->width * x->im->height;
     const size_t floats = 4u * px + occi_proj_pyramid_bytes(x->im->width, x->im->height);
     const size_t head = skip + fixed + ((floats + 7u) & ~(size_t)7u);
@@ -73,6 +77,7 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     unsigned char *const base = (unsigned char *)scratch + skip;
     x->filter = (occ_code_t *)(void *)base;
     x->hist = (uint32_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u);
+    x->lv = (occ_proj_levels_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u);
     *mem = (float *)(void *)(base + fixed);
     x->out = (occ_code_t *)(void *)((unsigned char *)scratch + head);
     x->cap = (bytes - head) / 8u;

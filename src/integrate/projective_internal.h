@@ -14,6 +14,13 @@
 /* Entries of the end points' repeat filter (direct mapped, 8 bytes each). */
 #define OCC_PROJ_FILTER_N 1024u
 
+/* Per node level, the walk's constants (see occ_proj_t). */
+typedef struct {
+    float side[OCC_MAX_DEPTH + 1u]; /* node edge length (m) */
+    float edge[OCC_MAX_DEPTH + 1u][3][3];
+    float plane_pos[OCC_MAX_DEPTH + 1u][4][3];
+} occ_proj_levels_t;
+
 typedef struct {
     occ_map_t *map;
     occ_raygeo_t g;
@@ -34,9 +41,7 @@ typedef struct {
     float pn[4][3], pr[4][3]; /* the walk's side planes and their products with the map axes */
     /* Per node level, the walk's constants (the same products test_node used to form per node):
      * the edge vectors s r[a] (camera frame) and the side planes' positive parts s pr[p][a]. */
-    float side[OCC_MAX_DEPTH + 1u]; /* node edge length (m) */
-    float edge[OCC_MAX_DEPTH + 1u][3][3];
-    float plane_pos[OCC_MAX_DEPTH + 1u][4][3];
+    occ_proj_levels_t *lv;  /* in the caller's scratch (1.9 KB: off the stack for firmware) */
     float tabs;             /* |t.x| + |t.y| + |t.z| */
     float wf, hf;           /* image width and height as floats (exact) */
     float peps0;            /* 1e-5 (fx + fy + |cx| + |cy| + w + h) */

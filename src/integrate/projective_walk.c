@@ -71,13 +71,13 @@ static void planes_init(occ_proj_t *x)
     }
     for (unsigned l = 0; l <= x->g.depth && l <= OCC_MAX_DEPTH; l++) {
         const float s = (float)(x->g.res * (occ_rr_t)((uint32_t)1 << l));
-        x->side[l] = s;
+        x->lv->side[l] = s;
         for (unsigned a = 0; a < 3u; a++) {
             for (unsigned b = 0; b < 3u; b++) {
-                x->edge[l][a][b] = s * k->r[a][b];
+                x->lv->edge[l][a][b] = s * k->r[a][b];
             }
             for (unsigned p = 0; p < 4u; p++) {
-                x->plane_pos[l][p][a] = x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
+                x->lv->plane_pos[l][p][a] = x->pr[p][a] > 0.0f ? s * x->pr[p][a] : 0.0f;
             }
         }
     }
@@ -93,7 +93,7 @@ static bool outside_planes(const occ_proj_t *x, const float q0[3], const unsigne
                            const float peps)
 {
     for (unsigned p = 0; p < 4u; p++) {
-        const float *const c = x->plane_pos[l][p];
+        const float *const c = x->lv->plane_pos[l][p];
         const float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2] + c[0] +
                         c[1] + c[2];
         if (m < -peps) {
@@ -122,7 +122,7 @@ static void corner_uv(const occ_proj_camera_t *k, const float q[3], uv_t *f)
  * shared partial sums, the same values as summing per corner. */
 static void footprint(const occ_proj_t *x, const float q0[3], const unsigned l, uv_t *f)
 {
-    const float(*const e)[3] = x->edge[l];
+    float(*const e)[3] = x->lv->edge[l]; /* read only here */
     float c[8][3];
     for (unsigned b = 0; b < 3u; b++) {
         c[0][b] = q0[b];
@@ -180,7 +180,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
 {
     const occ_proj_camera_t *const cam = x->cam;
     x->r->nodes_tested++;
-    const float s = x->side[level];
+    const float s = x->lv->side[level];
     const float lo[3] = {key_low(&x->g, k[0]), key_low(&x->g, k[1]), key_low(&x->g, k[2])};
     const float bd2 = box_dist2(cam, lo, s);
     float mabs = x->tabs;
@@ -196,7 +196,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
     to_cam(cam, w, q0);
     float zmin = q0[2], zmax = q0[2];
     for (unsigned a = 0; a < 3u; a++) {
-        const float dz = x->edge[level][a][2];
+        const float dz = x->lv->edge[level][a][2];
         zmin += dz < 0.0f ? dz : 0.0f;
         zmax += dz > 0.0f ? dz : 0.0f;
     }
