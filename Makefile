@@ -163,7 +163,7 @@ test: $(DEPS_STAMP)
 
 # ---- cross (Cortex-M) ---------------------------------------------------------------------------
 CROSS_CC := arm-none-eabi-gcc
-CROSS_COMMON := $(WARN) -Os -ffunction-sections -fdata-sections -ffreestanding -fstack-usage $(FW_INC)
+CROSS_COMMON := $(WARN) -Os -ffunction-sections -fdata-sections -ffreestanding -fstack-usage -fcallgraph-info=su $(FW_INC)
 CROSS_M4 := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 CROSS_M0 := -mcpu=cortex-m0plus -mthumb -mfloat-abi=soft
 CROSS_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC)
@@ -180,7 +180,7 @@ $(BUILD)/cross/m0/%.o: %.c | $(FW_HEADERS)
 
 cross-objs: $(DEPS_STAMP) $(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o) $(CROSS_EXTRA)
 cross: cross-objs
-	@bash tests/cross_report.sh $(BUILD)/cross
+	@CROSS_M4_FLAGS="$(CROSS_M4)" CROSS_M0_FLAGS="$(CROSS_M0)" bash tests/cross_report.sh $(BUILD)/cross
 
 # The core must not reach for the heap, stdio or process exit.
 symcheck: $(BUILD)/libocc.a cross-objs

@@ -51,3 +51,10 @@ test-m4-qemu: $(FW_DIR)/m4_selftest.elf $(FW_DIR)/example_m4.elf
 	done
 TEST_STEPS += test-m4-qemu
 .PHONY: firmware-report test-m4-qemu
+
+# The stack budget (tests/stack_budget.py, run by make cross) reads the .ci call graphs that
+# -fcallgraph-info=su writes next to each object: objects built before that flag are rebuilt once.
+$(FW_DIR)/.callgraph-info:
+	@mkdir -p $(dir $@)
+	@touch $@
+$(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o): $(FW_DIR)/.callgraph-info

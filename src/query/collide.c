@@ -7,12 +7,12 @@
  */
 #include "query_internal.h"
 
-/* One open block: the children of the node whose first voxel is `key`. */
+/* One open block (its children's level is implicit: one below the frame under it). The key
+ * is not kept per frame: the frames are one path, whose key `path` holds (8 B a frame, not 20:
+ * the walk's stack is on the caller's call chain, see the header's stack bound). */
 typedef struct {
     uint32_t block;
-    occ_key_t key;
-    uint8_t level; /* the children's level */
-    uint8_t mask;  /* children still to visit: blocking and touching the volume */
+    uint8_t mask; /* children still to visit: blocking and touching the volume */
 } frame_t;
 
 static inline unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsigned states,
@@ -29,10 +29,9 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
                        unsigned level, uint32_t block, occ_query_node_t *out)
 {
     frame_t st[OCC_MAX_DEPTH];
+    occ_key_t path = key; /* bits above each frame's level: the path down to it */
     unsigned sp = 1;
     st[0].block = block;
-    st[0].key = key;
-    st[0].level = (uint8_t)level;
     st[0].mask = (uint8_t)open_mask(m, v, states, block, key, level);
     while (sp > 0u) {
         frame_t *const f = &st[sp - 1u];
@@ -43,22 +42,20 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
         }
         const unsigned slot = occ_first_slot(mk);
         f->mask = (uint8_t)(mk & (mk - 1u));
-        const unsigned l = f->level;
-        occ_key_t ck = f->key;
-        ck.k[0] |= (slot & 1u) << l;
-        ck.k[1] |= ((slot >> 1) & 1u) << l;
-        ck.k[2] |= ((slot >> 2) & 1u) << l;
+        const unsigned l = level - (sp - 1u);
+        const uint32_t keep = ~((2u << l) - 1u); /* bits above level l */
+        path.k[0] = (path.k[0] & keep) | ((slot & 1u) << l);
+        path.k[1] = (path.k[1] & keep) | (((slot >> 1) & 1u) << l);
+        path.k[2] = (path.k[2] & keep) | (((slot >> 2) & 1u) << l);
         const occ_entry_t e = occ_entry_at(m, f->block, l, slot);
         if (e.child == OCC_NONE) { /* a voxel, or a uniform node: it blocks and touches */
-            occi_q_fill_node(m, ck, l, e.value, e.flags, true, out);
+            occi_q_fill_node(m, path, l, e.value, e.flags, true, out);
             return true;
         }
         OCC_ASSERT(sp < OCC_MAX_DEPTH && l >= 1u);
         frame_t *const nf = &st[sp++];
         nf->block = e.child;
-        nf->key = ck;
-        nf->level = (uint8_t)(l - 1u);
-        nf->mask = (uint8_t)open_mask(m, v, states, e.child, ck, l - 1u);
+        nf->mask = (uint8_t)open_mask(m, v, states, e.child, path, l - 1u);
     }
     return false;
 }
