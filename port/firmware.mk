@@ -50,7 +50,31 @@ test-m4-qemu: $(FW_DIR)/m4_selftest.elf $(FW_DIR)/example_m4.elf
 	  [ $$rc -eq 0 ] || { echo "FAIL test-m4-qemu: $$img (100 = fault, 124 = hang, else failed checks)"; exit 1; }; \
 	done
 TEST_STEPS += test-m4-qemu
-.PHONY: firmware-report test-m4-qemu
+
+# ARMv6-M: the core built for Cortex-M0+ runs its self-test on qemu's microbit (Cortex-M0, the same
+# instruction set; 16 KB RAM, so an 8 KB arena). qemu has no M0+ model.
+FW_M0_LD := port/baremetal/microbit.ld
+FW_M0_LDFLAGS = $(CROSS_M0) -T $(FW_M0_LD) -nostartfiles --specs=nano.specs --specs=rdimon.specs \
+                 -Wl,--gc-sections
+FW_M0_SELFTEST_OBJ := $(BUILD)/cross/m0/port/baremetal/m0_selftest.o $(BUILD)/cross/m0/port/baremetal/startup_m4.o
+$(BUILD)/cross/m0/port/baremetal/startup_m4.o: EXTRA_CFLAGS += -DOCC_BM_SEMIHOSTING=1
+$(FW_DIR)/libocc_m0.a: $(patsubst %.c,$(BUILD)/cross/m0/%.o,$(OCC_CORE_SRC) $(OCC_FEED_SRC))
+	@mkdir -p $(dir $@)
+	@rm -f $@
+	arm-none-eabi-ar rcs $@ $^
+$(FW_DIR)/m0_selftest.elf: $(FW_M0_SELFTEST_OBJ) $(FW_DIR)/libocc_m0.a $(FW_M0_LD)
+	$(CROSS_CC) $(FW_M0_LDFLAGS) -Wl,-Map=$@.map -o $@ $(FW_M0_SELFTEST_OBJ) $(FW_DIR)/libocc_m0.a -lm
+QEMU_M0_RUN := timeout --foreground -k 2 120 qemu-system-arm -M microbit -nographic -monitor none \
+               -serial null -semihosting-config enable=on,target=native -kernel
+test-m0-qemu: $(FW_DIR)/m0_selftest.elf
+	@command -v qemu-system-arm >/dev/null || { echo "SKIP test-m0-qemu: qemu-system-arm not installed (environment limit)"; exit 77; }
+	@t0=$$(date +%s%N); rc=0; (cd $(FW_DIR) && $(QEMU_M0_RUN) m0_selftest.elf) || rc=$$?; \
+	 echo "qemu-system-arm microbit: m0_selftest.elf exit $$rc in $$(( ($$(date +%s%N) - t0) / 1000000 )) ms"; \
+	 [ $$rc -eq 0 ] || { echo "FAIL test-m0-qemu: m0_selftest (100 = fault, 124 = hang, else failed checks)"; exit 1; }; \
+	 echo "PASS test-m0-qemu"
+CROSS_EXTRA += $(FW_DIR)/m0_selftest.elf
+TEST_STEPS += test-m0-qemu
+.PHONY: firmware-report test-m4-qemu test-m0-qemu
 
 # The stack budget (tests/stack_budget.py, run by make cross) reads the .ci call graphs that
 # -fcallgraph-info=su writes next to each object: objects built before that flag are rebuilt once.

@@ -1,0 +1,117 @@
+/* m0_selftest.c - the core on ARMv6-M (built for Cortex-M0+, run on qemu's microbit board:
+ * Cortex-M0, 16 KB RAM, semihosting): map init / update / read / prune / stats on an 8 KB
+ * arena, a ray cast and sphere checks against a hand-built block, pool exhaustion on a tiny
+ * arena. Expected values are hand-computed from the block's geometry. The exit status is the
+ * number of failed checks (qemu passes it to make). */
+#include <math.h>
+#include <stdio.h>
+
+#include "occmap/occmap.h"
+#include "occmap/occ_query.h"
+
+static unsigned checks, failed;
+
+static void check(int ok, const char *what)
+{
+    checks++;
+    if (!ok) {
+        failed++;
+        printf("FAIL %s\n", what);
+    }
+}
+
+static uint8_t arena[8u * 1024u];
+static uint8_t tiny_arena[OCC_ARENA_BYTES(20, 2)];
+static occ_map_t map;
+
+/* Voxels x, y, z in [0, 8) (0 .. 0.8 m at 0.1 m) all hit: one pruned level-3 node. */
+static void build_block(void)
+{
+    for (int x = 0; x < 8; x++) {
+        for (int y = 0; y < 8; y++) {
+            for (int z = 0; z < 8; z++) {
+                const occ_vec3_t q = {0.05f + 0.1f * (float)x, 0.05f + 0.1f * (float)y,
+                                      0.05f + 0.1f * (float)z};
+                (void)occ_map_update(&map, q, 2.0f);
+            }
+        }
+    }
+}
+
+static void test_map(void)
+{
+    occ_map_config_t cfg = occ_map_config_default();
+    check(occ_map_init(&map, &cfg, arena, sizeof arena) == OCC_OK, "map init on an 8 KB arena");
+    const occ_vec3_t p = {1.23f, -4.56f, 0.78f};
+    check(occ_map_state_at(&map, p) == OCC_STATE_UNKNOWN, "unobserved reads UNKNOWN");
+    check(occ_map_update(&map, p, cfg.hit) == OCC_OK, "update hit");
+    occ_node_info_t info;
+    check(occ_map_read(&map, p, 0, &info) == OCC_OK && info.observed &&
+              fabsf(info.logodds - cfg.hit) < 0.002f,
+          "read back the hit log-odds (soft-float fixed point)");
+    for (int i = 0; i < 3; i++) {
+        (void)occ_map_update(&map, p, cfg.miss);
+    }
+    check(occ_map_state_at(&map, p) == OCC_STATE_FREE, "hit + 3 misses reads FREE");
+    build_block();
+    const occ_vec3_t c = {0.05f, 0.05f, 0.05f};
+    check(occ_map_read(&map, c, 3, &info) == OCC_OK && info.state == OCC_STATE_OCCUPIED &&
+              (info.flags & OCC_NODE_UNIFORM) != 0u,
+          "8x8x8 block pruned to one uniform level-3 node");
+    check(occ_map_check(&map) == OCC_OK, "occ_map_check");
+    occ_map_stats_t st;
+    occ_map_stats(&map, &st);
+    check(st.occupied_voxels == 512u && st.free_voxels == 1u, "stats: 512 occupied, 1 free");
+}
+
+static void test_queries(void)
+{
+    occ_ray_result_t r;
+    const occ_vec3_t o = {-2.05f, 0.35f, 0.35f};
+    const occ_vec3_t dx = {1.0f, 0.0f, 0.0f};
+    check(occ_cast_ray(&map, o, dx, true, 0.0f, &r) == OCC_OK && r.hit && r.stop == OCC_RAY_HIT &&
+              fabsf(r.end.x - 0.05f) < 1e-4f && fabsf(r.end.y - 0.35f) < 1e-4f,
+          "ray along +x stops in voxel x = 0.05 m of the block");
+    check(occ_cast_ray(&map, o, dx, true, 1.0f, &r) == OCC_OK && !r.hit &&
+              r.stop == OCC_RAY_MAX_RANGE,
+          "the same ray with a 1 m range ends before the block");
+    occ_collision_t col;
+    const occ_vec3_t in = {0.4f, 0.4f, 0.4f};
+    check(occ_collide_sphere(&map, in, 0.1f, OCC_UNKNOWN_SAFE, &col) == OCC_OK && !col.safe &&
+              col.node.state == OCC_STATE_OCCUPIED,
+          "sphere inside the block: unsafe, an OCCUPIED node");
+    const occ_vec3_t away = {3.0f, 3.0f, 3.0f};
+    check(occ_collide_sphere(&map, away, 0.5f, OCC_UNKNOWN_SAFE, &col) == OCC_OK && col.safe,
+          "sphere in unknown space, unknown safe: safe");
+    check(occ_collide_sphere(&map, away, 0.5f, OCC_UNKNOWN_UNSAFE, &col) == OCC_OK && !col.safe,
+          "sphere in unknown space, unknown unsafe: unsafe");
+    const occ_vec3_t nan3 = {NAN, 0.0f, 0.0f};
+    check(occ_collide_sphere(&map, nan3, 0.5f, OCC_UNKNOWN_SAFE, &col) == OCC_ERR_ARG && !col.safe,
+          "NaN centre: OCC_ERR_ARG and reads unsafe");
+}
+
+static void test_exhaustion(void)
+{
+    occ_map_config_t cfg = occ_map_config_default();
+    occ_map_t small;
+    check(occ_map_init(&small, &cfg, tiny_arena, sizeof tiny_arena) == OCC_OK, "tiny map init");
+    unsigned ok = 0, nomem = 0;
+    for (int i = 0; i < 40; i++) {
+        const occ_vec3_t q = {(float)i * 7.3f, (float)i * -3.1f, 1.0f};
+        const occ_err_t e = occ_map_update(&small, q, 1.0f);
+        ok += e == OCC_OK;
+        nomem += e == OCC_ERR_NOMEM;
+    }
+    check(nomem > 0u && ok > 0u && small.oom_count == nomem && occ_map_check(&small) == OCC_OK,
+          "pool exhaustion is OCC_ERR_NOMEM and the map stays consistent");
+}
+
+int main(void)
+{
+    printf("m0-selftest: ARMv6-M (built for Cortex-M0+) under qemu microbit, semihosting\n");
+    test_map();
+    test_queries();
+    test_exhaustion();
+    printf("m0-selftest: %u checks, %u failed\n", checks, failed);
+    return failed > 255u ? 255 : (int)failed;
+}
