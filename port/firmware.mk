@@ -82,3 +82,32 @@ $(FW_DIR)/.callgraph-info:
 	@mkdir -p $(dir $@)
 	@touch $@
 $(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o): $(FW_DIR)/.callgraph-info
+
+# ---- make bench-m4: instruction counts per call on the emulated Cortex-M4F ----------------------
+# A crop of OctoMap's geb079 (cropped on the host by port/baremetal/crop_map.c, embedded as a C
+# array in build/fw), loaded with occ_io_load from flash into a static arena; qemu -icount
+# shift=0 makes virtual time count instructions, read from the CMSDK dual timer around each call.
+GEB079_BT := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt
+BENCH_M4_CROP := -2.0 -3.0 -0.4 4.0 3.0 2.8
+$(BUILD)/fw/crop_map: $(BUILD)/relhost/port/baremetal/crop_map.o $(BUILD)/relhost/port/posix/file_io.o $(BUILD)/libocc.a
+	@mkdir -p $(dir $@)
+	$(CC) -o $@ $^ -lm
+$(FW_DIR)/geb079_crop.occ: $(BUILD)/fw/crop_map port/firmware.mk
+	@test -f $(GEB079_BT) || { echo "SKIP bench-m4: $(GEB079_BT) absent (liboctomap-dev)"; exit 77; }
+	$(BUILD)/fw/crop_map $(GEB079_BT) $@ $(BENCH_M4_CROP)
+$(FW_DIR)/geb079_crop.c: $(FW_DIR)/geb079_crop.occ port/baremetal/embed_bytes.py
+	python3 port/baremetal/embed_bytes.py $< $@ occ_bench_map \
+	  occ_bench_box_min=$(subst $(eval) ,$(comma),$(wordlist 1,3,$(BENCH_M4_CROP))) \
+	  occ_bench_box_max=$(subst $(eval) ,$(comma),$(wordlist 4,6,$(BENCH_M4_CROP)))
+comma := ,
+FW_BENCH_OBJ := $(BUILD)/cross/m4/port/baremetal/bench_m4.o $(BUILD)/cross/m4/$(FW_DIR)/geb079_crop.o \
+                $(BUILD)/cross/m4/port/baremetal/startup_m4.o
+$(FW_DIR)/bench_m4.elf: $(FW_BENCH_OBJ) $(FW_DIR)/libocc_m4.a $(FW_LD)
+	$(CROSS_CC) $(FW_LDFLAGS) -u _printf_float -Wl,-Map=$@.map -o $@ $(FW_BENCH_OBJ) $(FW_DIR)/libocc_m4.a -lm
+QEMU_M4_ICOUNT := timeout --foreground -k 2 300 qemu-system-arm -M mps2-an386 -icount shift=0 \
+                  -nographic -monitor none -serial null -semihosting-config enable=on,target=native -kernel
+bench-m4: $(FW_DIR)/bench_m4.elf
+	@command -v qemu-system-arm >/dev/null || { echo "SKIP bench-m4: qemu-system-arm not installed"; exit 77; }
+	@cd $(FW_DIR) && $(QEMU_M4_ICOUNT) bench_m4.elf
+BENCH_STEPS += bench-m4
+.PHONY: bench-m4
