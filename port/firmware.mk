@@ -111,3 +111,9 @@ bench-m4: $(FW_DIR)/bench_m4.elf
 	@cd $(FW_DIR) && $(QEMU_M4_ICOUNT) bench_m4.elf
 BENCH_STEPS += bench-m4
 .PHONY: bench-m4
+
+# The stack-budget checker against hand-made call graphs with hand-computed answers.
+test-stack-budget:
+	@python3 tests/stack_budget_check.py
+TEST_STEPS += test-stack-budget
+.PHONY: test-stack-budget
