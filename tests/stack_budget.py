@@ -115,6 +115,22 @@ def public_functions(header_dir):
     return names
 
 
+STATED_RE = re.compile(r"^\s*\*\s+((?:occ_[\w*]+,?\s*)+):\s+stack <= ([\d,]+) / ([\d,]+) B")
+
+
+def stated_bounds(header_dir):
+    """The headers' own statements (their "Budgets" sections): {header: [(patterns, m4, m0)]}."""
+    out = collections.defaultdict(list)
+    for h in sorted(glob.glob(os.path.join(header_dir, "*.h"))):
+        for line in open(h, encoding="utf-8"):
+            m = STATED_RE.match(line)
+            if m:
+                pats = [p.strip() for p in m.group(1).replace(",", " ").split()]
+                out[os.path.basename(h)].append((pats, int(m.group(2).replace(",", "")),
+                                                 int(m.group(3).replace(",", ""))))
+    return out
+
+
 def read_budgets(path):
     rules, missing_ok = [], []
     for line in open(path, encoding="utf-8"):
@@ -229,6 +245,25 @@ def main():
         print(row + " %6d%s " % (rule[1], "!" if any(o.startswith(fn + " ") for o in over)
                                  else " ") + " > ".join(map(short, chain0[1:5])) +
               (" ..." if len(chain0) > 5 else ""))
+    stated = stated_bounds(header_dir)
+    unstated = []
+    for fn in sorted(names):
+        if fn not in targets[0].frames:
+            continue
+        st = next((x for x in stated.get(names[fn], ()) if any(fnmatch.fnmatchcase(fn, p)
+                                                              for p in x[0])), None)
+        if st is None:
+            unstated.append(fn)
+            continue
+        for i, t in enumerate(targets):
+            b = t.worst(fn)[0]
+            if b > st[1 + min(i, 1)]:
+                bad.append("%s: %d B on %s, but %s states <= %d B" % (fn, b, t.name, names[fn],
+                                                                      st[1 + min(i, 1)]))
+    print("== stack bounds the headers state: %d entry points checked, %d without a statement%s"
+          % (len(names) - len(unstated) - len([n for n in names if n not in targets[0].frames]),
+             len(unstated), (": " + " ".join(unstated[:8]) + (" ..." if len(unstated) > 8
+                                                             else "")) if unstated else ""))
     print("== indirect calls below the entry points (the caller adds its callback's stack)")
     for site in sorted(indirect):
         print("  %s\n      from: %s" % (source_line(site), " ".join(sorted(indirect[site]))))

@@ -3,7 +3,7 @@
 format) with hand-computed answers: a chain sum through a static helper and a library call
 (memset, whose frame comes from newlib's disassembly), an indirect call listed with '+', an
 entry point over budget, recursion, a declared function missing from the build, a function
-without a budget. Prints PASS / FAIL lines; exit 1 on a failure.
+without a budget, a header's stated stack bound below the chain. Prints PASS / FAIL lines; exit 1 on a failure.
 
 usage: stack_budget_check.py   (needs arm-none-eabi-gcc / objdump, like make cross)"""
 import os
@@ -104,6 +104,12 @@ def main():
         rc, out = run(tmp, budgets="occ_deep 128 1024 1024\n* 1024 1024 1024\n")
         check(rc == 0 and "occ_deep m4 %d B > 128 B" % (140 + ms) in out,
               "within the budget but above the class target: printed, not failed")
+        rc, out = run(tmp, header_extra="/* Budgets\n *   occ_leaf, occ_cb: stack <= 24 / 24 B; work: O(1)\n */")
+        check(rc == 0 and "2 entry points checked, 1 without a statement" in out,
+              "a header's stated bound that holds passes (a pattern list, one without)")
+        rc, out = run(tmp, header_extra="/* Budgets\n *   occ_leaf: stack <= 15 / 15 B; work: O(1)\n */")
+        check(rc == 1 and "occ_leaf: 16 B on m4, but x.h states <= 15 B" in out,
+              "a header stating one byte less than the chain fails")
     print("%s stack-budget-check: %d failed" % ("FAIL" if failed else "PASS", failed))
     return 1 if failed else 0
 
