@@ -163,7 +163,7 @@ test: $(DEPS_STAMP)
 
 # ---- cross (Cortex-M) ---------------------------------------------------------------------------
 CROSS_CC := arm-none-eabi-gcc
-CROSS_COMMON := $(WARN) -Os -ffunction-sections -fdata-sections -ffreestanding -fstack-usage -fcallgraph-info=su $(FW_INC)
+CROSS_COMMON := $(WARN) -Os -ffunction-sections -fdata-sections -ffreestanding -fstack-usage $(FW_INC)
 CROSS_M4 := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 CROSS_M0 := -mcpu=cortex-m0plus -mthumb -mfloat-abi=soft
 CROSS_SRC := $(OCC_CORE_SRC) $(OCC_FEED_SRC)

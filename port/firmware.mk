@@ -77,7 +77,9 @@ TEST_STEPS += test-m0-qemu
 .PHONY: firmware-report test-m4-qemu test-m0-qemu
 
 # The stack budget (tests/stack_budget.py, run by make cross) reads the .ci call graphs that
-# -fcallgraph-info=su writes next to each object: objects built before that flag are rebuilt once.
+# -fcallgraph-info=su writes next to each core object (only there: a compile from stdin would
+# leave a--.ci in the tree); objects built before that flag are rebuilt once.
+$(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o): EXTRA_CFLAGS += -fcallgraph-info=su
 $(FW_DIR)/.callgraph-info:
 	@mkdir -p $(dir $@)
 	@touch $@
