@@ -79,11 +79,12 @@ TEST_STEPS += test-m0-qemu
 # The stack budget (tests/stack_budget.py, run by make cross) reads the .ci call graphs that
 # -fcallgraph-info=su writes next to each core object (only there: a compile from stdin would
 # leave a--.ci in the tree); objects built before that flag are rebuilt once.
-$(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o): EXTRA_CFLAGS += -fcallgraph-info=su
+FW_CG_OBJ := $(foreach t,m4 m0,$(patsubst %.c,$(BUILD)/cross/$(t)/%.o,$(OCC_CORE_SRC) $(OCC_FEED_SRC)))
+$(FW_CG_OBJ): EXTRA_CFLAGS += -fcallgraph-info=su
 $(FW_DIR)/.callgraph-info:
 	@mkdir -p $(dir $@)
 	@touch $@
-$(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o): $(FW_DIR)/.callgraph-info
+$(FW_CG_OBJ): $(FW_DIR)/.callgraph-info
 
 # ---- make bench-m4: instruction counts per call on the emulated Cortex-M4F ----------------------
 # A crop of OctoMap's geb079 (cropped on the host by port/baremetal/crop_map.c, embedded as a C
