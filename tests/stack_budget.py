@@ -189,6 +189,29 @@ class Target:
         return self.memo[fn]
 
 
+def depth_to(t, fn, target, memo, path=()):
+    """Deepest stack from fn's frame down to and including target's frame (None: unreachable)."""
+    if fn == target:
+        return t.frames[fn][0]
+    if fn in memo:
+        return memo[fn]
+    if fn in path or fn not in t.frames:
+        return None
+    best = None
+    for callee, _ in t.calls.get(fn, ()):
+        if callee == INDIRECT:
+            continue
+        d = depth_to(t, callee, target, memo, path + (fn,))
+        if d is not None and (best is None or d > best):
+            best = d
+    memo[fn] = None if best is None else best + t.frames[fn][0]
+    return memo[fn]
+
+
+def site_function(t, site):
+    return next((f for f, cs in t.calls.items() if (INDIRECT, site) in cs), None)
+
+
 def short(fn):
     return fn.rsplit(":", 1)[-1]
 
@@ -265,8 +288,14 @@ def main():
              len(unstated), (": " + " ".join(unstated[:8]) + (" ..." if len(unstated) > 8
                                                              else "")) if unstated else ""))
     print("== indirect calls below the entry points (the caller adds its callback's stack)")
+    print("   (stack in use at the call, %s: the callback's own stack comes on top of it)" %
+          targets[0].name)
     for site in sorted(indirect):
-        print("  %s\n      from: %s" % (source_line(site), " ".join(sorted(indirect[site]))))
+        t = targets[0]
+        sf = site_function(t, site)
+        memo = {}
+        at = ["%s %d B" % (fn, depth_to(t, fn, sf, memo) or 0) for fn in sorted(indirect[site])]
+        print("  %s\n      %s" % (source_line(site), "; ".join(at)))
     print("== above the class target of issue 24 (! in the table; the budget file says why): %s"
           % ("none" if not over else "; ".join(over)))
     for t in targets:

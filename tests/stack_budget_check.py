@@ -84,8 +84,8 @@ def main():
         check(row(out, "occ_deep") == (100 + 40 + ms, ""),
               "occ_deep = 100 + helper 40 + memset %d (from %s) = %d" % (ms, lib, 140 + ms))
         check(row(out, "occ_leaf") == (16, ""), "occ_leaf = its own 16 B")
-        check(row(out, "occ_cb") == (24, "+") and "src/a.c:21" in out,
-              "occ_cb: 24 B + the callback, its call site listed")
+        check(row(out, "occ_cb") == (24, "+") and "src/a.c:21" in out and "occ_cb 24 B" in out,
+              "occ_cb: 24 B + the callback, its call site listed with the 24 B in use there")
         rc, out = run(tmp, budgets="occ_deep 1024 %d 0\n* 1024 1024 1024\n" % (139 + ms))
         check(rc == 1 and re.search(r"FAIL stack budget: occ_deep: %d B on m4, budget %d B" %
                                     (140 + ms, 139 + ms), out) is not None,
