@@ -315,7 +315,7 @@ int main(void)
     run("occ_map_state_at (point lookup)", op_lookup, N_CALLS, "one descent");
     run("occ_collide_sphere r 0.5 m", op_sphere, N_CALLS, "unknown unsafe");
     run("occ_collide_capsule 1 m, r 0.3 m", op_capsule, N_CALLS, "unknown unsafe");
-    run("occ_cast_ray 10 m", op_ray, N_CALLS, "<= 127 voxels, unknown ignored");
+    run("occ_cast_ray 10 m", op_ray, N_CALLS, "0.08 m voxels, unknown ignored");
     run("occ_sectors_compute 72 sectors", op_sectors, N_CALLS, "default config");
     run("occ_map_insert_cloud 64 rays", op_scan, N_CALLS, "8 m range, 360 deg fan");
     run("occ_map_insert_depth 8x8 ToF", op_tof, N_CALLS, "4 m range, 45 deg FoV");
