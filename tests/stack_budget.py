@@ -3,8 +3,9 @@
 
 Sources: GCC 12's -fcallgraph-info=su (.ci files: one node per function with its -fstack-usage
 frame, one edge per call left after inlining) for the core, and the disassembly of the target's
-newlib / libgcc archives for the library functions the core calls (frame = every push, vpush and
-sub sp in the function summed, an upper bound; callees from the call relocations).
+newlib / libgcc archives for the library functions the core calls (frame = every push, vpush,
+sub sp and sp pre-decrement in the function summed, an upper bound; callees from the call
+relocations; an assembler routine's other names share its frame).
 An entry point is every function declared in include/occmap/*.h (host/ excluded). Its bound is
 its frame plus the worst bound of its callees. Calls through function pointers (GCC's
 __indirect_call) count as 0 here and are listed: the caller adds its own callback's stack.
@@ -24,7 +25,7 @@ import subprocess
 import sys
 
 NODE_RE = re.compile(r'^node: \{ title: "([^"]+)" label: "([^"]*)"')
-EDGE_RE = re.compile(r'^edge: \{ sourcename: "([^"]+)" targetname: "([^"]+)" label: "([^"]*)"')
+EDGE_RE = re.compile(r'^edge: \{ sourcename: "([^"]+)" targetname: "([^"]+)"(?: label: "([^"]*)")?')
 FRAME_RE = re.compile(r'\\n(\d+) bytes \(([a-z,]+)\)')
 INDIRECT = "__indirect_call"
 
@@ -43,12 +44,13 @@ def read_callgraph(root):
                 continue
             m = EDGE_RE.match(line)
             if m:
-                calls[m.group(1)].append((m.group(2), m.group(3)))
+                calls[m.group(1)].append((m.group(2), m.group(3) or ""))
     return frames, calls
 
 
 PUSH_RE = re.compile(r'\t(push|stmdb\s+sp!,|vpush)(?:\.w)?\s+\{([^}]*)\}')
 SUBSP_RE = re.compile(r'\tsub(?:\.w|w)?\s+sp,\s*(?:sp,\s*)?#(\d+)')
+PREINDEX_RE = re.compile(r'\[sp,\s*#-(\d+)\]!')  # str / strd with sp write-back
 CALL_RE = re.compile(r'R_ARM_THM_(?:CALL|JUMP24|JUMP11)\s+(\S+)')
 
 
@@ -64,6 +66,26 @@ def reg_count(regs):
     return n
 
 
+SYM_RE = re.compile(r"^([0-9a-f]{8}) (.{7}) (\S+)\t[0-9a-f]+ (?:\.hidden )?(\S+)$")
+
+
+def lib_aliases(path):
+    """{(member, section, address): [global names]}: assembler routines have several names
+    (__aeabi_uidiv = __udivsi3) and objdump labels only one of them."""
+    out = subprocess.run(["arm-none-eabi-objdump", "-t", path], stdout=subprocess.PIPE,
+                         check=True).stdout.decode(errors="replace")
+    groups, member = collections.defaultdict(list), None
+    for line in out.splitlines():
+        m = re.match(r"^(\S+\.o):\s+file format", line)
+        if m:
+            member = m.group(1)
+            continue
+        m = SYM_RE.match(line)
+        if m and m.group(3).startswith(".text") and ("g" in m.group(2) or "w" in m.group(2)):
+            groups[(member, m.group(3), int(m.group(1), 16))].append(m.group(4))
+    return groups
+
+
 def read_libs(cflags):
     """Library frames and calls from objdump -dr of libc_nano, libm and libgcc for the target."""
     frames, calls = {}, collections.defaultdict(list)
@@ -72,17 +94,27 @@ def read_libs(cflags):
                               stdout=subprocess.PIPE, check=True).stdout.decode().strip()
         if not os.path.exists(path):
             continue
+        aliases = lib_aliases(path)
         out = subprocess.run(["arm-none-eabi-objdump", "-dr", path], stdout=subprocess.PIPE,
                              check=True).stdout.decode(errors="replace")
-        cur = None
+        cur, member, section, labels = None, None, None, []
         for line in out.splitlines():
-            m = re.match(r'^[0-9a-f]+ <([^>]+)>:$', line)
+            m = re.match(r"^(\S+\.o):\s+file format", line)
             if m:
-                cur = m.group(1)
+                member = m.group(1)
+                continue
+            m = re.match(r"^Disassembly of section (\S+):", line)
+            if m:
+                section = m.group(1)
+                continue
+            m = re.match(r'^([0-9a-f]+) <([^>]+)>:$', line)
+            if m:
+                cur = m.group(2)
                 if cur in frames:  # a name defined twice: keep the first (the linker's choice)
                     cur = None
                 else:
                     frames[cur] = [0, "static", os.path.basename(path)]
+                    labels.append((cur, aliases.get((member, section, int(m.group(1), 16)), ())))
                 continue
             if cur is None:
                 continue
@@ -91,13 +123,18 @@ def read_libs(cflags):
                 per = 8 if m.group(1) == "vpush" and "d" in m.group(2) else 4
                 frames[cur][0] += per * reg_count(m.group(2))
                 continue
-            m = SUBSP_RE.search(line)
+            m = SUBSP_RE.search(line) or PREINDEX_RE.search(line)
             if m:
                 frames[cur][0] += int(m.group(1))
                 continue
             m = CALL_RE.search(line)
             if m and m.group(1) != cur and not m.group(1).startswith("."):
                 calls[cur].append((m.group(1), frames[cur][2]))
+        for label, names in labels:  # every other name of the same code: the same frame
+            for n in names:
+                if n not in frames:
+                    frames[n] = frames[label]
+                    calls[n] = calls[label]
     return {k: tuple(v) for k, v in frames.items()}, calls
 
 

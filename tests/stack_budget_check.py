@@ -76,6 +76,17 @@ def memset_frame():
     return frames["memset"][0], lib
 
 
+def uldivmod_chain():
+    """__aeabi_uldivmod's chain on M4 from the archives; an assembler routine whose callee
+    (__udivmoddi4) and whose other names (__aeabi_ldiv0) objdump does not label."""
+    import stack_budget
+    frames, calls = stack_budget.read_libs(M4)
+    t = stack_budget.Target.__new__(stack_budget.Target)
+    t.frames, t.calls, t.problems, t.memo = frames, calls, [], {}
+    b = t.worst("__aeabi_uldivmod")[0]
+    return b if not t.problems else -1
+
+
 def main():
     ms, lib = memset_frame()
     with tempfile.TemporaryDirectory() as tmp:
@@ -104,6 +115,10 @@ def main():
         rc, out = run(tmp, budgets="occ_deep 128 1024 1024\n* 1024 1024 1024\n")
         check(rc == 0 and "occ_deep m4 %d B > 128 B" % (140 + ms) in out,
               "within the budget but above the class target: printed, not failed")
+        rc, out = run(tmp, ci_extra='edge: { sourcename: "occ_leaf" targetname: "__aeabi_uldivmod" }')
+        ul = uldivmod_chain()
+        check(rc == 0 and row(out, "occ_leaf") == (16 + ul, "") and ul > 0,
+              "a libcall edge without a label (GCC's __aeabi_uldivmod) counts: 16 + %d B" % ul)
         rc, out = run(tmp, header_extra="/* Budgets\n *   occ_leaf, occ_cb: stack <= 24 / 24 B; work: O(1)\n */")
         check(rc == 0 and "2 entry points checked, 1 without a statement" in out,
               "a header's stated bound that holds passes (a pattern list, one without)")
