@@ -52,7 +52,8 @@ test-m4-qemu: $(FW_DIR)/m4_selftest.elf $(FW_DIR)/example_m4.elf
 TEST_STEPS += test-m4-qemu
 
 # ARMv6-M: the core built for Cortex-M0+ runs its self-test on qemu's microbit (Cortex-M0, the same
-# instruction set; 16 KB RAM, so an 8 KB arena). qemu has no M0+ model.
+# instruction set; 16 KB RAM, so an 8 KB arena). qemu has no M0+ model. The self-test also paints
+# the stack around a few calls: what they really used must stay within the static bounds.
 FW_M0_LD := port/baremetal/microbit.ld
 FW_M0_LDFLAGS = $(CROSS_M0) -T $(FW_M0_LD) -nostartfiles --specs=nano.specs --specs=rdimon.specs \
                  -Wl,--gc-sections
@@ -68,9 +69,13 @@ QEMU_M0_RUN := timeout --foreground -k 2 120 qemu-system-arm -M microbit -nograp
                -serial null -semihosting-config enable=on,target=native -kernel
 test-m0-qemu: $(FW_DIR)/m0_selftest.elf
 	@command -v qemu-system-arm >/dev/null || { echo "SKIP test-m0-qemu: qemu-system-arm not installed (environment limit)"; exit 77; }
-	@t0=$$(date +%s%N); rc=0; (cd $(FW_DIR) && $(QEMU_M0_RUN) m0_selftest.elf) || rc=$$?; \
+	@t0=$$(date +%s%N); rc=0; (cd $(FW_DIR) && $(QEMU_M0_RUN) m0_selftest.elf > m0_selftest.log) || rc=$$?; \
+	 cat $(FW_DIR)/m0_selftest.log; \
 	 echo "qemu-system-arm microbit: m0_selftest.elf exit $$rc in $$(( ($$(date +%s%N) - t0) / 1000000 )) ms"; \
 	 [ $$rc -eq 0 ] || { echo "FAIL test-m0-qemu: m0_selftest (100 = fault, 124 = hang, else failed checks)"; exit 1; }; \
+	 python3 tests/stack_measured_check.py $(FW_DIR)/m0_selftest.log $(BUILD)/cross/m0/src "$(CROSS_M0)" \
+	   $(BUILD)/cross/m0/port/baremetal/m0_selftest.su \
+	   || { echo "FAIL test-m0-qemu: a call used more stack than its static bound"; exit 1; }; \
 	 echo "PASS test-m0-qemu"
 CROSS_EXTRA += $(FW_DIR)/m0_selftest.elf
 TEST_STEPS += test-m0-qemu

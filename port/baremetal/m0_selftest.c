@@ -2,7 +2,10 @@
  * Cortex-M0, 16 KB RAM, semihosting): map init / update / read / prune / stats on an 8 KB
  * arena, a ray cast and sphere checks against a hand-built block, pool exhaustion on a tiny
  * arena. Expected values are hand-computed from the block's geometry. The exit status is the
- * number of failed checks (qemu passes it to make). */
+ * number of failed checks (qemu passes it to make).
+ * It also measures the stack a few entry points really use (the stack below SP painted, the
+ * call made, the lowest overwritten word found) and prints "stack-measured m0 NAME WRAPPER BYTES":
+ * make test-m0-qemu checks them against the static call-chain bounds (tests/stack_budget.py). */
 #include <math.h>
 #include <stdio.h>
 
@@ -106,11 +109,90 @@ static void test_exhaustion(void)
           "pool exhaustion is OCC_ERR_NOMEM and the map stays consistent");
 }
 
+/* ---- measured stack ---------------------------------------------------------------------------
+ * No interrupts run here, so nothing but the call writes below SP. */
+#define PAINT_WORDS 768u /* 3 KB: above every bound this image calls */
+#define PAINT 0xA5C3E1F7u
+static occ_collision_t probe_col;
+static occ_ray_result_t probe_ray;
+
+static void call_state_at(void)
+{
+    const occ_vec3_t q = {0.35f, 0.35f, 0.35f};
+    (void)occ_map_state_at(&map, q);
+}
+
+static void call_update(void)
+{
+    const occ_vec3_t q = {-1.05f, 2.05f, 0.35f};
+    (void)occ_map_update(&map, q, -0.4f);
+}
+
+static void call_cast_ray(void)
+{
+    const occ_vec3_t o = {-2.05f, 0.35f, 0.35f};
+    const occ_vec3_t d = {1.0f, 0.1f, 0.05f};
+    (void)occ_cast_ray(&map, o, d, true, 0.0f, &probe_ray);
+}
+
+static void call_sphere(void)
+{
+    const occ_vec3_t c = {0.9f, 0.4f, 0.4f};
+    (void)occ_collide_sphere(&map, c, 0.2f, OCC_UNKNOWN_SAFE, &probe_col);
+}
+
+static void call_capsule(void)
+{
+    const occ_vec3_t a = {-0.5f, 0.4f, 0.4f}, b = {1.2f, 0.45f, 0.5f};
+    (void)occ_collide_capsule(&map, a, b, 0.15f, OCC_UNKNOWN_SAFE, &probe_col);
+}
+
+static void call_check(void)
+{
+    (void)occ_map_check(&map);
+}
+
+/* Bytes below the caller's SP that `call` (and the call's own wrapper frame) wrote. */
+static unsigned stack_used(void (*call)(void))
+{
+    uint32_t *sp;
+    __asm__ volatile("mov %0, sp" : "=r"(sp));
+    volatile uint32_t *const lo = sp - PAINT_WORDS;
+    for (volatile uint32_t *p = lo; p < sp - 16; p++) { /* 64 B kept for this frame's call */
+        *p = PAINT;
+    }
+    call();
+    volatile uint32_t *p = lo;
+    while (p < sp && *p == PAINT) {
+        p++;
+    }
+    return (unsigned)((uintptr_t)sp - (uintptr_t)p);
+}
+
+static void measure_stacks(void)
+{
+    static const struct {
+        const char *name, *wrapper; /* the wrapper's own frame is part of what is measured */
+        void (*call)(void);
+    } probes[] = {{"occ_map_state_at", "call_state_at", call_state_at},
+                  {"occ_map_update", "call_update", call_update},
+                  {"occ_cast_ray", "call_cast_ray", call_cast_ray},
+                  {"occ_collide_sphere", "call_sphere", call_sphere},
+                  {"occ_collide_capsule", "call_capsule", call_capsule},
+                  {"occ_map_check", "call_check", call_check}};
+    for (unsigned i = 0; i < sizeof probes / sizeof probes[0]; i++) {
+        const unsigned used = stack_used(probes[i].call);
+        check(used > 0u && used < PAINT_WORDS * 4u, "stack probe inside the painted area");
+        printf("stack-measured m0 %s %s %u\n", probes[i].name, probes[i].wrapper, used);
+    }
+}
+
 int main(void)
 {
     printf("m0-selftest: ARMv6-M (built for Cortex-M0+) under qemu microbit, semihosting\n");
     test_map();
     test_queries();
+    measure_stacks();
     test_exhaustion();
     printf("m0-selftest: %u checks, %u failed\n", checks, failed);
     return failed > 255u ? 255 : (int)failed;
