@@ -180,7 +180,7 @@ $(BUILD)/cross/m0/%.o: %.c | $(FW_HEADERS)
 
 cross-objs: $(DEPS_STAMP) $(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o) $(CROSS_EXTRA)
 cross: cross-objs
-	@bash tests/cross_report.sh $(BUILD)/cross
+	@CROSS_M4_FLAGS="$(CROSS_M4)" CROSS_M0_FLAGS="$(CROSS_M0)" bash tests/cross_report.sh $(BUILD)/cross
 
 # The core must not reach for the heap, stdio or process exit.
 symcheck: $(BUILD)/libocc.a cross-objs

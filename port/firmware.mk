@@ -50,4 +50,78 @@ test-m4-qemu: $(FW_DIR)/m4_selftest.elf $(FW_DIR)/example_m4.elf
 	  [ $$rc -eq 0 ] || { echo "FAIL test-m4-qemu: $$img (100 = fault, 124 = hang, else failed checks)"; exit 1; }; \
 	done
 TEST_STEPS += test-m4-qemu
-.PHONY: firmware-report test-m4-qemu
+
+# ARMv6-M: the core built for Cortex-M0+ runs its self-test on qemu's microbit (Cortex-M0, the same
+# instruction set; 16 KB RAM, so an 8 KB arena). qemu has no M0+ model. The self-test also paints
+# the stack around a few calls: what they really used must stay within the static bounds.
+FW_M0_LD := port/baremetal/microbit.ld
+FW_M0_LDFLAGS = $(CROSS_M0) -T $(FW_M0_LD) -nostartfiles --specs=nano.specs --specs=rdimon.specs \
+                 -Wl,--gc-sections
+FW_M0_SELFTEST_OBJ := $(BUILD)/cross/m0/port/baremetal/m0_selftest.o $(BUILD)/cross/m0/port/baremetal/startup_m4.o
+$(BUILD)/cross/m0/port/baremetal/startup_m4.o: EXTRA_CFLAGS += -DOCC_BM_SEMIHOSTING=1
+$(FW_DIR)/libocc_m0.a: $(patsubst %.c,$(BUILD)/cross/m0/%.o,$(OCC_CORE_SRC) $(OCC_FEED_SRC))
+	@mkdir -p $(dir $@)
+	@rm -f $@
+	arm-none-eabi-ar rcs $@ $^
+$(FW_DIR)/m0_selftest.elf: $(FW_M0_SELFTEST_OBJ) $(FW_DIR)/libocc_m0.a $(FW_M0_LD)
+	$(CROSS_CC) $(FW_M0_LDFLAGS) -Wl,-Map=$@.map -o $@ $(FW_M0_SELFTEST_OBJ) $(FW_DIR)/libocc_m0.a -lm
+QEMU_M0_RUN := timeout --foreground -k 2 120 qemu-system-arm -M microbit -nographic -monitor none \
+               -serial null -semihosting-config enable=on,target=native -kernel
+test-m0-qemu: $(FW_DIR)/m0_selftest.elf
+	@command -v qemu-system-arm >/dev/null || { echo "SKIP test-m0-qemu: qemu-system-arm not installed (environment limit)"; exit 77; }
+	@t0=$$(date +%s%N); rc=0; (cd $(FW_DIR) && $(QEMU_M0_RUN) m0_selftest.elf > m0_selftest.log) || rc=$$?; \
+	 cat $(FW_DIR)/m0_selftest.log; \
+	 echo "qemu-system-arm microbit: m0_selftest.elf exit $$rc in $$(( ($$(date +%s%N) - t0) / 1000000 )) ms"; \
+	 [ $$rc -eq 0 ] || { echo "FAIL test-m0-qemu: m0_selftest (100 = fault, 124 = hang, else failed checks)"; exit 1; }; \
+	 python3 tests/stack_measured_check.py $(FW_DIR)/m0_selftest.log $(BUILD)/cross/m0/src "$(CROSS_M0)" \
+	   $(BUILD)/cross/m0/port/baremetal/m0_selftest.su \
+	   || { echo "FAIL test-m0-qemu: a call used more stack than its static bound"; exit 1; }; \
+	 echo "PASS test-m0-qemu"
+CROSS_EXTRA += $(FW_DIR)/m0_selftest.elf
+TEST_STEPS += test-m0-qemu
+.PHONY: firmware-report test-m4-qemu test-m0-qemu
+
+# The stack budget (tests/stack_budget.py, run by make cross) reads the .ci call graphs that
+# -fcallgraph-info=su writes next to each core object (only there: a compile from stdin would
+# leave a--.ci in the tree); objects built before that flag are rebuilt once.
+FW_CG_OBJ := $(foreach t,m4 m0,$(patsubst %.c,$(BUILD)/cross/$(t)/%.o,$(OCC_CORE_SRC) $(OCC_FEED_SRC)))
+$(FW_CG_OBJ): EXTRA_CFLAGS += -fcallgraph-info=su
+$(FW_DIR)/.callgraph-info:
+	@mkdir -p $(dir $@)
+	@touch $@
+$(FW_CG_OBJ): $(FW_DIR)/.callgraph-info
+
+# ---- make bench-m4: instruction counts per call on the emulated Cortex-M4F ----------------------
+# A crop of OctoMap's geb079 (cropped on the host by port/baremetal/crop_map.c, embedded as a C
+# array in build/fw), loaded with occ_io_load from flash into a static arena; qemu -icount
+# shift=0 makes virtual time count instructions, read from the CMSDK dual timer around each call.
+GEB079_BT := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt
+BENCH_M4_CROP := -2.0 -3.0 -0.4 4.0 3.0 2.8
+$(BUILD)/fw/crop_map: $(BUILD)/relhost/port/baremetal/crop_map.o $(BUILD)/relhost/port/posix/file_io.o $(BUILD)/libocc.a
+	@mkdir -p $(dir $@)
+	$(CC) -o $@ $^ -lm
+$(FW_DIR)/geb079_crop.occ: $(BUILD)/fw/crop_map port/firmware.mk
+	@test -f $(GEB079_BT) || { echo "SKIP bench-m4: $(GEB079_BT) absent (liboctomap-dev)"; exit 77; }
+	$(BUILD)/fw/crop_map $(GEB079_BT) $@ $(BENCH_M4_CROP)
+$(FW_DIR)/geb079_crop.c: $(FW_DIR)/geb079_crop.occ port/baremetal/embed_bytes.py
+	python3 port/baremetal/embed_bytes.py $< $@ occ_bench_map \
+	  occ_bench_box_min=$(subst $(eval) ,$(comma),$(wordlist 1,3,$(BENCH_M4_CROP))) \
+	  occ_bench_box_max=$(subst $(eval) ,$(comma),$(wordlist 4,6,$(BENCH_M4_CROP)))
+comma := ,
+FW_BENCH_OBJ := $(BUILD)/cross/m4/port/baremetal/bench_m4.o $(BUILD)/cross/m4/$(FW_DIR)/geb079_crop.o \
+                $(BUILD)/cross/m4/port/baremetal/startup_m4.o
+$(FW_DIR)/bench_m4.elf: $(FW_BENCH_OBJ) $(FW_DIR)/libocc_m4.a $(FW_LD)
+	$(CROSS_CC) $(FW_LDFLAGS) -u _printf_float -Wl,-Map=$@.map -o $@ $(FW_BENCH_OBJ) $(FW_DIR)/libocc_m4.a -lm
+QEMU_M4_ICOUNT := timeout --foreground -k 2 300 qemu-system-arm -M mps2-an386 -icount shift=0 \
+                  -nographic -monitor none -serial null -semihosting-config enable=on,target=native -kernel
+bench-m4: $(FW_DIR)/bench_m4.elf
+	@command -v qemu-system-arm >/dev/null || { echo "SKIP bench-m4: qemu-system-arm not installed"; exit 77; }
+	@cd $(FW_DIR) && $(QEMU_M4_ICOUNT) bench_m4.elf
+BENCH_STEPS += bench-m4
+.PHONY: bench-m4
+
+# The stack-budget checker against hand-made call graphs with hand-computed answers.
+test-stack-budget:
+	@python3 tests/stack_budget_check.py
+TEST_STEPS += test-stack-budget
+.PHONY: test-stack-budget

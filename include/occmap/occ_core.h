@@ -418,6 +418,35 @@ float occ_value_to_logodds(occ_value_t v);
 occ_value_t occ_value_from_logodds(float logodds);
 bool occ_value_observed(occ_value_t v);
 
+/* ---- Budgets (issue 24) -------------------------------------------------------------------
+ * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
+ * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
+ * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
+ *   occ_map_read, occ_map_read_key: stack <= 192 / 256 B; work: one descent, <= depth_levels blocks
+ *       read
+ *   occ_map_state_at: stack <= 128 / 192 B; work: one descent, <= depth_levels blocks read
+ *   occ_map_update, occ_map_update_key: stack <= 1,024 / 1,024 B; work: one path: <= depth_levels
+ *       blocks, allocates <= depth-1 inner + 1 leaf
+ *   occ_map_observe_key: stack <= 960 / 960 B; work: as occ_map_update_key
+ *   occ_map_observe_codes: stack <= 960 / 960 B; work: n codes x <= depth_levels blocks (about n
+ *       when clustered)
+ *   occ_map_observe_need: stack <= 960 / 960 B; work: n codes x <= depth_levels blocks, read only
+ *   occ_map_set_key, occ_map_forget_key: stack <= 704 / 704 B; work: one path + the blocks of the
+ *       subtree it releases
+ *   occ_map_stats: stack <= 448 / 512 B; work: every node once
+ *   occ_map_check: stack <= 384 / 448 B; work: every node + every free block once
+ *   occ_walk_next: stack <= 256 / 256 B; work: O(1) amortized per node
+ *   occ_map_node_root, occ_map_node_child: stack <= 256 / 256 B; work: one block read
+ *   occ_map_init, occ_map_clear, occ_map_config_default: stack <= 256 / 256 B;
+ *   occ_map_pool_stats, occ_walk_begin, occ_walk_status: stack <= 256 / 256 B;
+ *   occ_walk_skip_children: stack <= 256 / 256 B; work: O(1), no tree walk
+ *   occ_map_key, occ_map_key_range, occ_map_key_center: stack <= 256 / 256 B;
+ *   occ_key_at_level, occ_map_node_size, occ_morton_*: stack <= 256 / 256 B;
+ *   occ_value_*, occ_arena_blocks_for_bytes, occ_err_str: stack <= 256 / 256 B; work: O(1), no map
+ *       access
+ *   occ_map_state_of: stack <= 128 / 192 B; work: O(1), no map access
+ */
+
 #ifdef __cplusplus
 }
 #endif

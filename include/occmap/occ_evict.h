@@ -147,6 +147,16 @@ occ_err_t occ_map_evict_for(occ_map_t *map, const occ_vec3_t *center,
 
 /* occ_map_observe_need() (occmap.h) tells an integrator how much to ask for. */
 
+/* ---- Budgets (issue 24) -------------------------------------------------------------------
+ * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
+ * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
+ * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
+ *   occ_map_evict: stack <= 768 / 768 B; work: <= budget_blocks + depth block visits per call (no
+ *       budget: a whole sweep)
+ *   occ_map_evict_for: stack <= 768 / 768 B; work: a whole sweep if needed (ignores budget_blocks)
+ *   occ_evict_out_init, occ_evict_policy_default: stack <= 256 / 256 B; work: O(1)
+ */
+
 #ifdef __cplusplus
 }
 #endif

@@ -336,6 +336,19 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
                                     const occ_proj_camera_t *camera, void *scratch,
                                     size_t scratch_bytes, occ_proj_result_t *out);
 
+/* ---- Budgets (issue 24) -------------------------------------------------------------------
+ * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
+ * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
+ * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
+ *   occ_map_insert_cloud, occ_map_insert_rays: stack <= 1,472 / 1,536 B; work: n_points rays x <= 3
+ *       (ceil(max_ray / res) + 2) + 2 voxels, then one path per distinct voxel
+ *   occ_ray_keys: stack <= 448 / 512 B; work: <= occ_ray_max_keys() keys, no map access
+ *   occ_insert_scratch_bytes_scan: stack <= 256 / 320 B; work: O(n_points) (FAST_DISCRETE: + its
+ *       coarse box)
+ *   occ_insert_scratch_bytes: stack <= 256 / 320 B; work: O(1)
+ *   occ_ray_max_keys, occ_insert_params_default: stack <= 256 / 256 B; work: O(1)
+ */
+
 #ifdef __cplusplus
 }
 #endif

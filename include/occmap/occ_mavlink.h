@@ -333,6 +333,18 @@ bool occ_mav_feed_pose(const occ_mav_feed_t *f, uint64_t now_us, occ_pose_t *pos
 /* The next time poll() may have something to send (for a sleeping loop). */
 uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f);
 
+/* ---- Budgets (issue 24) -------------------------------------------------------------------
+ * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
+ * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
+ * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
+ *   occ_mav_feed_poll: stack <= 960 / 1,024 B; work: one message: occ_sectors_compute
+ *       (occ_sectors.h) when OBSTACLE_DISTANCE is due
+ *   occ_mav_feed_rx: stack <= 768 / 832 B; work: one frame, O(payload)
+ *   occ_mav_parser_push: stack <= 384 / 384 B; work: O(1) per byte, O(log n) per frame
+ *   occ_mav_feed_pose: stack <= 320 / 448 B; work: O(1)
+ *   occ_mav_*: stack <= 384 / 384 B; work: O(1) or O(payload bytes); no map access
+ */
+
 #ifdef __cplusplus
 }
 #endif

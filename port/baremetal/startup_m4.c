@@ -1,5 +1,6 @@
-/* startup_m4.c - Cortex-M4F reset code for the example image and the qemu self-test:
- * vector table, FPU on, .data copied, .bss cleared, main() called. With OCC_BM_SEMIHOSTING the
+/* startup_m4.c - Cortex-M reset code for the example image and the qemu self-tests (M4F; the
+ * same file serves ARMv6-M, which has no FPU to enable): vector table, FPU on, .data copied,
+ * .bss cleared, main() called. With OCC_BM_SEMIHOSTING the
  * image talks to the debugger / qemu (printf, exit status); a fault exits with status 100. */
 #include <stdint.h>
 #include <stdlib.h>
@@ -44,10 +45,12 @@ void occ_bm_fault(void)
 
 void occ_bm_reset(void)
 {
+#if defined(__ARM_FP)
     /* CP10 and CP11 full access before any floating-point instruction. */
     volatile uint32_t *const cpacr = (volatile uint32_t *)0xE000ED88u;
     *cpacr |= 0xFu << 20;
     __asm__ volatile("dsb\n\tisb" ::: "memory");
+#endif
     const uint32_t *src = &_sidata;
     for (uint32_t *dst = &_sdata; dst < &_edata;) {
         *dst++ = *src++;

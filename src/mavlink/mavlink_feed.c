@@ -319,6 +319,37 @@ static size_t poll_request(occ_mav_feed_t *f, uint64_t now_us, uint8_t *out, siz
     return n;
 }
 
+/* The OBSTACLE_DISTANCE of the sectors just computed. Out of line: its 72-distance message
+ * would otherwise sit on the stack under occ_sectors_compute (make cross, issue 24). */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static size_t encode_obstacle(occ_mav_feed_t *f, uint64_t now_us, uint8_t *out, size_t cap)
+{
+    const occ_sectors_config_t *const sc = &f->cfg.sectors;
+    occ_mav_obstacle_distance_t m;
+    m.time_usec = now_us;
+    m.sensor_type = f->cfg.sensor_type;
+    for (unsigned i = 0; i < 72u; i++) {
+        m.distances[i] = i < f->priv.sectors.n ? f->priv.sectors.distance_cm[i] : UINT16_MAX;
+    }
+    const float inc = sc->increment_deg;
+    m.increment = 0;
+    if (f->cfg.autopilot == OCC_AUTOPILOT_ARDUPILOT && inc >= 1.0f && inc <= 255.0f) {
+        m.increment = (uint8_t)(inc + 0.5f);
+    }
+    m.min_distance = sc->min_distance_cm;
+    m.max_distance = sc->max_distance_cm;
+    m.increment_f = inc;
+    m.angle_offset = sc->angle_offset_deg;
+    m.frame = OCC_MAV_FRAME_BODY_FRD;
+    const size_t n = occ_mav_encode_obstacle_distance(&f->priv.tx, &m, out, cap);
+    if (n > 0u) {
+        f->counters.obstacle_tx++;
+    }
+    return n;
+}
+
 size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_us, uint8_t *out,
                          size_t cap)
 {
@@ -363,25 +394,5 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         f->counters.sector_errors++;
         return 0;
     }
-    occ_mav_obstacle_distance_t m;
-    m.time_usec = now_us;
-    m.sensor_type = f->cfg.sensor_type;
-    for (unsigned i = 0; i < 72u; i++) {
-        m.distances[i] = i < f->priv.sectors.n ? f->priv.sectors.distance_cm[i] : UINT16_MAX;
-    }
-    const float inc = sc->increment_deg;
-    m.increment = 0;
-    if (f->cfg.autopilot == OCC_AUTOPILOT_ARDUPILOT && inc >= 1.0f && inc <= 255.0f) {
-        m.increment = (uint8_t)(inc + 0.5f);
-    }
-    m.min_distance = sc->min_distance_cm;
-    m.max_distance = sc->max_distance_cm;
-    m.increment_f = inc;
-    m.angle_offset = sc->angle_offset_deg;
-    m.frame = OCC_MAV_FRAME_BODY_FRD;
-    const size_t n = occ_mav_encode_obstacle_distance(&f->priv.tx, &m, out, cap);
-    if (n > 0u) {
-        f->counters.obstacle_tx++;
-    }
-    return n;
+    return encode_obstacle(f, now_us, out, cap);
 }

@@ -7,13 +7,10 @@
  */
 #include "query_internal.h"
 
-/* One open block: the children of the node whose first voxel is `key`. */
-typedef struct {
-    uint32_t block;
-    occ_key_t key;
-    uint8_t level; /* the children's level */
-    uint8_t mask;  /* children still to visit: blocking and touching the volume */
-} frame_t;
+/* The open blocks of walk_below, one per level below the start node (a frame's children's
+ * level is implicit: one below the frame under it). Neither the key nor the level is kept per
+ * frame: the frames are one path, whose key `path` holds; blocks and masks in two arrays pack
+ * to 5 B a frame (not 20: the walk's stack is on every collision check's call chain). */
 
 static inline unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsigned states,
                                  uint32_t block, occ_key_t key, unsigned level)
@@ -28,37 +25,34 @@ static inline unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsi
 static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_key_t key,
                        unsigned level, uint32_t block, occ_query_node_t *out)
 {
-    frame_t st[OCC_MAX_DEPTH];
+    uint32_t blocks[OCC_MAX_DEPTH];
+    uint8_t masks[OCC_MAX_DEPTH]; /* children still to visit: blocking and touching the volume */
+    occ_key_t path = key;         /* bits above each frame's level: the path down to it */
     unsigned sp = 1;
-    st[0].block = block;
-    st[0].key = key;
-    st[0].level = (uint8_t)level;
-    st[0].mask = (uint8_t)open_mask(m, v, states, block, key, level);
+    blocks[0] = block;
+    masks[0] = (uint8_t)open_mask(m, v, states, block, key, level);
     while (sp > 0u) {
-        frame_t *const f = &st[sp - 1u];
-        const unsigned mk = f->mask;
+        const unsigned mk = masks[sp - 1u];
         if (mk == 0u) {
             sp--;
             continue;
         }
         const unsigned slot = occ_first_slot(mk);
-        f->mask = (uint8_t)(mk & (mk - 1u));
-        const unsigned l = f->level;
-        occ_key_t ck = f->key;
-        ck.k[0] |= (slot & 1u) << l;
-        ck.k[1] |= ((slot >> 1) & 1u) << l;
-        ck.k[2] |= ((slot >> 2) & 1u) << l;
-        const occ_entry_t e = occ_entry_at(m, f->block, l, slot);
+        masks[sp - 1u] = (uint8_t)(mk & (mk - 1u));
+        const unsigned l = level - (sp - 1u);
+        const uint32_t keep = ~((2u << l) - 1u); /* bits above level l */
+        path.k[0] = (path.k[0] & keep) | ((slot & 1u) << l);
+        path.k[1] = (path.k[1] & keep) | (((slot >> 1) & 1u) << l);
+        path.k[2] = (path.k[2] & keep) | (((slot >> 2) & 1u) << l);
+        const occ_entry_t e = occ_entry_at(m, blocks[sp - 1u], l, slot);
         if (e.child == OCC_NONE) { /* a voxel, or a uniform node: it blocks and touches */
-            occi_q_fill_node(m, ck, l, e.value, e.flags, true, out);
+            occi_q_fill_node(m, path, l, e.value, e.flags, true, out);
             return true;
         }
         OCC_ASSERT(sp < OCC_MAX_DEPTH && l >= 1u);
-        frame_t *const nf = &st[sp++];
-        nf->block = e.child;
-        nf->key = ck;
-        nf->level = (uint8_t)(l - 1u);
-        nf->mask = (uint8_t)open_mask(m, v, states, e.child, ck, l - 1u);
+        blocks[sp] = e.child;
+        masks[sp] = (uint8_t)open_mask(m, v, states, e.child, path, l - 1u);
+        sp++;
     }
     return false;
 }
