@@ -257,8 +257,8 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * is unchanged.
  *
  * Scratch (caller's, any alignment): a fixed part (OCC_PROJ_FIXED_BYTES: alignment, an 8 KiB
- * repeat filter for end points, the radix sort's histograms, 2 KiB of per-level constants of
- * the walk, kept off the stack), 4 bytes per pixel (the depths), 8 bytes per pyramid cell
+ * repeat filter for end points, the radix sort's histograms, the call's context and the
+ * walk's per-level constants (3 KiB, kept off the stack)), 4 bytes per pixel (the depths), 8 bytes per pyramid cell
  * (min and max, levels 1.. of halved sides: at most OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells) and the output, in 8-byte slots: the end
  * points' codes after the repeat filter (twice while they are sorted), then one per voxel
  * update and two per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it for n_out
@@ -278,9 +278,10 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
 #define OCC_PROJ_CELLS(w, h) \
     ((size_t)(w) * (size_t)(h) / 3u + (size_t)(w) + (size_t)(h) + 20u)
 #define OCC_PROJ_LEVELS_BYTES 2048u /* the walk's per-level constants (kept off the stack) */
+#define OCC_PROJ_CTX_BYTES 1024u    /* the call's context (kept off the stack) */
 #define OCC_PROJ_FIXED_BYTES                                                               \
     (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u + \
-     OCC_PROJ_LEVELS_BYTES)
+     OCC_PROJ_LEVELS_BYTES + OCC_PROJ_CTX_BYTES)
 #define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                               \
     (OCC_PROJ_FIXED_BYTES + 8u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
      8u * (size_t)(n_out))

@@ -56,6 +56,8 @@ static bool camera_ok(const occ_proj_camera_t *k)
 /* The per-level tables live in the scratch's fixed part (OCC_PROJ_FIXED_BYTES counts
  * OCC_PROJ_LEVELS_BYTES for them): a C99 static assertion that they fit. */
 typedef char occ_proj_levels_fit[sizeof(occ_proj_levels_t) <= OCC_PROJ_LEVELS_BYTES ? 1 : -1];
+/* And the call's context (occ_proj_t) in OCC_PROJ_CTX_BYTES, a multiple of 8. */
+typedef char occ_proj_ctx_fit[sizeof(occ_proj_t) <= OCC_PROJ_CTX_BYTES && OCC_PROJ_CTX_BYTES % 8u == 0u ? 1 : -1];
 
 /* Carve the scratch: the filter and the sort's histograms (8-byte aligned), the depths and
  * the pyramid (floats), then the output (8-byte codes). false when it cannot hold all that and
@@ -163,6 +165,47 @@ static void count_output(occ_proj_t *x)
                            x->r->pixels_beyond_max - r->points_skipped;
 }
 
+/* The call's context sits at the front of the scratch (OCC_PROJ_CTX_BYTES of its fixed part),
+ * off the stack that firmware budgets. NULL when the scratch cannot hold it. */
+static occ_proj_t *context_in(void *scratch, const size_t bytes, size_t *used)
+{
+    if (scratch == NULL) {
+        return NULL;
+    }
+    const size_t skip = (size_t)((8u - ((uintptr_t)scratch & 7u)) & 7u);
+    if (bytes < skip + OCC_PROJ_CTX_BYTES) {
+        return NULL;
+    }
+    *used = skip + OCC_PROJ_CTX_BYTES;
+    occ_proj_t *const x = (occ_proj_t *)(void *)((unsigned char *)scratch + skip);
+    memset(x, 0, sizeof *x);
+    return x;
+}
+
+/* Pyramid, end points, walk, then the writes, in the scratch after the context. */
+static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
+{
+    float *mem = NULL;
+    if (!carve(x, rest, rest_bytes, &mem)) {
+        return OCC_ERR_SCRATCH;
+    }
+    occi_proj_build(x, mem);
+    const bool hits_fit = occi_proj_hits(x);
+    if (hits_fit) {
+        occi_proj_walk(x);
+    }
+    size_t start[OCC_MAX_DEPTH + 2u];
+    const occ_code_t *const g = !hits_fit || x->overflow ? NULL : group_nodes(x, start);
+    const size_t slots = x->nh + x->nv + 2u * x->nn;
+    x->r->insert.scratch_used += 8u * (slots > x->hwm ? slots : x->hwm);
+    if (g == NULL) {
+        return OCC_ERR_SCRATCH;
+    }
+    x->nv = occi_proj_drop_hits(x->out + x->nh, x->nv, x->out, x->nh);
+    count_output(x);
+    return apply(x, g, start);
+}
+
 occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *image,
                                     const occ_proj_camera_t *camera, void *scratch,
                                     const size_t scratch_bytes, occ_proj_result_t *out)
@@ -175,41 +218,30 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
     if (map == NULL || image == NULL || camera == NULL || !image_ok(image) || !camera_ok(camera)) {
         return OCC_ERR_ARG;
     }
-    occ_proj_t x;
-    memset(&x, 0, sizeof x);
-    x.map = map;
-    x.im = image;
-    x.cam = camera;
-    x.r = &res;
-    occi_raygeo_init(&x.g, map);
+    occ_raygeo_t g;
+    occi_raygeo_init(&g, map);
     const float t[3] = {camera->t.x, camera->t.y, camera->t.z};
     uint32_t kt[3];
-    if (!occi_raygeo_key(&x.g, t, kt)) {
+    if (!occi_raygeo_key(&g, t, kt)) {
         return OCC_ERR_RANGE;
     }
-    x.max2 = camera->max_range_m * camera->max_range_m;
-    x.min2 = camera->min_range_m * camera->min_range_m;
-    x.far = 1024.0f * camera->max_range_m;
-    x.keep = 1.0f - camera->noise_rel;
-    x.m0 = 0.8660254f * map->cfg.resolution_m;
     res.pixels = (size_t)image->width * image->height;
-    float *mem = NULL;
+    size_t used = 0;
+    occ_proj_t *const x = context_in(scratch, scratch_bytes, &used);
     occ_err_t e = OCC_ERR_SCRATCH;
-    if (carve(&x, scratch, scratch_bytes, &mem)) {
-        occi_proj_build(&x, mem);
-        const bool hits_fit = occi_proj_hits(&x);
-        if (hits_fit) {
-            occi_proj_walk(&x);
-        }
-        size_t start[OCC_MAX_DEPTH + 2u];
-        const occ_code_t *const g = !hits_fit || x.overflow ? NULL : group_nodes(&x, start);
-        const size_t slots = x.nh + x.nv + 2u * x.nn;
-        res.insert.scratch_used += 8u * (slots > x.hwm ? slots : x.hwm);
-        if (g != NULL) {
-            x.nv = occi_proj_drop_hits(x.out + x.nh, x.nv, x.out, x.nh);
-            count_output(&x);
-            e = apply(&x, g, start);
-        }
+    if (x != NULL) {
+        x->map = map;
+        x->im = image;
+        x->cam = camera;
+        x->r = &res;
+        x->g = g;
+        x->max2 = camera->max_range_m * camera->max_range_m;
+        x->min2 = camera->min_range_m * camera->min_range_m;
+        x->far = 1024.0f * camera->max_range_m;
+        x->keep = 1.0f - camera->noise_rel;
+        x->m0 = 0.8660254f * map->cfg.resolution_m;
+        e = run(x, (unsigned char *)scratch + used, scratch_bytes - used);
+        res.insert.scratch_used += used;
     }
     if (out != NULL) {
         *out = res;
