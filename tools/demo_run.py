@@ -1,0 +1,280 @@
+#!/usr/bin/env python3
+"""demo_run.py - `make demo`: the onboard loop (`occmap run`) on real data, checked by OctoMap.
+
+  1. tools/autopilot_standin.py plays ArduPilot on UDP loopback (HEARTBEAT, TIMESYNC, streams
+     only once SET_MESSAGE_INTERVAL asks) and streams the recording's ground-truth poses as
+     LOCAL_POSITION_NED + ATTITUDE at their timestamps;
+  2. `occmap run --depth-dir DIR ... --feed-log --stats --exit-after-depth` maps the depth frames
+     as they come and sends OBSTACLE_DISTANCE; the stand-in records every message it receives;
+  3. every received OBSTACLE_DISTANCE must be a feed-log line (same time_usec and distances) with
+     the fields the autopilots need, every frame of the directory must be integrated or counted
+     dropped, and build/demo_ref (OctoMap, tools/demo_ref.cpp) recomputes every logged message's
+     sectors from the frames integrated up to it: the agreement must reach --min-agree;
+  4. pictures in OUT (loop_map.png, loop_strip.png) and the telemetry summary.
+usage: demo_run.py --occmap BIN --ref build/demo_ref --depth-dir DIR --out OUT [--frames N]
+       [--res 0.1] [--stride 4] [--tol-m 0.2] [--min-agree 0.9] [--fake] [--run-args "..."]
+Exit 0 when every check passes; prints PASS/FAIL lines.
+"""
+import argparse
+import json
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import autopilot_standin as sa  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+FR1 = (517.3, 516.5, 318.6, 255.3)  # freiburg1 calibration (tum_fr1_rpy/SOURCE.md)
+FR2 = (520.9, 521.0, 325.1, 249.7)  # freiburg2 (data/README.md)
+
+
+def short_copy(src, out, n):
+    """A TUM directory with the first n frames of src (index file cut, depth/ and poses linked)."""
+    dst = os.path.join(out, "%s_first%d" % (os.path.basename(os.path.normpath(src)), n))
+    shutil.rmtree(dst, ignore_errors=True)
+    os.makedirs(dst)
+    src = os.path.abspath(src)
+    os.symlink(os.path.join(src, "depth"), os.path.join(dst, "depth"))
+    idx = "my_association.txt" if os.path.exists(os.path.join(src, "my_association.txt")) else "depth.txt"
+    kept = 0
+    with open(os.path.join(src, idx)) as f, open(os.path.join(dst, idx), "w") as g:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                g.write(line)
+            elif kept < n:
+                g.write(line)
+                kept += 1
+    if idx == "depth.txt":
+        os.symlink(os.path.join(src, "groundtruth.txt"), os.path.join(dst, "groundtruth.txt"))
+    return dst
+
+
+def read_jsonl(path):
+    out = []
+    if os.path.exists(path):
+        for line in open(path):
+            line = line.strip()
+            if line.startswith("{"):
+                try:
+                    out.append(json.loads(line))
+                except ValueError:
+                    pass
+    return out
+
+
+def pick(cfg, names, default):
+    """The first of `names` found in the config object (nested one level), else default."""
+    for n in names:
+        if n in cfg:
+            return cfg[n], n
+        for v in cfg.values():
+            if isinstance(v, dict) and n in v:
+                return v[n], n
+    return default, None
+
+
+def ref_args(cfg, res, stride, intr):
+    """demo_ref options from occmap run's {"config": ...} line (defaults where it is silent)."""
+    used, missing = [], []
+
+    def get(names, default):
+        v, n = pick(cfg, names, default)
+        (used if n else missing).append(names[0])
+        return v
+    res = get(["res", "resolution_m"], res)
+    stride = get(["stride", "depth_stride"], stride)
+    intr = get(["intrinsics", "depth_intrinsics"], list(intr))
+    band = get(["band", "band_m"], None)
+    below = get(["band_below_m"], 0.5) if band is None else (band[0] if isinstance(band, list) else band)
+    above = get(["band_above_m"], 0.5) if band is None else (band[1] if isinstance(band, list) else band)
+    a = ["--res", str(res), "--stride", str(stride), "--intrinsics", ",".join(str(v) for v in intr),
+         "--band", "%s,%s" % (below, above),
+         "--ignore-ground", str(int(bool(get(["ignore_ground"], True)))),
+         "--clearance", str(get(["ground_clearance_m"], 0.1)),
+         "--offset-deg", str(get(["angle_offset_deg", "angle_offset"], -20.0)),
+         "--unknown-as-distance", str(int(bool(get(["unknown_as_distance"], False)))),
+         "--min-range", str(get(["min_range_m", "depth_min_range_m"], 0.0)),
+         "--max-range", str(get(["max_range_m", "depth_max_range_m"], -1.0) or -1.0)]
+    return a, used, missing
+
+
+def check_link(st, feed, frames_n, errors):
+    """Received messages against the feed log, fields, heartbeats, requests, frame accounting."""
+    logged = {(m["time_usec"], tuple(m["distances"])) for m in feed}
+    unmatched = [o for o in st.obstacles if (o["time_usec"], tuple(o["distances"])) not in logged]
+    if unmatched:
+        errors.append("%d OBSTACLE_DISTANCE received that the feed log does not hold (first: time_usec %d)"
+                      % (len(unmatched), unmatched[0]["time_usec"]))
+    if len(st.obstacles) + 1 < len(feed):
+        errors.append("feed log has %d messages, the autopilot received %d" % (len(feed), len(st.obstacles)))
+    for o in st.obstacles:
+        d = o["distances"]
+        inc = o["increment_f"] or o["increment"]
+        if o["src"] != [1, 196] or o["frame"] != 12 or inc != 5.0 or len(d) != 72 or 0 in d \
+                or not (0 < o["min_cm"] < o["max_cm"]):
+            errors.append("bad OBSTACLE_DISTANCE fields: %s" % {k: v for k, v in o.items() if k != "distances"})
+            break
+    if not any(h["src"] == [1, 196] for h in st.heartbeats):
+        errors.append("no HEARTBEAT from 1/196")
+    asked = {int(r[2]) for r in st.requests if r[1] == sa.CMD_SET_MESSAGE_INTERVAL}
+    if sa.MSG_LPN not in asked and sa.MSG_ODOM not in asked:
+        errors.append("occmap run never asked for LOCAL_POSITION_NED / ODOMETRY (asked %s)" % sorted(asked))
+    seen = [i for m in feed for i in m.get("frames", [])] + [i for m in feed for i in m.get("frames_dropped", [])]
+    if sorted(seen) != list(range(frames_n)):
+        dup = len(seen) - len(set(seen))
+        errors.append("frames accounted %d of %d (%d twice)" % (len(set(seen)), frames_n, dup))
+
+
+def telemetry(stats):
+    """The stats lines' summary: the config, the last line, and the run's extremes."""
+    cfg = next((s["config"] for s in stats if "config" in s), {})
+    lines = [s for s in stats if "config" not in s]
+    print("demo: occmap run config: %s" % json.dumps(cfg))
+    if lines:
+        print("demo: telemetry, %d lines; last: %s" % (len(lines), json.dumps(lines[-1])))
+    return cfg
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--occmap", required=True)
+    ap.add_argument("--ref", required=True)
+    ap.add_argument("--depth-dir", required=True)
+    ap.add_argument("--poses")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--frames", type=int, default=0)
+    ap.add_argument("--res", type=float, default=0.1)
+    ap.add_argument("--stride", type=int, default=4)
+    ap.add_argument("--tol-m", type=float, default=0.2)
+    ap.add_argument("--min-agree", type=float, default=0.9)
+    ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--fake", action="store_true", help="tools/demo_fake_run.py plays occmap run")
+    ap.add_argument("--run-args", default="", help="more options for occmap run")
+    ap.add_argument("--name", default="loop")
+    ap.add_argument("--plant", action="store_true",
+                    help="then prove the checker: planted wrong distances in the feed log must fail it")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    t_start = time.monotonic()
+    d = short_copy(a.depth_dir, a.out, a.frames) if a.frames else a.depth_dir
+    frames, poses = sa.read_recording(d, a.poses)
+    intr = FR2 if "fr2" in d or "freiburg2" in d else FR1
+    p = lambda n: os.path.join(a.out, "%s_%s" % (a.name, n))  # noqa: E731
+    for f in ("feed.jsonl", "stats.jsonl", "standin.jsonl"):
+        if os.path.exists(p(f)):
+            os.remove(p(f))
+    st = sa.Standin(poses, sa.t_ref_of(frames), record=p("standin.jsonl"))
+    th = st.start()
+    base = ([sys.executable, os.path.join(HERE, "demo_fake_run.py"), "--occmap", a.occmap, "run"] if a.fake
+            else [a.occmap, "run"])
+    cmd = base + ["--udp", "127.0.0.1:%d" % st.port, "--depth-dir", d, "--depth-stride", str(a.stride),
+                  "--res", str(a.res), "--depth-intrinsics", ",".join(str(v) for v in intr),
+                  "--feed-log", p("feed.jsonl"), "--stats", p("stats.jsonl"), "--exit-after-depth",
+                  "--duration", str(int(a.timeout))] + shlex.split(a.run_args)
+    span = frames[-1][0] - frames[0][0]
+    print("demo: %s: %d frames over %.1f s, %d poses; stand-in on 127.0.0.1:%d; %s"
+          % (d, len(frames), span, len(st.poses), st.port, " ".join(cmd)), flush=True)
+    errors = []
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        out, err = proc.communicate(timeout=a.timeout + 30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        out, err = proc.communicate()
+        errors.append("occmap run did not exit within %.0f s" % (a.timeout + 30))
+    time.sleep(0.3)
+    st.stop.set()
+    th.join(5)
+    if proc.returncode != 0:
+        errors.append("occmap run exit %s: %s" % (proc.returncode, err.strip()[-600:]))
+    t_loop = time.monotonic() - t_start
+    feed = read_jsonl(p("feed.jsonl"))
+    stats = read_jsonl(p("stats.jsonl"))
+    print("demo: loop done in %.1f s: stand-in %s" % (t_loop, json.dumps(st.summary())), flush=True)
+    for s in st.statustexts:
+        print("demo: STATUSTEXT from %s: %s" % (s["src"], s["text"]))
+    if not feed:
+        errors.append("empty feed log")
+    else:
+        check_link(st, feed, len(frames), errors)
+    cfg = telemetry(stats)
+    ref = None
+    if feed:
+        args, used, missing = ref_args(cfg, a.res, a.stride, intr)
+        if missing:
+            print("demo: config line lacks %s: demo_ref uses its defaults there" % ", ".join(missing))
+        seqs = sorted({feed[int(i * (len(feed) - 1) / 5)]["seq"] for i in range(6)})
+        cmd_ref = [a.ref, "--feed-log", p("feed.jsonl"), "--depth-dir", d, "--tol-m", str(a.tol_m),
+                   "--min-agree", str(a.min_agree), "--out", p("ref.jsonl"), "--slices", a.out,
+                   "--slice-seqs", ",".join(str(s) for s in seqs)] + args
+        if a.poses:
+            cmd_ref += ["--poses", a.poses]
+        t0 = time.monotonic()
+        r = subprocess.run(cmd_ref, stdout=subprocess.PIPE, text=True)
+        t_ref = time.monotonic() - t0
+        print("demo: %s\ndemo: OctoMap reference over %d messages in %.1f s: %s"
+              % (" ".join(cmd_ref), len(feed), t_ref, r.stdout.strip()), flush=True)
+        try:
+            ref = json.loads(r.stdout.strip().splitlines()[-1])
+        except (ValueError, IndexError):
+            ref = None
+        if r.returncode != 0:
+            errors.append("OctoMap reference disagrees (demo_ref exit %d)" % r.returncode)
+        pictures(a, feed, seqs, cfg)
+        if a.plant:
+            plant(a, feed, cmd_ref, errors)
+    n_int = sum(len(m.get("frames", [])) for m in feed)
+    n_drop = sum(len(m.get("frames_dropped", [])) for m in feed)
+    print("demo: %d OBSTACLE_DISTANCE received, %d frames integrated, %d dropped, agreement %s, total %.1f s"
+          % (len(st.obstacles), n_int, n_drop, "%.1f %%" % (100 * ref["agree_frac"]) if ref else "-",
+             time.monotonic() - t_start))
+    for e in errors:
+        print("FAIL demo %s: %s" % (a.name, e))
+    print("%s demo %s" % ("FAIL" if errors else "PASS", a.name), flush=True)
+    return 1 if errors else 0
+
+
+def plant(a, feed, cmd_ref, errors):
+    """The checker must refuse a feed log whose sectors lie: every sector "no obstacle", and every
+    sector an obstacle at 1 m (the tolerance is 0.2 m)."""
+    for what, val in (("all free", lambda m: m["max_cm"] + 1), ("all obstacles at 1 m", lambda m: 100)):
+        bad = p_bad = os.path.join(a.out, "%s_planted.jsonl" % a.name)
+        with open(bad, "w") as f:
+            for m in feed:
+                f.write(json.dumps(dict(m, distances=[val(m)] * len(m["distances"]))) + "\n")
+        c = list(cmd_ref)
+        c[c.index("--feed-log") + 1] = p_bad
+        c = c[:c.index("--out")] + ["--min-agree", "0.5"]
+        r = subprocess.run(c, stdout=subprocess.PIPE, text=True)
+        print("demo: planted %s: demo_ref exit %d %s" % (what, r.returncode, r.stdout.strip()[:160]))
+        if r.returncode != 1:
+            errors.append("the OctoMap checker accepted a feed log with %s sectors" % what)
+
+
+def pictures(a, feed, seqs, cfg):
+    import demo_pictures as dp
+    msgs = {m["seq"]: m for m in feed}
+    slices = [dp.read_slice(os.path.join(a.out, "slice_%d.txt" % s)) for s in seqs
+              if os.path.exists(os.path.join(a.out, "slice_%d.txt" % s))]
+    for s in seqs:
+        path = os.path.join(a.out, "slice_%d.txt" % s)
+        if os.path.exists(path):
+            os.replace(path, os.path.join(a.out, "%s_slice_%d.txt" % (a.name, s)))
+    max_cm = feed[-1]["max_cm"]
+    off, _ = pick(cfg, ["angle_offset_deg", "angle_offset"], -20.0)
+    if slices:
+        w, h = dp.map_panels(os.path.join(a.out, "%s_map.png" % a.name), slices, msgs, float(off), max_cm)
+        print("demo: %s/%s_map.png (%dx%d): map slice, path and sectors at messages %s"
+              % (a.out, a.name, w, h, seqs))
+    refs = {r["seq"]: r for r in read_jsonl(os.path.join(a.out, "%s_ref.jsonl" % a.name))}
+    rows = [refs.get(m["seq"], {}).get("ok") for m in feed]
+    w, h = dp.strip(os.path.join(a.out, "%s_strip.png" % a.name), feed, rows, max_cm)
+    print("demo: %s/%s_strip.png (%dx%d): sectors over time, disagreements below" % (a.out, a.name, w, h))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
