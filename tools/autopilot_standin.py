@@ -29,6 +29,7 @@ import bisect
 import json
 import math
 import os
+import sys
 import threading
 import time
 
@@ -303,7 +304,44 @@ class Standin:
                 "bad_data": self.bad, "other_rx": self.other}
 
 
+def selftest():
+    """The frame rules on hand-worked poses; returns a list of failures."""
+    bad = []
+    near = lambda a, b: all(abs(x - y) < 1e-9 for x, y in zip(a, b))  # noqa: E731
+    mrt = body_from_camera((0, 0, 0, 0, 0, 0))
+    # Camera looking north (ENU +y), image x to the east, image y down: level, heading north.
+    R_wc = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]
+    ned, roll, pitch, yaw, q_nf, (p, q) = to_mavlink([1.0, 2.0, 3.0], mat_to_quat(R_wc), mrt)
+    if not near(ned, (2.0, 1.0, -3.0)) or not near((roll, pitch, yaw), (0.0, 0.0, 0.0)):
+        bad.append("north-looking camera: ned %s rpy %s (want (2,1,-3), 0,0,0)" % (ned, (roll, pitch, yaw)))
+    # The same camera looking east (ENU +x): yaw +90 deg (NED, clockwise from north).
+    R_wc = [[0, 0, 1], [-1, 0, 0], [0, -1, 0]]
+    _, roll, pitch, yaw, _, _ = to_mavlink([0, 0, 0], mat_to_quat(R_wc), mrt)
+    if not near((roll, pitch, yaw), (0.0, 0.0, math.pi / 2)):
+        bad.append("east-looking camera: rpy %s (want 0, 0, pi/2)" % ((roll, pitch, yaw),))
+    # Looking north, tilted 30 deg down (pitch -30), rolled: body x = camera z, body up = -camera y.
+    R_wc = mul(rpy_mat(0.0, 0.0, math.pi / 2), mul(rpy_mat(0.2, math.radians(30), 0.0), BODY_FROM_OPTICAL))
+    _, roll, pitch, yaw, _, (p, q) = to_mavlink([0, 0, 0], mat_to_quat(R_wc), mrt)
+    R_wb = quat_to_mat(q)
+    if not near([R_wb[i][0] for i in range(3)], [R_wc[i][2] for i in range(3)]) or \
+            not near([R_wb[i][2] for i in range(3)], [-R_wc[i][1] for i in range(3)]) or \
+            not near((roll, pitch, yaw), (0.2, -math.radians(30), 0.0)):
+        bad.append("tilted camera: rpy %s (want 0.2, -0.524, 0)" % ((roll, pitch, yaw),))
+    # A mount 0.1 m forward: the body origin is 0.1 m behind the camera.
+    ned, _, _, _, _, _ = to_mavlink([0, 0, 0], mat_to_quat([[1, 0, 0], [0, 0, 1], [0, -1, 0]]),
+                                    body_from_camera((0.1, 0, 0, 0, 0, 0)))
+    if not near(ned, (-0.1, 0.0, 0.0)):
+        bad.append("mount 0.1 m forward: ned %s (want -0.1, 0, 0)" % (ned,))
+    return bad
+
+
 def main():
+    if "--selftest" in sys.argv:
+        bad = selftest()
+        for b in bad:
+            print("FAIL standin frames: " + b)
+        print("%s standin frames" % ("FAIL" if bad else "PASS"))
+        return 1 if bad else 0
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--depth-dir", required=True)
     ap.add_argument("--poses", help="groundtruth.txt (default: the directory's)")
@@ -322,4 +360,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

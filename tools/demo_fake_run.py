@@ -64,7 +64,7 @@ def main():
     feed = open(o["--feed-log"], "w") if "--feed-log" in o else None
     res, stride = float(o["--res"]), int(o["--depth-stride"])
     stats.write(json.dumps({"config": {"fake": True, "res": res, "stride": stride, "method": "simple",
-                                       "intrinsics": list(INTR), "mount": [0, 0, 0, 0, 0, 0],
+                                       "intrinsics": [float(v) for v in o.get("--depth-intrinsics", ",".join(map(str, INTR))).split(",")], "mount": [0, 0, 0, 0, 0, 0],
                                        "band_below_m": BAND, "band_above_m": BAND, "ignore_ground": True,
                                        "ground_clearance_m": 0.1, "angle_offset_deg": OFFSET,
                                        "min_cm": MIN_CM, "max_cm": MAX_CM}}) + "\n")

@@ -37,6 +37,7 @@ demo-static: demo-mavlink
 # first 60 frames through the real `occmap run` (skipped while the command does not exist).
 test-demo-tools: $(BUILD)/occmap $(BUILD)/demo_ref $(BUILD)/.deps-ok
 	@if [ ! -d $(DEMO_TUM) ]; then echo "SKIP: $(DEMO_TUM) absent (../shared)"; exit 77; fi
+	$(PY) tools/autopilot_standin.py --selftest
 	$(DEMO_PY) --depth-dir $(DEMO_TUM) --frames 40 --fake --plant --name test_fake --timeout 30
 test-demo-loop: $(BUILD)/occmap $(BUILD)/demo_ref $(BUILD)/.deps-ok
 	@if [ ! -d $(DEMO_TUM) ]; then echo "SKIP: $(DEMO_TUM) absent (../shared)"; exit 77; fi

@@ -53,6 +53,36 @@ def short_copy(src, out, n):
     return dst
 
 
+def sequence_copy(src, out):
+    """The association layout (my_association.txt: rgb depth tx ty tz qx qy qz qw per frame, only
+    some PNGs present) as the TUM sequence layout `occmap run --depth-dir` reads: depth.txt with
+    the frames whose PNG is here, groundtruth.txt with every line's pose (the time is the depth
+    file's name), depth/ linked."""
+    dst = os.path.join(out, os.path.basename(os.path.normpath(src)) + "_seq")
+    shutil.rmtree(dst, ignore_errors=True)
+    os.makedirs(dst)
+    src = os.path.abspath(src)
+    os.symlink(os.path.join(src, "depth"), os.path.join(dst, "depth"))
+    rows = []
+    for line in open(os.path.join(src, "my_association.txt")):
+        f = line.split()
+        if len(f) >= 9 and not line.startswith("#"):
+            rows.append((os.path.basename(f[1])[:-4], f[1], f[2:9]))
+    rows.sort(key=lambda r: float(r[0]))
+    # A depth frame associated with two RGB frames is listed twice: keep its first pose.
+    rows = [r for i, r in enumerate(rows) if i == 0 or float(r[0]) > float(rows[i - 1][0])]
+    with open(os.path.join(dst, "depth.txt"), "w") as g:
+        g.write("# depth maps\n# from %s/my_association.txt (frames present)\n# timestamp filename\n" % src)
+        for t, png, _ in rows:
+            if os.path.exists(os.path.join(src, png)):
+                g.write("%s %s\n" % (t, png))
+    with open(os.path.join(dst, "groundtruth.txt"), "w") as g:
+        g.write("# ground truth trajectory\n# from my_association.txt\n# timestamp tx ty tz qx qy qz qw\n")
+        for t, _, v in rows:
+            g.write("%s %s\n" % (t, " ".join(v)))
+    return dst
+
+
 def read_jsonl(path):
     out = []
     if os.path.exists(path):
@@ -160,9 +190,12 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     t_start = time.monotonic()
-    d = short_copy(a.depth_dir, a.out, a.frames) if a.frames else a.depth_dir
+    d = a.depth_dir
+    if os.path.exists(os.path.join(d, "my_association.txt")):
+        d = sequence_copy(d, a.out)
+    d = short_copy(d, a.out, a.frames) if a.frames else d
     frames, poses = sa.read_recording(d, a.poses)
-    intr = FR2 if "fr2" in d or "freiburg2" in d else FR1
+    intr = FR2 if "fr2" in os.path.basename(d) or "freiburg2" in d else FR1
     p = lambda n: os.path.join(a.out, "%s_%s" % (a.name, n))  # noqa: E731
     for f in ("feed.jsonl", "stats.jsonl", "standin.jsonl"):
         if os.path.exists(p(f)):
