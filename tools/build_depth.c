@@ -18,7 +18,7 @@ static bool file_exists(const char *dir, const char *name)
 }
 
 /* TUM names its sequences rgbd_dataset_freiburgN_...: the camera follows from the name. */
-static occ_depth_camera_t camera_for(const char *dir)
+occ_depth_camera_t build_depth_camera_for(const char *dir)
 {
     return strstr(dir, "freiburg1") != NULL || strstr(dir, "fr1") != NULL
                ? occ_depth_camera_tum_fr1()
@@ -37,7 +37,7 @@ int build_depth_load(const char *dir, unsigned stride, size_t max_frames,
         e = occ_depth_read_tum_dir(dir, stride, max_frames, frames, n_frames, msg, sizeof msg);
     } else {
         info->layout = "groundtruth";
-        info->cam = camera_for(dir);
+        info->cam = build_depth_camera_for(dir);
         e = occ_depth_read_tum_sequence(dir, &info->cam, stride, max_frames, frames, n_frames,
                                         &info->frames_dropped, msg, sizeof msg);
     }

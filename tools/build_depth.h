@@ -19,6 +19,10 @@ typedef struct {
 int build_depth_load(const char *dir, unsigned stride, size_t max_frames,
                      occ_scan_frame_t **frames, size_t *n_frames, build_depth_info_t *info);
 
+/* The TUM camera a sequence directory was taken with: freiburg1's when the path names
+ * freiburg1 / fr1, else freiburg2's (also `occmap run --depth-dir`). */
+occ_depth_camera_t build_depth_camera_for(const char *dir);
+
 /* The info as JSON members (", \"depth_layout\": ..., \"frames_dropped\": N") or text lines. */
 void build_depth_print_json(FILE *f, const build_depth_info_t *info);
 void build_depth_print_text(FILE *f, const build_depth_info_t *info);

@@ -15,6 +15,7 @@ int cmd_info(int argc, char **argv);      /* cmd_info.c     files */
 int cmd_convert(int argc, char **argv);   /* cmd_convert.c  files */
 int cmd_feed(int argc, char **argv);      /* cmd_feed.c     MAVLink */
 int cmd_can_feed(int argc, char **argv);  /* cmd_can_feed.c DroneCAN */
+int cmd_run(int argc, char **argv);       /* cmd_run.c      the onboard loop */
 
 /* Parse "a,b,c,..." into exactly n floats; false on any malformed or non-finite entry. */
 int cli_parse_floats(const char *s, float *out, int n);

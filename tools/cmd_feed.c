@@ -75,31 +75,6 @@ static void feed_opts_init(feed_opts_t *o)
     o->pose_interval_ms = o->cfg.pose_interval_us / 1000u;
 }
 
-/* Which voxels count and what an element says: the band, the ground, angles, unknown space. */
-static int sector_option(occ_sectors_config_t *sc, const char *a, const char *v)
-{
-    bool ok;
-    if (strcmp(a, "--band-m") == 0) {
-        float band_m = 0.0f;
-        ok = cli_parse_float_in(v, 0.01f, 100.0f, &band_m);
-        sc->band_below_m = sc->band_above_m = band_m;
-    } else if (strcmp(a, "--band-below-m") == 0) {
-        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->band_below_m);
-    } else if (strcmp(a, "--band-above-m") == 0) {
-        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->band_above_m);
-    } else if (strcmp(a, "--ground-clearance-m") == 0) {
-        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->ground_clearance_m);
-    } else if (strcmp(a, "--angle-offset-deg") == 0) {
-        ok = cli_parse_float_in(v, -360.0f, 360.0f, &sc->angle_offset_deg);
-    } else if (strcmp(a, "--unknown") == 0) {
-        ok = strcmp(v, "no-data") == 0 || strcmp(v, "distance") == 0;
-        sc->unknown_as_distance = ok ? strcmp(v, "distance") == 0 : sc->unknown_as_distance;
-    } else {
-        return FEED_OPT_UNKNOWN;
-    }
-    return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
-}
-
 /* Who is who on the MAVLink side: our ids, the autopilot's, its streams and its kind. */
 static int mavlink_option(feed_opts_t *o, const char *a, const char *v)
 {
@@ -147,7 +122,7 @@ static int feed_option(void *ctx, const char *a, const char *v)
         }
         return FEED_OPT_OK;
     }
-    const int r = sector_option(&o->cfg.sectors, a, v);
+    const int r = feed_args_sector_option(&o->cfg.sectors, a, v);
     return r != FEED_OPT_UNKNOWN ? r : mavlink_option(o, a, v);
 }
 

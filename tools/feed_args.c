@@ -40,6 +40,31 @@ static int shared_option(feed_args_t *a, const char *opt, const char *v)
     return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
 }
 
+/* Which voxels count and what an element says: the band, the ground, angles, unknown space. */
+int feed_args_sector_option(occ_sectors_config_t *sc, const char *a, const char *v)
+{
+    bool ok;
+    if (strcmp(a, "--band-m") == 0) {
+        float band_m = 0.0f;
+        ok = cli_parse_float_in(v, 0.01f, 100.0f, &band_m);
+        sc->band_below_m = sc->band_above_m = band_m;
+    } else if (strcmp(a, "--band-below-m") == 0) {
+        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->band_below_m);
+    } else if (strcmp(a, "--band-above-m") == 0) {
+        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->band_above_m);
+    } else if (strcmp(a, "--ground-clearance-m") == 0) {
+        ok = cli_parse_float_in(v, 0.0f, 100.0f, &sc->ground_clearance_m);
+    } else if (strcmp(a, "--angle-offset-deg") == 0) {
+        ok = cli_parse_float_in(v, -360.0f, 360.0f, &sc->angle_offset_deg);
+    } else if (strcmp(a, "--unknown") == 0) {
+        ok = strcmp(v, "no-data") == 0 || strcmp(v, "distance") == 0;
+        sc->unknown_as_distance = ok ? strcmp(v, "distance") == 0 : sc->unknown_as_distance;
+    } else {
+        return FEED_OPT_UNKNOWN;
+    }
+    return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
+}
+
 static bool is_flag(const feed_cmd_t *cmd, const char *opt)
 {
     for (const char *const *f = cmd->flags; f != NULL && *f != NULL; f++) {

@@ -42,6 +42,11 @@ typedef struct {
  * message on stderr (a missing value or an unknown option, then the usage; a bad value). */
 int feed_args_parse(feed_args_t *a, const feed_cmd_t *cmd, int argc, char **argv);
 
+/* The sector options `occmap feed` and `occmap run` share: --band-m, --band-below-m,
+ * --band-above-m, --ground-clearance-m, --angle-offset-deg, --unknown no-data|distance, into `sc`.
+ * FEED_OPT_OK, FEED_OPT_BAD_VALUE or FEED_OPT_UNKNOWN (not one of them). */
+int feed_args_sector_option(occ_sectors_config_t *sc, const char *opt, const char *val);
+
 /* min_m, max_m in whole centimetres (rounded) into the sector settings. */
 void feed_args_apply_range(const feed_args_t *a, occ_sectors_config_t *sc);
 

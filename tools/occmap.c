@@ -14,6 +14,7 @@ static const struct {
     {"info", cmd_info, "info MAP [--json]: format and statistics of a map file"},
     {"convert", cmd_convert, "convert IN OUT: between .bt, .ot and .occ"},
     {"feed", cmd_feed, "feed --map MAP --udp HOST:PORT ...: OBSTACLE_DISTANCE over MAVLink"},
+    {"run", cmd_run, "run --udp HOST:PORT --depth-dir DIR ...: the onboard loop (map + feed)"},
     {"can-feed", cmd_can_feed, "can-feed --map MAP --socketcan IF|--mcast BUS ...: DroneCAN"},
 };
 

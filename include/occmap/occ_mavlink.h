@@ -296,6 +296,7 @@ typedef struct {
         occ_quat_t ned_from_frd;     /* last attitude, body FRD -> local NED (unit) */
         uint64_t next_obstacle_us, next_heartbeat_us;
         occ_sectors_t sectors;       /* last result + scratch */
+        uint8_t system_status;       /* HEARTBEAT's MAV_STATE (occ_mav_feed_set_status) */
     } priv;                          /* internal: do not touch, layout may change */
 } occ_mav_feed_t;
 

@@ -1,5 +1,6 @@
 /* mavlink_feed.c - poses in, OBSTACLE_DISTANCE + HEARTBEAT out, on the caller's clock. */
 #include "occmap/occ_mavlink.h"
+#include "occmap/occ_mavlink_run.h"
 
 #include <math.h>
 #include <string.h>
@@ -62,7 +63,15 @@ occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg)
     f->have_autopilot = cfg->autopilot_sysid != 0u;
     f->ap_sysid = cfg->autopilot_sysid;
     f->ap_compid = cfg->autopilot_compid;
+    f->priv.system_status = MAV_STATE_ACTIVE_;
     return OCC_OK;
+}
+
+void occ_mav_feed_set_status(occ_mav_feed_t *f, uint8_t system_status)
+{
+    if (f != NULL) {
+        f->priv.system_status = system_status;
+    }
 }
 
 static bool is_pose_message(uint32_t msgid)
@@ -328,7 +337,7 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         hb.type = MAV_TYPE_ONBOARD_CONTROLLER_;
         hb.autopilot = MAV_AUTOPILOT_INVALID_;
         hb.base_mode = 0;
-        hb.system_status = MAV_STATE_ACTIVE_;
+        hb.system_status = f->priv.system_status;
         hb.mavlink_version = 3;
         const size_t n = occ_mav_encode_heartbeat(&f->priv.tx, &hb, out, cap);
         if (n > 0u) {

@@ -1,0 +1,45 @@
+/* run_link.h - the link side of `occmap run` (main thread): MAVLink in (poses into the history,
+ * TIMESYNC, the feed's autopilot bookkeeping), out (OBSTACLE_DISTANCE from the live map,
+ * HEARTBEAT with the loop's status, SET_MESSAGE_INTERVAL, TIMESYNC, STATUSTEXT), the feed log
+ * and the telemetry lines. */
+#ifndef OCC_TOOLS_RUN_LINK_H_INCLUDED
+#define OCC_TOOLS_RUN_LINK_H_INCLUDED
+
+#include "run.h"
+
+typedef struct {
+    uint64_t sent;                  /* OBSTACLE_DISTANCE sent */
+    uint64_t last_us;               /* local time of the last one */
+    uint32_t *interval_us;          /* every period between two, in order */
+    size_t n, cap;
+} run_feed_timing_t;
+
+typedef struct {
+    const run_opts_t *opt;
+    run_state_t *st;
+    run_mapguard_t *guard;
+    const run_depth_t *depth;       /* NULL without --depth-dir */
+    occ_link_t *link;
+    occ_mav_feed_t *feed;
+    occ_mav_parser_t parser;        /* our own pass over the bytes (poses, TIMESYNC) */
+    occ_mav_pose_rx_t prx;
+    occ_mav_sender_t tx;            /* TIMESYNC and STATUSTEXT (the feed has its own) */
+    FILE *stats, *feed_log;
+    uint64_t t0, next_stats, next_timesync;
+    uint32_t timesync_sent, refusals_logged, statustexts;
+    bool ever_sent, stale, autopilot_logged;
+    const char *stale_why;
+    uint64_t od_seq;
+    run_feed_timing_t ft;
+    bool done_seen;                 /* the mapper finished: */
+    uint64_t done_sent, done_us;    /* obstacle count and time then (--exit-after-depth) */
+} run_link_t;
+
+/* Until stop, --duration or --exit-after-depth. 0, or 1 after a link error. */
+int run_link_loop(run_link_t *l);
+
+/* Telemetry (run_stats.c): the config line, one line a second, the final line. */
+void run_stats_config(run_link_t *l);
+void run_stats_line(run_link_t *l, uint64_t now, const char *key, bool map_check_ok);
+
+#endif
