@@ -8,6 +8,8 @@ Listens like SITL's udpin and, as a companion port of ArduPilot does:
     ATTITUDE (30), ATTITUDE_QUATERNION (31) and ODOMETRY (331), FAILED for other ids; other
     commands get UNSUPPORTED;
   - answers TIMESYNC requests (tc1 == 0) with tc1 = its boot time in ns and ts1 echoed;
+  - streams of equal interval share one tick (ArduPilot's deferred-message buckets), so
+    LOCAL_POSITION_NED and ATTITUDE of one pose go out together;
   - streams the recording's poses at their timestamps: its boot clock starts at 0 when it starts,
     and a pose recorded at TUM time t is due at boot time (t - T_REF) (interface file, issue 21:
     T_REF = first depth.txt timestamp - 1 s). At each stream tick the newest due pose is sent once,
@@ -203,7 +205,10 @@ class Standin:
                         self.intervals.pop(mid, None)
                     else:
                         self.intervals[mid] = int(iv) if iv > 0 else 100000  # 0: the default rate
-                        self.next_due[mid] = self.boot_us()
+                        # ArduPilot keeps messages of equal interval in one bucket, sent together:
+                        # join the tick of a stream already running at this interval.
+                        mate = [m for m, v in self.intervals.items() if m != mid and v == self.intervals[mid]]
+                        self.next_due[mid] = self.next_due[mate[0]] if mate else self.boot_us()
             else:
                 result = MAV_RESULT_FAILED
         self.conn.mav.command_ack_send(m.command, result, 0, 0, h.srcSystem, h.srcComponent)

@@ -12,7 +12,7 @@
      sectors from the frames integrated up to it: the agreement must reach --min-agree;
   4. pictures in OUT (loop_map.png, loop_strip.png) and the telemetry summary.
 usage: demo_run.py --occmap BIN --ref build/demo_ref --depth-dir DIR --out OUT [--frames N]
-       [--res 0.1] [--stride 4] [--tol-m 0.2] [--min-agree 0.9] [--fake] [--run-args "..."]
+       [--res 0.1] [--stride 4] [--tol-m 0.2] [--min-agree 0.9] [--plant] [--run-args "..."]
 Exit 0 when every check passes; prints PASS/FAIL lines.
 """
 import argparse
@@ -27,7 +27,6 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import autopilot_standin as sa  # noqa: E402
 
-HERE = os.path.dirname(os.path.abspath(__file__))
 FR1 = (517.3, 516.5, 318.6, 255.3)  # freiburg1 calibration (tum_fr1_rpy/SOURCE.md)
 FR2 = (520.9, 521.0, 325.1, 249.7)  # freiburg2 (data/README.md)
 
@@ -118,9 +117,8 @@ def ref_args(cfg, res, stride, intr):
     res = get(["res", "resolution_m"], res)
     stride = get(["stride", "depth_stride"], stride)
     intr = get(["intrinsics", "depth_intrinsics"], list(intr))
-    band = get(["band", "band_m"], None)
-    below = get(["band_below_m"], 0.5) if band is None else (band[0] if isinstance(band, list) else band)
-    above = get(["band_above_m"], 0.5) if band is None else (band[1] if isinstance(band, list) else band)
+    below = get(["band_below_m"], 0.5)
+    above = get(["band_above_m"], 0.5)
     a = ["--res", str(res), "--stride", str(stride), "--intrinsics", ",".join(str(v) for v in intr),
          "--band", "%s,%s" % (below, above),
          "--ignore-ground", str(int(bool(get(["ignore_ground"], True)))),
@@ -154,18 +152,22 @@ def check_link(st, feed, frames_n, errors):
     if sa.MSG_LPN not in asked and sa.MSG_ODOM not in asked:
         errors.append("occmap run never asked for LOCAL_POSITION_NED / ODOMETRY (asked %s)" % sorted(asked))
     seen = [i for m in feed for i in m.get("frames", [])] + [i for m in feed for i in m.get("frames_dropped", [])]
-    if sorted(seen) != list(range(frames_n)):
+    if sorted(seen) != frames_n:
         dup = len(seen) - len(set(seen))
-        errors.append("frames accounted %d of %d (%d twice)" % (len(set(seen)), frames_n, dup))
+        errors.append("frames accounted %d of %d (%d twice)" % (len(set(seen)), len(frames_n), dup))
 
 
 def telemetry(stats):
-    """The stats lines' summary: the config, the last line, and the run's extremes."""
+    """The telemetry summary: occmap run's config line, then its final line (or the last one),
+    one key a line."""
     cfg = next((s["config"] for s in stats if "config" in s), {})
     lines = [s for s in stats if "config" not in s]
     print("demo: occmap run config: %s" % json.dumps(cfg))
     if lines:
-        print("demo: telemetry, %d lines; last: %s" % (len(lines), json.dumps(lines[-1])))
+        last = lines[-1].get("final", lines[-1])
+        print("demo: telemetry (%d lines a second; %s):" % (len(lines), "final" if "final" in lines[-1] else "last"))
+        for k, v in last.items():
+            print("demo:   %-14s %s" % (k, json.dumps(v)))
     return cfg
 
 
@@ -182,7 +184,6 @@ def main():
     ap.add_argument("--tol-m", type=float, default=0.2)
     ap.add_argument("--min-agree", type=float, default=0.9)
     ap.add_argument("--timeout", type=float, default=120.0)
-    ap.add_argument("--fake", action="store_true", help="tools/demo_fake_run.py plays occmap run")
     ap.add_argument("--run-args", default="", help="more options for occmap run")
     ap.add_argument("--name", default="loop")
     ap.add_argument("--plant", action="store_true",
@@ -202,15 +203,15 @@ def main():
             os.remove(p(f))
     st = sa.Standin(poses, sa.t_ref_of(frames), record=p("standin.jsonl"))
     th = st.start()
-    base = ([sys.executable, os.path.join(HERE, "demo_fake_run.py"), "--occmap", a.occmap, "run"] if a.fake
-            else [a.occmap, "run"])
-    cmd = base + ["--udp", "127.0.0.1:%d" % st.port, "--depth-dir", d, "--depth-stride", str(a.stride),
+    cmd = [a.occmap, "run","--udp", "127.0.0.1:%d" % st.port, "--depth-dir", d, "--depth-stride", str(a.stride),
                   "--res", str(a.res), "--depth-intrinsics", ",".join(str(v) for v in intr),
                   "--feed-log", p("feed.jsonl"), "--stats", p("stats.jsonl"), "--exit-after-depth",
                   "--duration", str(int(a.timeout))] + shlex.split(a.run_args)
-    span = frames[-1][0] - frames[0][0]
+    # depth.txt may list frames whose PNG is not here (tum_fr1_rpy: 722 listed, 500 copied).
+    present = [i for i, f in enumerate(frames) if os.path.exists(os.path.join(d, f[1]))]
+    span = frames[present[-1]][0] - frames[present[0]][0]
     print("demo: %s: %d frames over %.1f s, %d poses; stand-in on 127.0.0.1:%d; %s"
-          % (d, len(frames), span, len(st.poses), st.port, " ".join(cmd)), flush=True)
+          % (d, len(present), span, len(st.poses), st.port, " ".join(cmd)), flush=True)
     errors = []
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -233,7 +234,7 @@ def main():
     if not feed:
         errors.append("empty feed log")
     else:
-        check_link(st, feed, len(frames), errors)
+        check_link(st, feed, present, errors)
     cfg = telemetry(stats)
     ref = None
     if feed:
