@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "run_link.h"
+#include "run_ranges.h"
 #include "occmap/occ_port.h"
 #include "occmap/host/occ_file.h"
 
@@ -129,11 +130,14 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
 {
     static occ_mav_feed_t feed; /* sector scratch: off the stack */
     static run_state_t st;
+    static run_ranges_t ranges;
     run_mapguard_t guard;
     int status = make_feed(o, &feed);
     if (status != 0 || make_state(&st) != 0 || run_mapguard_init(&guard, map) != 0) {
         return status != 0 ? status : 1;
     }
+    memset(&ranges, 0, sizeof ranges);
+    st.ranges = &ranges;
     occ_link_t link;
     static run_link_t l;
     memset(&l, 0, sizeof l);
@@ -148,6 +152,7 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
     pc.sysid = (uint8_t)o->target_sysid;
     pc.compid = (uint8_t)o->target_compid;
     (void)occ_mav_pose_rx_init(&l.prx, &pc);
+    (void)occ_mav_ranges_init(&l.ranges_tr, (uint8_t)o->sysid, (uint8_t)o->compid);
     l.tx.sysid = (uint8_t)o->sysid;
     l.tx.compid = (uint8_t)o->compid;
     l.stats = open_out(o->stats_path, stderr);

@@ -28,6 +28,7 @@ typedef struct {
     float intrinsics[4];             /* fx, fy, cx, cy (pixels) */
     float mount[6];                  /* x, y, z (m), roll, pitch, yaw (deg): body FLU <- mount */
     uint32_t stride;
+    uint32_t max_frames;             /* 0: all */
     float depth_min_m, depth_max_m;
     float res_m;
     size_t arena_bytes;
@@ -37,6 +38,7 @@ typedef struct {
     uint32_t pose_timeout_ms, sensor_timeout_ms;
     const char *stats_path, *feed_log_path;
     bool exit_after_depth;
+    bool mavlink_ranges;             /* integrate range messages of other components */
     uint32_t replay_speed;           /* 1: recorded timing; 0: as fast as the poses allow */
     float keep_radius_m;             /* eviction: protected ball around the camera */
 } run_opts_t;
@@ -102,6 +104,7 @@ typedef struct {
     run_list_t integrated, dropped;  /* since the last feed-log line */
     occ_evict_out_t evict;           /* written by the mapper under lock after each frame */
     occ_map_stats_t pool;            /* the pools after the last frame (occ_map_pool_stats) */
+    struct run_ranges_s *ranges;     /* range messages of other components (run_ranges.h) */
     volatile int stop;               /* either thread asks the other to end */
 } run_state_t;
 

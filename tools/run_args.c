@@ -37,7 +37,12 @@ void run_args_usage(FILE *f)
         "  --depth-mount x,y,z,roll,pitch,yaw   body FLU <- camera mount, m and deg; 0,0,0,0,0,0:\n"
         "                          at the body origin looking forward (optical x right, y down, z fwd)\n"
         "  --depth-stride 1        every N-th pixel in u and v\n"
+        "  --depth-max-frames N    replay only the first N frames that have a PNG (default all)\n"
         "  --depth-min-m 0 --depth-max-m 4   range kept; beyond max clears to max (OctoMap's rule)\n"
+        "  --mavlink-ranges        also integrate DISTANCE_SENSOR / OBSTACLE_DISTANCE(_3D) from other\n"
+        "                          components on the link, each with the pose at its arrival on the\n"
+        "                          autopilot's clock (off by default: ArduPilot re-sends its proximity\n"
+        "                          boundary, our own data, as DISTANCE_SENSOR)\n"
         "  A frame is integrated with the pose interpolated at its time (gaps > 100 ms refused); a\n"
         "  frame with no pose for its time is dropped and counted by reason, never integrated.\n"
         "Map and memory:\n"
@@ -72,7 +77,8 @@ void run_args_usage(FILE *f)
         "Exit status: 0; 1 i/o error or occ_map_check() failed at the end; 2 usage.\n");
 }
 
-static const char *const run_flags[] = {"--exit-after-depth", "--no-ignore-ground", "--3d", NULL};
+static const char *const run_flags[] = {"--exit-after-depth", "--no-ignore-ground", "--3d",
+                                        "--mavlink-ranges", NULL};
 
 static void defaults(run_opts_t *o)
 {
@@ -141,6 +147,8 @@ static int depth_option(run_opts_t *o, const char *a, const char *v)
         o->have_intrinsics = ok;
     } else if (strcmp(a, "--depth-mount") == 0) {
         ok = cli_parse_floats(v, o->mount, 6);
+    } else if (strcmp(a, "--depth-max-frames") == 0) {
+        ok = cli_parse_u32(v, 1, UINT32_MAX, &o->max_frames);
     } else if (strcmp(a, "--depth-stride") == 0) {
         ok = cli_parse_u32(v, 1, 64, &o->stride);
     } else if (strcmp(a, "--depth-min-m") == 0) {
@@ -189,6 +197,8 @@ static int run_option(void *ctx, const char *a, const char *v)
             o->exit_after_depth = true;
         } else if (strcmp(a, "--3d") == 0) {
             want_3d = true;
+        } else if (strcmp(a, "--mavlink-ranges") == 0) {
+            o->mavlink_ranges = true;
         } else {
             o->feed.sectors.ignore_ground = false;
         }

@@ -65,7 +65,7 @@ int run_depth_open(run_depth_t *d, const run_opts_t *o)
     }
     const uint64_t t_ref = e[0].t_us - 1000000u; /* T_REF = first timestamp - 1 s */
     for (size_t i = 0; i < n; i++) {
-        if (file_exists(o->depth_dir, e[i].file)) {
+        if ((o->max_frames == 0u || d->n < o->max_frames) && file_exists(o->depth_dir, e[i].file)) {
             run_frame_t *const f = &d->frames[d->n++];
             f->index = i;
             f->remote_us = e[i].t_us - t_ref;

@@ -4,6 +4,7 @@
 
 #include "cli.h"
 #include "run_link.h"
+#include "run_ranges.h"
 #include "occmap/occ_port.h"
 
 static void send_frame(run_link_t *l, const uint8_t *out, size_t n)
@@ -54,6 +55,9 @@ static void take_frame(run_link_t *l, const occ_mav_frame_t *f, uint64_t now)
     occ_pose_sample_t s;
     if (occ_mav_pose_rx_take(&l->prx, f, &s)) {
         take_pose(l, &s, now);
+    } else if (l->opt->mavlink_ranges &&
+               run_ranges_take(l->st, l->st->ranges, &l->ranges_tr, f, now)) {
+        return;
     } else if (f->msgid == OCC_MAV_MSG_TIMESYNC && f->sysid == l->opt->target_sysid &&
                f->compid == l->opt->target_compid) {
         take_timesync(l, f, now);

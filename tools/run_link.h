@@ -6,6 +6,7 @@
 #define OCC_TOOLS_RUN_LINK_H_INCLUDED
 
 #include "run.h"
+#include "occmap/occ_mavlink_ranges.h"
 
 typedef struct {
     uint64_t sent;                  /* OBSTACLE_DISTANCE sent */
@@ -23,6 +24,7 @@ typedef struct {
     occ_mav_feed_t *feed;
     occ_mav_parser_t parser;        /* our own pass over the bytes (poses, TIMESYNC) */
     occ_mav_pose_rx_t prx;
+    occ_mav_ranges_t ranges_tr;     /* range messages of other components -> beams */
     occ_mav_sender_t tx;            /* TIMESYNC and STATUSTEXT (the feed has its own) */
     FILE *stats, *feed_log;
     uint64_t t0, next_stats, next_timesync;

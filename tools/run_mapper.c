@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "run.h"
+#include "run_ranges.h"
 #include "occmap/occ_port.h"
 #include "occmap/host/occ_file.h"
 
@@ -39,8 +40,9 @@ static uint64_t wait_release(run_mapper_t *m, const run_frame_t *f)
         if (known && (int64_t)now >= release) {
             return now;
         }
+        run_ranges_service(m);
         const int64_t wait = known ? release - (int64_t)now : 10000;
-        sleep_us(wait > 10000 ? 10000u : (uint64_t)wait);
+        sleep_us(wait > 10000 ? 10000u : wait < 0 ? 0u : (uint64_t)wait);
     }
 }
 
@@ -57,15 +59,22 @@ static occ_err_t wait_pose(run_mapper_t *m, const run_frame_t *f, uint64_t relea
         const bool any = occ_pose_history_span(&m->st->hist, &oldest, &newest) == OCC_OK;
         const uint64_t last_rx = m->st->last_pose_local_us;
         const uint64_t since = m->opt->replay_speed == 0u && last_rx > released ? last_rx : released;
-        const bool give_up = m->st->stop || now - since > timeout;
+        /* fast replay waits for the first pose however long it takes (the streams start when
+         * the autopilot answers), then gives up after a timeout without a new pose */
+        const bool wait_first = m->opt->replay_speed == 0u && !any;
+        const bool give_up = m->st->stop || (!wait_first && now - since > timeout);
         occ_err_t e = OCC_ERR_TIME;
         if ((any && newest >= f->remote_us) || give_up) {
             e = occ_pose_history_at(&m->st->hist, f->remote_us, pose, why);
         }
         (void)pthread_mutex_unlock(&m->st->lock);
+        if (m->st->stop) {
+            return OCC_ERR_STATE; /* ending: the frame is neither integrated nor dropped */
+        }
         if ((any && newest >= f->remote_us) || give_up) {
             return e;
         }
+        run_ranges_service(m);
         sleep_us(2000);
     }
 }
@@ -253,15 +262,19 @@ static void do_frame(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
     }
     occ_pose_t map_from_body;
     occ_pose_refusal_t why = OCC_POSE_OK;
-    if (wait_pose(m, f, released, &map_from_body, &why) != OCC_OK) {
+    const occ_err_t pe = wait_pose(m, f, released, &map_from_body, &why);
+    if (pe == OCC_ERR_STATE) {
+        return;
+    }
+    if (pe != OCC_OK) {
         record(m, f, refusal_reason(why), false, 0, released);
         return;
     }
-    const uint64_t t0 = occ_port_clock_us();
     if (load(m, f, b) != OCC_OK) {
-        record(m, f, RUN_DROP_ERROR, false, 0, t0);
+        record(m, f, RUN_DROP_ERROR, false, 0, occ_port_clock_us());
         return;
     }
+    const uint64_t t0 = occ_port_clock_us(); /* integrate time: the write section, not the PNG */
     const occ_pose_t map_from_cam = occ_pose_compose(&map_from_body, &m->depth->body_from_camera);
     bool partial = false;
     size_t points = 0;
@@ -309,18 +322,20 @@ void *run_mapper_main(void *arg)
     uint64_t next_save = occ_port_clock_us() + (uint64_t)(m->opt->save_every_s * 1e6f);
     for (size_t i = 0; m->depth != NULL && i < m->depth->n && !m->st->stop; i++) {
         do_frame(m, &m->depth->frames[i], &b);
+        run_ranges_service(m);
         maybe_save(m, &next_save);
     }
-    while (m->depth == NULL && !m->st->stop) { /* no sensor of ours: saves only */
+    (void)pthread_mutex_lock(&m->st->lock);
+    m->st->mc.done = true; /* the depth directory is replayed (--exit-after-depth) */
+    (void)pthread_mutex_unlock(&m->st->lock);
+    while (!m->st->stop) { /* range messages and saves until the end */
+        run_ranges_service(m);
         maybe_save(m, &next_save);
-        sleep_us(50000);
+        sleep_us(5000);
     }
     free(b.px);
     free(b.part);
     free(b.tmp);
     free(b.scratch);
-    (void)pthread_mutex_lock(&m->st->lock);
-    m->st->mc.done = true;
-    (void)pthread_mutex_unlock(&m->st->lock);
     return NULL;
 }

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "run_link.h"
+#include "run_ranges.h"
 
 static const char *const drop_names[RUN_DROP_REASONS] = {
     "no_pose_yet", "no_pose_too_old", "no_pose_too_new", "no_pose_gap", "nomem", "error"};
@@ -133,6 +134,8 @@ void run_stats_line(run_link_t *l, uint64_t now, const char *key, bool map_check
     (void)pthread_mutex_lock(&l->st->lock);
     print_mapping(f, l->st);
     print_clock(f, l, now);
+    fprintf(f, ", ");
+    run_ranges_print(f, l->st->ranges, &l->ranges_tr);
     (void)pthread_mutex_unlock(&l->st->lock);
     fprintf(f, ", ");
     print_feed(f, l);

@@ -85,8 +85,10 @@ occ_err_t occ_timesync_take(occ_timesync_t *ts, const occ_mav_timesync_t *reply,
 /* ---- poses from the autopilot, on its clock ----------------------------------------------------
  * Takes LOCAL_POSITION_NED, ATTITUDE, ATTITUDE_QUATERNION and ODOMETRY (frames 1, 16, 18, 20)
  * only from (sysid, compid); everything else is ignored (counted). A position and an attitude
- * make one pose when their stamps are at most pair_tol_us apart; the pose is stamped with the
- * later of the two (the message that completed it), in remote microseconds, and converted by
+ * make one pose when their stamps are at most pair_tol_us apart and the one received first is
+ * newer than the last pose handed out (so P(t1) A(t1) P(t2) A(t2) gives poses at t1 and t2, never
+ * P(t2) with A(t1)); the pose is stamped with the later of the two, in remote microseconds,
+ * and converted by
  * occ_pose_from_ned() to map ENU <- body FLU. ODOMETRY is a whole pose. A pose is handed out only
  * when its stamp is newer than the last one handed out (so a history push never fails for
  * order). NaN / Inf / zero quaternions are refused (counted in bad). */

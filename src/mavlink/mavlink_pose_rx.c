@@ -60,6 +60,9 @@ static bool pair(occ_mav_pose_rx_t *rx, bool have_other, uint64_t other_us, uint
         rx->counters.unpaired++;
         return false;
     }
+    if (rx->priv.have_out && other_us <= rx->priv.out_us) {
+        return false; /* the partner is in the last pose already: wait for its own partner */
+    }
     return emit(rx, t_us > other_us ? t_us : other_us, out);
 }
 

@@ -1,0 +1,11 @@
+# run.mk - `occmap run`, the onboard loop (issue 21), against a pymavlink autopilot stand-in over
+# UDP loopback on the real TUM fr1_rpy sequence (tests/run_peer.py): SET_MESSAGE_INTERVAL
+# retries and the pose filter, frames without a pose dropped (the pose history's rule) and the
+# never-stop memory rule in a 32 KiB arena over all 500 frames, stale-input silence, the feed's
+# jitter with mapping busy. The C parts (TIMESYNC offset, pose filter): tests/test_run_mavlink.c.
+RUN_DATA := ../shared/data/depth/tum_fr1_rpy
+test-run-loop: $(BUILD)/occmap $(BUILD)/.deps-ok
+	$(PY) tests/run_peer.py --occmap $(BUILD)/occmap --data $(RUN_DATA) --out $(BUILD)/run \
+	  --tiny-arena 32K --test all
+TEST_STEPS += test-run-loop
+.PHONY: test-run-loop

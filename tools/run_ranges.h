@@ -1,0 +1,38 @@
+/* run_ranges.h - range messages other components send on the link (DISTANCE_SENSOR,
+ * OBSTACLE_DISTANCE, OBSTACLE_DISTANCE_3D; occ_mavlink_ranges.h) into `occmap run`'s map: the
+ * link thread translates them and queues them stamped with the autopilot's time of their
+ * arrival (local receive time + clock offset: a companion sensor's own time_boot is not the
+ * autopilot's clock); the mapping thread integrates each with the pose at that time. */
+#ifndef OCC_TOOLS_RUN_RANGES_H_INCLUDED
+#define OCC_TOOLS_RUN_RANGES_H_INCLUDED
+
+#include "run.h"
+#include "occmap/occ_mavlink_ranges.h"
+
+#define RUN_RANGES_QUEUE 64u
+
+typedef struct {
+    occ_mav_beams_t beams;
+    uint64_t remote_us, local_us;    /* autopilot time of arrival; local arrival */
+} run_range_msg_t;
+
+typedef struct run_ranges_s {
+    run_range_msg_t q[RUN_RANGES_QUEUE];
+    size_t head, n;
+    uint64_t queued, queue_full, no_clock; /* link side */
+    uint64_t integrated, no_pose, nomem, errors; /* mapping side */
+} run_ranges_t;
+
+/* Link thread: a parsed frame from another component; true if it was a range message (queued
+ * or counted). Takes st->lock. */
+bool run_ranges_take(run_state_t *st, run_ranges_t *r, occ_mav_ranges_t *tr,
+                     const occ_mav_frame_t *f, uint64_t now);
+
+/* Mapping thread: integrate every queued message whose pose is known (or give it up after
+ * --pose-timeout-ms). */
+void run_ranges_service(run_mapper_t *m);
+
+/* Telemetry members ("ranges": {...}); caller holds st->lock. */
+void run_ranges_print(FILE *f, const run_ranges_t *r, const occ_mav_ranges_t *tr);
+
+#endif
