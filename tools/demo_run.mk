@@ -14,7 +14,7 @@ DEMO_STRIDE := 4
 # Agreement with OctoMap: a sector agrees when its value is explained by the reference within
 # DEMO_TOL_M (2 voxels); the demo fails below DEMO_MIN_AGREE of all sectors (tools/demo_ref.cpp).
 DEMO_TOL_M := 0.2
-DEMO_MIN_AGREE := 0.95
+DEMO_MIN_AGREE := 0.98
 # The sector band is the camera's own voxel layer (+-0.05 m): a camera never sees the voxels right
 # above and below itself, so with the default +-0.5 m band the vehicle's own column is unknown and
 # every sector reads unknown (correct and fail-closed, but nothing to look at). Range 4 m = the
