@@ -46,7 +46,7 @@ struct Opts {
     double offset_deg = -20.0;
     double hit = 0.7, miss = 0.4, clamp_min = 0.1192, clamp_max = 0.971;
     double free_max = 0.0, occ_min = 0.0;  // log-odds thresholds (occ_core.h defaults)
-    double tol_m = 0.2, min_agree = 0.9, max_unsafe = 0.002, unsafe_m = 2.0;
+    double tol_m = 0.2, min_agree = 0.9, min_agree_seen = 0.9, max_unsafe = 0.002, unsafe_m = 2.0;
     double frame_dt = 0.0;  // seconds added to each frame's time before the pose lookup (diagnosis)
 };
 
@@ -56,7 +56,7 @@ void usage() {
                  "  [--res 0.1] [--stride 4] [--intrinsics fx,fy,cx,cy] [--min-range 0] [--max-range -1]\n"
                  "  [--band below,above] [--clearance 0.1] [--ignore-ground 1] [--unknown-as-distance 0]\n"
                  "  [--offset-deg -20] [--probs hit,miss,clamp_min,clamp_max] [--thresholds free_max,occ_min]\n"
-                 "  [--tol-m 0.2] [--min-agree 0.9] [--max-unsafe 0.002] [--unsafe-m 2] [--out per-message.jsonl] [--slices DIR --slice-seqs a,b,..]\n"
+                 "  [--tol-m 0.2] [--min-agree 0.9] [--min-agree-seen 0.9] [--max-unsafe 0.002] [--unsafe-m 2]\n  [--out per-message.jsonl] [--slices DIR --slice-seqs a,b,..]\n"
                  "  [--save-bt FILE]  the reference map at the end (OctoMap .bt)\n"
                  "  [--frame-dt S]  shift every frame's pose time by S seconds (diagnosis of clock errors)\n");
 }
@@ -99,6 +99,7 @@ bool parse_args(int argc, char **argv, Opts &o) {
         else if (a == "--tol-m") o.tol_m = std::atof(v);
         else if (a == "--min-agree") o.min_agree = std::atof(v);
         else if (a == "--max-unsafe") o.max_unsafe = std::atof(v);
+        else if (a == "--min-agree-seen") o.min_agree_seen = std::atof(v);
         else if (a == "--unsafe-m") o.unsafe_m = std::atof(v);
         else if (a == "--intrinsics" && parse_list(v, t, 4)) { o.fx = t[0]; o.fy = t[1]; o.cx = t[2]; o.cy = t[3]; }
         else if (a == "--band" && parse_list(v, t, 2)) { o.band_below = t[0]; o.band_above = t[1]; }
@@ -481,6 +482,78 @@ void write_slice(const Opts &o, const Msg &m, const Slice &s, double res, double
     std::fclose(f);
 }
 
+struct Totals {
+    long long msgs = 0, total = 0, agreed = 0, unsafe = 0, worst_seq = -1, inserted = 0;
+    long long seen_total = 0, seen_agreed = 0;  // sectors not unknown on both sides
+    double worst = 1.0;
+    long long kinds[3][3] = {{0}};  // [reference kind][logged kind]: obstacle, unknown, free
+};
+
+int kind_of(int cm, int max_cm) { return cm == 65535 ? 1 : (cm > max_cm ? 2 : 0); }
+
+// One logged message against the reference sectors: per-sector agreement into okv, totals.
+int check_msg(const Opts &o, const Msg &m, const Ref &r, std::vector<int> &okv, Totals &t) {
+    const int min_cm = (int)m.min_cm, max_cm = (int)m.max_cm, n = (int)m.dist.size();
+    int ok = 0;
+    okv.assign((size_t)n, 0);
+    for (int k = 0; k < n; ++k) {
+        const int g = (int)m.dist[k];
+        okv[(size_t)k] = agree(g, r, k, o.tol_m, min_cm, max_cm, o.unknown_as_distance);
+        ok += okv[(size_t)k];
+        const int gk = kind_of(g, max_cm), rk = kind_of(r.cm[k], max_cm);
+        t.kinds[rk][gk]++;
+        if (rk != 1 || gk != 1) {
+            ++t.seen_total;
+            t.seen_agreed += okv[(size_t)k];
+        }
+        if (gk == 2 && r.d_occ[k] <= r.d_unk[k] && r.d_occ[k] < std::min(max_cm / 100.0 - o.tol_m, o.unsafe_m))
+            ++t.unsafe;
+    }
+    const double frac = (double)ok / n;
+    if (frac < t.worst) {
+        t.worst = frac;
+        t.worst_seq = m.seq;
+    }
+    t.total += n;
+    t.agreed += ok;
+    ++t.msgs;
+    return ok;
+}
+
+void write_result(FILE *out, const Msg &m, long long inserted, int ok, double za, double zb, const Ref &r,
+                  const std::vector<int> &okv) {
+    const int n = (int)r.cm.size();
+    std::fprintf(out, "{\"seq\": %lld, \"frames_total\": %lld, \"agree\": %d, \"n\": %d, \"band\": [%.3f, %.3f], \"ref\": [",
+                 m.seq, inserted, ok, n, za, zb);
+    for (int k = 0; k < n; ++k) std::fprintf(out, "%d%s", r.cm[k], k + 1 < n ? ", " : "], \"ok\": [");
+    for (int k = 0; k < n; ++k) std::fprintf(out, "%d%s", okv[(size_t)k], k + 1 < n ? ", " : "]}\n");
+}
+
+bool print_summary(const Opts &o, const Totals &t, size_t leaves) {
+    const double frac = t.total ? (double)t.agreed / t.total : 0.0;
+    const double seen = t.seen_total ? (double)t.seen_agreed / t.seen_total : 1.0;
+    const bool pass = t.msgs > 0 && frac >= o.min_agree && seen >= o.min_agree_seen &&
+                      (double)t.unsafe <= o.max_unsafe * (double)t.total;
+    std::printf("{\"demo_ref\": \"%s\", \"messages\": %lld, \"frames_inserted\": %lld, \"sectors\": %lld, "
+                "\"agree\": %lld, \"agree_frac\": %.4f, \"min_agree\": %.3f, \"seen\": %lld, \"seen_agree_frac\": %.4f, "
+                "\"min_agree_seen\": %.3f, \"tol_m\": %.3f, \"max_unsafe\": %.4f, "
+                "\"unsafe_m\": %.2f, \"worst_msg_frac\": %.4f, \"worst_seq\": %lld, \"unsafe_free\": %lld, "
+                "\"ref_vs_logged\": {\"obstacle\": [%lld, %lld, %lld], \"unknown\": [%lld, %lld, %lld], "
+                "\"free\": [%lld, %lld, %lld]}, \"octomap_leaves\": %zu}\n",
+                pass ? "PASS" : "FAIL", t.msgs, t.inserted, t.total, t.agreed, frac, o.min_agree, t.seen_total, seen, o.min_agree_seen, o.tol_m,
+                o.max_unsafe, o.unsafe_m, t.worst, t.worst_seq, t.unsafe, t.kinds[0][0], t.kinds[0][1],
+                t.kinds[0][2], t.kinds[1][0], t.kinds[1][1], t.kinds[1][2], t.kinds[2][0], t.kinds[2][1],
+                t.kinds[2][2], leaves);
+    return pass;
+}
+
+double yaw_of(const std::vector<double> &pose) {
+    const double q[4] = {pose[3], pose[4], pose[5], pose[6]}, fwd[3] = {1, 0, 0};
+    double bx[3];
+    rotate(q, fwd, bx);
+    return std::atan2(bx[1], bx[0]);  // the body x axis seen from above
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -507,9 +580,7 @@ int main(int argc, char **argv) {
     tree.setClampingThresMax(o.clamp_max);
     FILE *out = o.out.empty() ? nullptr : std::fopen(o.out.c_str(), "w");
     const std::vector<long long> shots = parse_seqs(o.slice_seqs);
-    long long msgs = 0, total = 0, agreed = 0, unsafe = 0, worst_seq = -1, inserted = 0;
-    double worst = 1.0;
-    long long kinds[3][3] = {{0}};  // [ref kind][logged kind]: obstacle, unknown, free
+    Totals t;
     std::string line;
     while (std::getline(fl, line)) {
         if (line.find("\"distances\"") == std::string::npos) continue;
@@ -524,53 +595,22 @@ int main(int argc, char **argv) {
                 std::fprintf(stderr, "demo_ref: seq %lld names frame %g, not in %s\n", m.seq, fi, o.depth_dir.c_str());
                 return 2;
             }
-            ++inserted;
+            ++t.inserted;
         }
         const double v[3] = {m.pose[0], m.pose[1], m.pose[2]};
-        const double q[4] = {m.pose[3], m.pose[4], m.pose[5], m.pose[6]}, fwd[3] = {1, 0, 0};
-        double bx[3];
-        rotate(q, fwd, bx);
-        const double yaw = std::atan2(bx[1], bx[0]);
         double za, zb;
         band_of(tree, o, v, za, zb);
-        const int min_cm = (int)m.min_cm, max_cm = (int)m.max_cm, n = (int)m.dist.size();
-        const Slice s = make_slice(tree, o, v, za, zb, max_cm / 100.0);
-        const Ref r = sectors(s, o, v, yaw, tree.getResolution(), n, m.inc_deg, min_cm, max_cm);
-        int ok = 0;
-        std::vector<int> okv((size_t)n, 0);
-        for (int k = 0; k < n; ++k) {
-            const int g = (int)m.dist[k];
-            const bool a = agree(g, r, k, o.tol_m, min_cm, max_cm, o.unknown_as_distance);
-            ok += a;
-            okv[(size_t)k] = a;
-            const int gk = g == 65535 ? 1 : (g > max_cm ? 2 : 0), rk = r.cm[k] == 65535 ? 1 : (r.cm[k] > max_cm ? 2 : 0);
-            kinds[rk][gk]++;
-            if (gk == 2 && r.d_occ[k] <= r.d_unk[k] && r.d_occ[k] < std::min(max_cm / 100.0 - o.tol_m, o.unsafe_m)) ++unsafe;
-        }
-        const double frac = (double)ok / n;
-        if (frac < worst) { worst = frac; worst_seq = m.seq; }
-        total += n;
-        agreed += ok;
-        ++msgs;
-        if (out) {
-            std::fprintf(out, "{\"seq\": %lld, \"frames_total\": %lld, \"agree\": %d, \"n\": %d, \"band\": [%.3f, %.3f], \"ref\": [",
-                         m.seq, inserted, ok, n, za, zb);
-            for (int k = 0; k < n; ++k) std::fprintf(out, "%d%s", r.cm[k], k + 1 < n ? ", " : "], \"ok\": [");
-            for (int k = 0; k < n; ++k) std::fprintf(out, "%d%s", okv[(size_t)k], k + 1 < n ? ", " : "]}\n");
-        }
+        const Slice s = make_slice(tree, o, v, za, zb, m.max_cm / 100.0);
+        const Ref r = sectors(s, o, v, yaw_of(m.pose), tree.getResolution(), (int)m.dist.size(), m.inc_deg,
+                              (int)m.min_cm, (int)m.max_cm);
+        std::vector<int> okv;
+        const int ok = check_msg(o, m, r, okv, t);
+        if (out) write_result(out, m, t.inserted, ok, za, zb, r, okv);
         if (!o.slice_dir.empty() && std::find(shots.begin(), shots.end(), m.seq) != shots.end())
             write_slice(o, m, s, tree.getResolution(), za, zb, r);
     }
     if (out) std::fclose(out);
-    if (!o.save_bt.empty() && !tree.writeBinaryConst(o.save_bt)) std::fprintf(stderr, "demo_ref: cannot write %s\n", o.save_bt.c_str());
-    const double frac = total ? (double)agreed / total : 0.0;
-    const bool pass = msgs > 0 && frac >= o.min_agree && (double)unsafe <= o.max_unsafe * (double)total;
-    std::printf("{\"demo_ref\": \"%s\", \"messages\": %lld, \"frames_inserted\": %lld, \"sectors\": %lld, "
-                "\"agree\": %lld, \"agree_frac\": %.4f, \"min_agree\": %.3f, \"tol_m\": %.3f, \"max_unsafe\": %.4f, \"unsafe_m\": %.2f, \"worst_msg_frac\": %.4f, "
-                "\"worst_seq\": %lld, \"unsafe_free\": %lld, \"ref_vs_logged\": {\"obstacle\": [%lld, %lld, %lld], "
-                "\"unknown\": [%lld, %lld, %lld], \"free\": [%lld, %lld, %lld]}, \"octomap_leaves\": %zu}\n",
-                pass ? "PASS" : "FAIL", msgs, inserted, total, agreed, frac, o.min_agree, o.tol_m, o.max_unsafe, o.unsafe_m, worst, worst_seq,
-                unsafe, kinds[0][0], kinds[0][1], kinds[0][2], kinds[1][0], kinds[1][1], kinds[1][2], kinds[2][0],
-                kinds[2][1], kinds[2][2], tree.getNumLeafNodes());
-    return pass ? 0 : 1;
+    if (!o.save_bt.empty() && !tree.writeBinaryConst(o.save_bt))
+        std::fprintf(stderr, "demo_ref: cannot write %s\n", o.save_bt.c_str());
+    return print_summary(o, t, tree.getNumLeafNodes()) ? 0 : 1;
 }

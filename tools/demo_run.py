@@ -12,7 +12,8 @@
      sectors from the frames integrated up to it: the agreement must reach --min-agree;
   4. pictures in OUT (loop_map.png, loop_strip.png) and the telemetry summary.
 usage: demo_run.py --occmap BIN --ref build/demo_ref --depth-dir DIR --out OUT [--frames N]
-       [--res 0.1] [--stride 4] [--tol-m 0.2] [--min-agree 0.9] [--plant] [--run-args "..."]
+       [--res 0.1] [--stride 4] [--tol-m 0.2] [--min-agree 0.9] [--min-agree-seen 0.9] [--plant]
+       [--run-args "..."]
 Exit 0 when every check passes; prints PASS/FAIL lines.
 """
 import argparse
@@ -171,7 +172,7 @@ def telemetry(stats):
     return cfg
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser()
     ap.add_argument("--occmap", required=True)
     ap.add_argument("--ref", required=True)
@@ -183,12 +184,73 @@ def main():
     ap.add_argument("--stride", type=int, default=4)
     ap.add_argument("--tol-m", type=float, default=0.2)
     ap.add_argument("--min-agree", type=float, default=0.9)
+    ap.add_argument("--min-agree-seen", type=float, default=0.9)
     ap.add_argument("--timeout", type=float, default=120.0)
     ap.add_argument("--run-args", default="", help="more options for occmap run")
     ap.add_argument("--name", default="loop")
     ap.add_argument("--plant", action="store_true",
                     help="then prove the checker: planted wrong distances in the feed log must fail it")
-    a = ap.parse_args()
+    return ap.parse_args()
+
+
+def run_loop(a, d, frames, poses, intr, path, errors):
+    """The stand-in in a thread and `occmap run` against it, until it exits. Returns the stand-in."""
+    for f in ("feed.jsonl", "stats.jsonl", "standin.jsonl"):
+        if os.path.exists(path(f)):
+            os.remove(path(f))
+    st = sa.Standin(poses, sa.t_ref_of(frames), record=path("standin.jsonl"))
+    th = st.start()
+    cmd = [a.occmap, "run", "--udp", "127.0.0.1:%d" % st.port, "--depth-dir", d, "--depth-stride", str(a.stride),
+           "--res", str(a.res), "--depth-intrinsics", ",".join(str(v) for v in intr),
+           "--feed-log", path("feed.jsonl"), "--stats", path("stats.jsonl"), "--exit-after-depth",
+           "--duration", str(int(a.timeout))] + shlex.split(a.run_args)
+    print("demo: %d poses; stand-in on 127.0.0.1:%d; %s" % (len(st.poses), st.port, " ".join(cmd)), flush=True)
+    t0 = time.monotonic()
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        _, err = proc.communicate(timeout=a.timeout + 30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        _, err = proc.communicate()
+        errors.append("occmap run did not exit within %.0f s" % (a.timeout + 30))
+    time.sleep(0.3)  # the last message in flight
+    st.stop.set()
+    th.join(5)
+    if proc.returncode != 0:
+        errors.append("occmap run exit %s: %s" % (proc.returncode, err.strip()[-600:]))
+    print("demo: loop done in %.1f s: stand-in %s" % (time.monotonic() - t0, json.dumps(st.summary())), flush=True)
+    for s in st.statustexts:
+        print("demo: STATUSTEXT from %s: %s" % (s["src"], s["text"]))
+    return st
+
+
+def check_ref(a, d, feed, cfg, intr, path, errors):
+    """build/demo_ref over the feed log; returns its summary (or None) and its command line."""
+    args, _, missing = ref_args(cfg, a.res, a.stride, intr)
+    if missing:
+        print("demo: config line lacks %s: demo_ref uses its defaults there" % ", ".join(missing))
+    seqs = sorted({feed[int(i * (len(feed) - 1) / 5)]["seq"] for i in range(6)})
+    cmd_ref = [a.ref, "--feed-log", path("feed.jsonl"), "--depth-dir", d, "--tol-m", str(a.tol_m),
+               "--min-agree", str(a.min_agree), "--min-agree-seen", str(a.min_agree_seen), "--out", path("ref.jsonl"), "--slices", a.out,
+               "--slice-seqs", ",".join(str(s) for s in seqs)] + args
+    if a.poses:
+        cmd_ref += ["--poses", a.poses]
+    t0 = time.monotonic()
+    r = subprocess.run(cmd_ref, stdout=subprocess.PIPE, text=True)
+    print("demo: %s\ndemo: OctoMap reference over %d messages in %.1f s: %s"
+          % (" ".join(cmd_ref), len(feed), time.monotonic() - t0, r.stdout.strip()), flush=True)
+    try:
+        ref = json.loads(r.stdout.strip().splitlines()[-1])
+    except (ValueError, IndexError):
+        ref = None
+    if r.returncode != 0:
+        errors.append("OctoMap reference disagrees (demo_ref exit %d)" % r.returncode)
+    pictures(a, feed, seqs, cfg)
+    return ref, cmd_ref
+
+
+def main():
+    a = parse_args()
     os.makedirs(a.out, exist_ok=True)
     t_start = time.monotonic()
     d = a.depth_dir
@@ -197,74 +259,29 @@ def main():
     d = short_copy(d, a.out, a.frames) if a.frames else d
     frames, poses = sa.read_recording(d, a.poses)
     intr = FR2 if "fr2" in os.path.basename(d) or "freiburg2" in d else FR1
-    p = lambda n: os.path.join(a.out, "%s_%s" % (a.name, n))  # noqa: E731
-    for f in ("feed.jsonl", "stats.jsonl", "standin.jsonl"):
-        if os.path.exists(p(f)):
-            os.remove(p(f))
-    st = sa.Standin(poses, sa.t_ref_of(frames), record=p("standin.jsonl"))
-    th = st.start()
-    cmd = [a.occmap, "run","--udp", "127.0.0.1:%d" % st.port, "--depth-dir", d, "--depth-stride", str(a.stride),
-                  "--res", str(a.res), "--depth-intrinsics", ",".join(str(v) for v in intr),
-                  "--feed-log", p("feed.jsonl"), "--stats", p("stats.jsonl"), "--exit-after-depth",
-                  "--duration", str(int(a.timeout))] + shlex.split(a.run_args)
+    path = lambda n: os.path.join(a.out, "%s_%s" % (a.name, n))  # noqa: E731
     # depth.txt may list frames whose PNG is not here (tum_fr1_rpy: 722 listed, 500 copied).
     present = [i for i, f in enumerate(frames) if os.path.exists(os.path.join(d, f[1]))]
-    span = frames[present[-1]][0] - frames[present[0]][0]
-    print("demo: %s: %d frames over %.1f s, %d poses; stand-in on 127.0.0.1:%d; %s"
-          % (d, len(present), span, len(st.poses), st.port, " ".join(cmd)), flush=True)
+    print("demo: %s: %d frames over %.1f s" % (d, len(present), frames[present[-1]][0] - frames[present[0]][0]))
     errors = []
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        out, err = proc.communicate(timeout=a.timeout + 30)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        out, err = proc.communicate()
-        errors.append("occmap run did not exit within %.0f s" % (a.timeout + 30))
-    time.sleep(0.3)
-    st.stop.set()
-    th.join(5)
-    if proc.returncode != 0:
-        errors.append("occmap run exit %s: %s" % (proc.returncode, err.strip()[-600:]))
-    t_loop = time.monotonic() - t_start
-    feed = read_jsonl(p("feed.jsonl"))
-    stats = read_jsonl(p("stats.jsonl"))
-    print("demo: loop done in %.1f s: stand-in %s" % (t_loop, json.dumps(st.summary())), flush=True)
-    for s in st.statustexts:
-        print("demo: STATUSTEXT from %s: %s" % (s["src"], s["text"]))
-    if not feed:
-        errors.append("empty feed log")
-    else:
+    st = run_loop(a, d, frames, poses, intr, path, errors)
+    feed = read_jsonl(path("feed.jsonl"))
+    if feed:
         check_link(st, feed, present, errors)
-    cfg = telemetry(stats)
+    else:
+        errors.append("empty feed log")
+    cfg = telemetry(read_jsonl(path("stats.jsonl")))
     ref = None
     if feed:
-        args, used, missing = ref_args(cfg, a.res, a.stride, intr)
-        if missing:
-            print("demo: config line lacks %s: demo_ref uses its defaults there" % ", ".join(missing))
-        seqs = sorted({feed[int(i * (len(feed) - 1) / 5)]["seq"] for i in range(6)})
-        cmd_ref = [a.ref, "--feed-log", p("feed.jsonl"), "--depth-dir", d, "--tol-m", str(a.tol_m),
-                   "--min-agree", str(a.min_agree), "--out", p("ref.jsonl"), "--slices", a.out,
-                   "--slice-seqs", ",".join(str(s) for s in seqs)] + args
-        if a.poses:
-            cmd_ref += ["--poses", a.poses]
-        t0 = time.monotonic()
-        r = subprocess.run(cmd_ref, stdout=subprocess.PIPE, text=True)
-        t_ref = time.monotonic() - t0
-        print("demo: %s\ndemo: OctoMap reference over %d messages in %.1f s: %s"
-              % (" ".join(cmd_ref), len(feed), t_ref, r.stdout.strip()), flush=True)
-        try:
-            ref = json.loads(r.stdout.strip().splitlines()[-1])
-        except (ValueError, IndexError):
-            ref = None
-        if r.returncode != 0:
-            errors.append("OctoMap reference disagrees (demo_ref exit %d)" % r.returncode)
-        pictures(a, feed, seqs, cfg)
+        ref, cmd_ref = check_ref(a, d, feed, cfg, intr, path, errors)
         if a.plant:
             plant(a, feed, cmd_ref, errors)
     n_int = sum(len(m.get("frames", [])) for m in feed)
     n_drop = sum(len(m.get("frames_dropped", [])) for m in feed)
     print("demo: %d OBSTACLE_DISTANCE received, %d frames integrated, %d dropped, agreement %s, total %.1f s"
-          % (len(st.obstacles), n_int, n_drop, "%.1f %%" % (100 * ref["agree_frac"]) if ref else "-",
+          % (len(st.obstacles), n_int, n_drop,
+             "%.1f %% of all sectors, %.1f %% of the %d not unknown on both sides"
+             % (100 * ref["agree_frac"], 100 * ref["seen_agree_frac"], ref["seen"]) if ref else "-",
              time.monotonic() - t_start))
     for e in errors:
         print("FAIL demo %s: %s" % (a.name, e))
@@ -276,13 +293,16 @@ def plant(a, feed, cmd_ref, errors):
     """The checker must refuse a feed log whose sectors lie: every sector "no obstacle", and every
     sector an obstacle at 1 m (the tolerance is 0.2 m)."""
     for what, val in (("all free", lambda m: m["max_cm"] + 1), ("all obstacles at 1 m", lambda m: 100)):
-        bad = p_bad = os.path.join(a.out, "%s_planted.jsonl" % a.name)
-        with open(bad, "w") as f:
+        p_bad = os.path.join(a.out, "%s_planted.jsonl" % a.name)
+        with open(p_bad, "w") as f:
             for m in feed:
                 f.write(json.dumps(dict(m, distances=[val(m)] * len(m["distances"]))) + "\n")
         c = list(cmd_ref)
         c[c.index("--feed-log") + 1] = p_bad
-        c = c[:c.index("--out")] + ["--min-agree", "0.5"]
+        for opt in ("--out", "--slices", "--slice-seqs"):  # keep the real run's outputs
+            i = c.index(opt)
+            del c[i:i + 2]
+        c += ["--min-agree", "0.5", "--min-agree-seen", "0.5"]
         r = subprocess.run(c, stdout=subprocess.PIPE, text=True)
         print("demo: planted %s: demo_ref exit %d %s" % (what, r.returncode, r.stdout.strip()[:160]))
         if r.returncode != 1:
