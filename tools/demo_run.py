@@ -147,8 +147,11 @@ def check_link(st, feed, frames_n, errors):
                 or not (0 < o["min_cm"] < o["max_cm"]):
             errors.append("bad OBSTACLE_DISTANCE fields: %s" % {k: v for k, v in o.items() if k != "distances"})
             break
-    if not any(h["src"] == [1, 196] for h in st.heartbeats):
-        errors.append("no HEARTBEAT from 1/196")
+    ours = [h for h in st.heartbeats if h["src"] == [1, 196]]
+    if not ours or any(h["type"] != 18 for h in ours):  # MAV_TYPE_ONBOARD_CONTROLLER
+        errors.append("no HEARTBEAT from 1/196 as an onboard controller: %s" % ours[:1])
+    elif st.obstacles and not any(h["system_status"] == 4 for h in ours):  # MAV_STATE_ACTIVE
+        errors.append("OBSTACLE_DISTANCE sent but HEARTBEAT never said ACTIVE")
     asked = {int(r[2]) for r in st.requests if r[1] == sa.CMD_SET_MESSAGE_INTERVAL}
     if sa.MSG_LPN not in asked and sa.MSG_ODOM not in asked:
         errors.append("occmap run never asked for LOCAL_POSITION_NED / ODOMETRY (asked %s)" % sorted(asked))
