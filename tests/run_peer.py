@@ -230,6 +230,67 @@ class Check:
         return not self.bad
 
 
+def gt_camera(d):
+    """groundtruth.txt as (boot_us, position, quaternion w x y z): TUM's world <- camera."""
+    frames, _ = read_tum(d)
+    first = None
+    for line in open(os.path.join(d, "depth.txt")):
+        if not line.startswith("#") and line.strip():
+            first = float(line.split()[0])
+            break
+    out = []
+    for line in open(os.path.join(d, "groundtruth.txt")):
+        if line.startswith("#") or not line.strip():
+            continue
+        v = [float(x) for x in line.split()]
+        b = int(round((v[0] - first + 1.0) * 1e6))
+        if b > 0:
+            out.append((b // 1000 * 1000, v[1:4], (v[7], v[4], v[5], v[6])))  # stamps as sent (ms)
+    return out
+
+
+def slerp(a, b, s):
+    d = sum(x * y for x, y in zip(a, b))
+    if d < 0:
+        b, d = tuple(-x for x in b), -d
+    if d > 0.9995:
+        q = tuple(x + s * (y - x) for x, y in zip(a, b))
+    else:
+        th = math.acos(d)
+        q = tuple((math.sin((1 - s) * th) * x + math.sin(s * th) * y) / math.sin(th)
+                  for x, y in zip(a, b))
+    n = math.sqrt(sum(x * x for x in q))
+    return tuple(x / n for x in q)
+
+
+def camera_at(cam, t):
+    import bisect
+    ts = [c[0] for c in cam]
+    k = bisect.bisect_left(ts, t)
+    if ts[k] == t:
+        return cam[k][1], cam[k][2]
+    a, b = cam[k - 1], cam[k]
+    s = (t - a[0]) / (b[0] - a[0])
+    return [x + s * (y - x) for x, y in zip(a[1], b[1])], slerp(a[2], b[2], s)
+
+
+def pose_errors(lines, frames, cam, sent_us):
+    """Largest position (m) and rotation (deg) difference between the camera pose each frame
+    was integrated with (feed log) and TUM's ground truth interpolated at the frame's stamp
+    from the samples the stand-in sent."""
+    sent = set(sent_us)
+    cam = [c for c in cam if c[0] in sent]
+    t_of = dict(frames)
+    dp = da = 0.0
+    for ln in lines:
+        for idx, p in zip(ln["frames"], ln["frame_poses"]):
+            pos, q = camera_at(cam, t_of[idx])
+            dp = max(dp, math.sqrt(sum((x - y) ** 2 for x, y in zip(p[:3], pos))))
+            d = abs(sum(x * y for x, y in zip(p[3:], q)))
+            da = max(da, math.degrees(2 * math.acos(min(1.0, d))))
+    return dp, da
+
+
 def expected_drops(frames, sent_us):
     """The pose history's verdict per frame from the stamps actually sent."""
     out = {}
@@ -255,7 +316,7 @@ def test_requests(o, frames, gt):
     peer = Peer(port, gt, speed=4.0, ignore=2, foreign=True)
     st, fl = os.path.join(o.out, "req_stats.json"), os.path.join(o.out, "req_feed.json")
     rc, out, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--depth-dir", o.data,
-                                  "--replay-speed", "0", "--depth-stride", "16", "--duration", "5",
+                                  "--replay-speed", "0", "--depth-stride", "16", "--duration", "4",
                                   "--stats", st, "--feed-log", fl], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-500:]))
     c.that(peer.requests.get(32, 0) >= 3 and peer.requests.get(30, 0) >= 3,
@@ -322,10 +383,14 @@ def test_drop(o, frames, gt):
         n = sum(1 for w in want.values() if w == why)
         c.that(fr.get("dropped", {}).get(why) == n, "%s: %s, want %d" % (why, fr.get("dropped"), n))
     c.that(os.path.exists(omap), "-o not saved")
+    dp, da = pose_errors(lines, frames, gt_camera(o.data), peer.sent_us)
+    c.that(dp < 0.002 and da < 0.1, "integration poses off the ground truth by %.4f m / %.3f deg"
+           % (dp, da))
     return c.done("%d frames: %d integrated (%d partial), dropped %s (the %d of the gap as the "
-                  "history's rule says); %s evictions, arena %s, map_check ok, exit 0" %
+                  "history's rule says); %s evictions, arena %s, map_check ok, exit 0; frame "
+                  "poses within %.2g m / %.2g deg of the interpolated ground truth" %
                   (len(frames), fr.get("integrated", 0), fr.get("partial", 0), fr.get("dropped"),
-                   len(gap), fin.get("evictions"), fin.get("arena")))
+                   len(gap), fin.get("evictions"), fin.get("arena"), dp, da))
 
 
 def silence(c, peer, phrase):
@@ -355,7 +420,7 @@ def test_stale(o, frames, gt):
     rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--depth-dir", o.data,
                                 "--replay-speed", "0", "--depth-stride", "32",
                                 "--depth-max-frames", "60",
-                                "--sensor-timeout-ms", "600", "--duration", "5", "-o", omap,
+                                "--sensor-timeout-ms", "600", "--duration", "6", "-o", omap,
                                 "--stats", st], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     silence(c, peer, "sensors stale")
@@ -363,7 +428,7 @@ def test_stale(o, frames, gt):
     # the pose: a prior map (-o of the run above), poses for 1.5 s, then none
     port = free_port()
     peer = Peer(port, gt, stop_at_us=1500000)
-    rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--map", omap, "--duration", "3.5",
+    rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--map", omap, "--duration", "4.5",
                                 "--stats", os.path.join(o.out, "stale2_stats.json")], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     silence(c, peer, "pose stale")
@@ -378,7 +443,7 @@ def test_jitter(o, frames, gt):
     peer = Peer(port, gt, speed=1.0)
     st, fl = os.path.join(o.out, "jitter_stats.json"), os.path.join(o.out, "jitter_feed.json")
     rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % port, "--depth-dir", o.data,
-                                "--replay-speed", "0", "--depth-stride", "1", "--duration", "5",
+                                "--replay-speed", "0", "--depth-stride", "1", "--duration", "3",
                                 "--stats", st, "--feed-log", fl], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     fin = stats_lines(st)[-1].get("final", {}) if os.path.exists(st) else {}
@@ -409,7 +474,7 @@ def test_ranges(o, frames, gt):
     omap = os.path.join(o.out, "ranges.occ")
     st = os.path.join(o.out, "ranges_stats.json")
     p = subprocess.Popen([o.occmap, "run", "--udp", "127.0.0.1:%d" % port, "--mavlink-ranges",
-                          "--duration", "2.5", "-o", omap, "--stats", st],
+                          "--duration", "2", "-o", omap, "--stats", st],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     nxt = 0.0
     while p.poll() is None:

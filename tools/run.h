@@ -36,6 +36,7 @@ typedef struct {
     float save_every_s;              /* 0: only at exit */
     float pose_rate_hz;
     uint32_t pose_timeout_ms, sensor_timeout_ms;
+    uint32_t max_lag_ms;             /* recorded timing: a frame due longer ago is dropped (late) */
     const char *stats_path, *feed_log_path;
     bool exit_after_depth;
     bool mavlink_ranges;             /* integrate range messages of other components */
@@ -70,11 +71,12 @@ void run_depth_close(run_depth_t *d);
 
 /* ---- shared state ---------------------------------------------------------------------------- */
 enum { RUN_DROP_EMPTY, RUN_DROP_TOO_OLD, RUN_DROP_TOO_NEW, RUN_DROP_GAP, RUN_DROP_NOMEM,
-       RUN_DROP_ERROR, RUN_DROP_REASONS };
+       RUN_DROP_ERROR, RUN_DROP_LATE, RUN_DROP_REASONS };
 
 typedef struct {
     size_t *idx;
     uint32_t *version;               /* integrated: the version that holds it; dropped: unused */
+    occ_pose_t *pose;                /* integrated: map_from_camera used; dropped: identity */
     size_t n, cap;
 } run_list_t;
 
@@ -113,7 +115,7 @@ typedef struct {
 bool run_state_offset(const run_state_t *st, int64_t *offset_us, const char **source);
 
 /* Append (realloc'd; false when out of memory). */
-bool run_list_push(run_list_t *l, size_t idx, uint32_t version);
+bool run_list_push(run_list_t *l, size_t idx, uint32_t version, const occ_pose_t *pose);
 void run_list_free(run_list_t *l);
 
 /* ---- the mapping thread (run_mapper.c) --------------------------------------------------------- */

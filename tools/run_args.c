@@ -32,6 +32,8 @@ void run_args_usage(FILE *f)
         "                          first depth.txt time - 1 s) and released when the autopilot clock\n"
         "                          (TIMESYNC offset) reaches it; entries without a PNG are skipped\n"
         "  --replay-speed 1        1: recorded timing; 0: as fast as the poses allow (tests)\n"
+        "  --max-lag-ms 500        recorded timing: a frame the mapping reaches later than this after\n"
+        "                          its time is dropped and counted (late), as a camera driver would\n"
         "  --depth-intrinsics fx,fy,cx,cy   default: TUM freiburg1's when DIR names fr1/freiburg1,\n"
         "                          else freiburg2's (520.9,521.0,325.1,249.7)\n"
         "  --depth-mount x,y,z,roll,pitch,yaw   body FLU <- camera mount, m and deg; 0,0,0,0,0,0:\n"
@@ -70,6 +72,7 @@ void run_args_usage(FILE *f)
         "                          {\"config\": ...}, the last {\"final\": ...} with map_check\n"
         "  --feed-log FILE         one JSON line per OBSTACLE_DISTANCE sent: time_usec, seq, version,\n"
         "                          frames / frames_dropped (depth.txt indices since the last line),\n"
+        "                          frame_poses (map <- camera each frame was integrated with),\n"
         "                          pose [x y z qw qx qy qz] (map ENU, body FLU), distances, ...\n"
         "  --duration S            end after S seconds (0: until SIGINT/SIGTERM)\n"
         "  --exit-after-depth      end once every frame is integrated or dropped and one more\n"
@@ -96,6 +99,7 @@ static void defaults(run_opts_t *o)
     o->pose_rate_hz = 50.0f;
     o->pose_timeout_ms = 500;
     o->sensor_timeout_ms = 1000;
+    o->max_lag_ms = 500;
     o->replay_speed = 1u;
     o->keep_radius_m = 3.0f;
 }
@@ -155,6 +159,8 @@ static int depth_option(run_opts_t *o, const char *a, const char *v)
         ok = cli_parse_float_in(v, 0.0f, 100.0f, &o->depth_min_m);
     } else if (strcmp(a, "--depth-max-m") == 0) {
         ok = cli_parse_float_in(v, 0.05f, 100.0f, &o->depth_max_m);
+    } else if (strcmp(a, "--max-lag-ms") == 0) {
+        ok = cli_parse_u32(v, 0, 3600000, &o->max_lag_ms);
     } else if (strcmp(a, "--replay-speed") == 0) {
         ok = cli_parse_u32(v, 0, 1, &o->replay_speed);
     } else {

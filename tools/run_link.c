@@ -165,11 +165,23 @@ static void print_list(FILE *f, const run_list_t *l, size_t n)
     }
 }
 
+/* The camera poses the listed frames were integrated with: [x, y, z, qw, qx, qy, qz] each. */
+static void print_poses(FILE *f, const run_list_t *l, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        const occ_pose_t *const p = &l->pose[i];
+        fprintf(f, "%s[%.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g]", i > 0u ? ", " : "",
+                (double)p->p.x, (double)p->p.y, (double)p->p.z, (double)p->q.w, (double)p->q.x,
+                (double)p->q.y, (double)p->q.z);
+    }
+}
+
 /* Drop the first n entries of a list. */
 static void list_shift(run_list_t *l, size_t n)
 {
     memmove(l->idx, l->idx + n, (l->n - n) * sizeof *l->idx);
     memmove(l->version, l->version + n, (l->n - n) * sizeof *l->version);
+    memmove(l->pose, l->pose + n, (l->n - n) * sizeof *l->pose);
     l->n -= n;
 }
 
@@ -199,6 +211,8 @@ static void log_obstacle(run_link_t *l, const uint8_t *out, size_t len, uint64_t
     fprintf(o, "{\"time_usec\": %llu, \"seq\": %llu, \"version\": %u, \"frames\": [",
             (unsigned long long)m.time_usec, (unsigned long long)l->od_seq, v);
     print_list(o, &st->integrated, n_int);
+    fprintf(o, "], \"frame_poses\": [");
+    print_poses(o, &st->integrated, n_int);
     fprintf(o, "], \"frames_dropped\": [");
     print_list(o, &st->dropped, st->dropped.n);
     list_shift(&st->integrated, n_int);
@@ -225,6 +239,7 @@ static void poll_feed(run_link_t *l, uint64_t now, bool map_ok)
     }
     run_view_t view;
     run_read_begin(l->guard, RUN_READER_FEED, &view);
+    now = occ_port_clock_us(); /* after a wait for the writer: the time it really goes out */
     for (;;) {
         uint8_t out[OCC_MAV_FRAME_MAX];
         const uint32_t before = l->feed->counters.obstacle_tx;

@@ -20,7 +20,8 @@ static void sleep_us(uint64_t us)
 }
 
 /* Recorded timing: wait until the autopilot clock (local + offset) reaches the frame's stamp.
- * Returns the local release time; 0 when asked to stop. */
+ * Returns the local time the frame was due (earlier than now when the mapping is behind); fast
+ * replay: now. 0 when asked to stop. */
 static uint64_t wait_release(run_mapper_t *m, const run_frame_t *f)
 {
     for (;;) {
@@ -38,7 +39,7 @@ static uint64_t wait_release(run_mapper_t *m, const run_frame_t *f)
         (void)pthread_mutex_unlock(&m->st->lock);
         const int64_t release = (int64_t)f->remote_us - off;
         if (known && (int64_t)now >= release) {
-            return now;
+            return release > 0 ? (uint64_t)release : now;
         }
         run_ranges_service(m);
         const int64_t wait = known ? release - (int64_t)now : 10000;
@@ -200,7 +201,7 @@ static occ_err_t load(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
 }
 
 static void record(run_mapper_t *m, const run_frame_t *f, int drop, bool partial, size_t points,
-                   uint64_t t0)
+                   uint64_t t0, const occ_pose_t *map_from_cam)
 {
     const uint64_t now = occ_port_clock_us();
     run_state_t *const st = m->st;
@@ -212,14 +213,15 @@ static void record(run_mapper_t *m, const run_frame_t *f, int drop, bool partial
     c->frames_done++;
     if (drop >= 0) {
         c->dropped[drop]++;
-        (void)run_list_push(&st->dropped, f->index, 0);
+        (void)run_list_push(&st->dropped, f->index, 0, NULL);
     } else {
         c->integrated++;
         c->partial += partial ? 1u : 0u;
         c->points += points;
         c->last_integrated_local_us = now;
         /* inside the write section: the version write_end publishes holds this frame */
-        (void)run_list_push(&st->integrated, f->index, run_write_next_version(m->guard));
+        (void)run_list_push(&st->integrated, f->index, run_write_next_version(m->guard),
+                            map_from_cam);
         if (c->n_integrate == c->cap_integrate) {
             const size_t cap = c->cap_integrate == 0u ? 1024u : 2u * c->cap_integrate;
             uint32_t *const p = realloc(c->integrate_us, cap * sizeof *p);
@@ -260,6 +262,10 @@ static void do_frame(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
     if (released == 0u) {
         return;
     }
+    if (occ_port_clock_us() - released > (uint64_t)m->opt->max_lag_ms * 1000u) {
+        record(m, f, RUN_DROP_LATE, false, 0, released, NULL); /* behind the camera: newer frames wait */
+        return;
+    }
     occ_pose_t map_from_body;
     occ_pose_refusal_t why = OCC_POSE_OK;
     const occ_err_t pe = wait_pose(m, f, released, &map_from_body, &why);
@@ -267,11 +273,11 @@ static void do_frame(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
         return;
     }
     if (pe != OCC_OK) {
-        record(m, f, refusal_reason(why), false, 0, released);
+        record(m, f, refusal_reason(why), false, 0, released, NULL);
         return;
     }
     if (load(m, f, b) != OCC_OK) {
-        record(m, f, RUN_DROP_ERROR, false, 0, occ_port_clock_us());
+        record(m, f, RUN_DROP_ERROR, false, 0, occ_port_clock_us(), NULL);
         return;
     }
     const uint64_t t0 = occ_port_clock_us(); /* integrate time: the write section, not the PNG */
@@ -281,7 +287,7 @@ static void do_frame(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
     occ_map_t *const map = run_write_begin(m->guard);
     const occ_err_t e = integrate(m, map, b, &map_from_cam, &partial, &points);
     const int drop = e == OCC_OK ? -1 : e == OCC_ERR_NOMEM ? RUN_DROP_NOMEM : RUN_DROP_ERROR;
-    record(m, f, drop, partial, points, t0);
+    record(m, f, drop, partial, points, t0, &map_from_cam);
     run_write_end(m->guard);
 }
 

@@ -20,7 +20,7 @@ bool run_state_offset(const run_state_t *st, int64_t *offset_us, const char **so
     return false;
 }
 
-bool run_list_push(run_list_t *l, size_t idx, uint32_t version)
+bool run_list_push(run_list_t *l, size_t idx, uint32_t version, const occ_pose_t *pose)
 {
     if (l->n == l->cap) {
         const size_t cap = l->cap == 0u ? 64u : 2u * l->cap;
@@ -34,10 +34,16 @@ bool run_list_push(run_list_t *l, size_t idx, uint32_t version)
             return false;
         }
         l->version = v;
+        occ_pose_t *const p = realloc(l->pose, cap * sizeof *p);
+        if (p == NULL) {
+            return false;
+        }
+        l->pose = p;
         l->cap = cap;
     }
     l->idx[l->n] = idx;
     l->version[l->n] = version;
+    l->pose[l->n] = pose != NULL ? *pose : occ_pose_identity();
     l->n++;
     return true;
 }
@@ -46,8 +52,10 @@ void run_list_free(run_list_t *l)
 {
     free(l->idx);
     free(l->version);
+    free(l->pose);
     l->idx = NULL;
     l->version = NULL;
+    l->pose = NULL;
     l->n = l->cap = 0;
 }
 

@@ -7,7 +7,7 @@
 #include "run_ranges.h"
 
 static const char *const drop_names[RUN_DROP_REASONS] = {
-    "no_pose_yet", "no_pose_too_old", "no_pose_too_new", "no_pose_gap", "nomem", "error"};
+    "no_pose_yet", "no_pose_too_old", "no_pose_too_new", "no_pose_gap", "nomem", "error", "late"};
 
 static void print_sectors(FILE *f, const occ_sectors_config_t *s)
 {
@@ -49,10 +49,11 @@ void run_stats_config(run_link_t *l)
     FILE *const f = l->stats;
     fprintf(f, "{\"config\": {\"res\": %.9g, \"arena_bytes\": %zu, \"evict\": \"robot\", "
             "\"keep_radius_m\": %.9g, \"rate_hz\": %.9g, \"pose_rate_hz\": %.9g, "
-            "\"pose_timeout_ms\": %u, \"sensor_timeout_ms\": %u, \"target\": [%u, %u], "
+            "\"pose_timeout_ms\": %u, \"sensor_timeout_ms\": %u, \"max_lag_ms\": %u, "
+            "\"target\": [%u, %u], "
             "\"ids\": [%u, %u], \"prior_map\": %s%s%s, ", (double)l->guard->map->cfg.resolution_m,
             o->arena_bytes, (double)o->keep_radius_m, (double)o->fa.rate_hz,
-            (double)o->pose_rate_hz, o->pose_timeout_ms, o->sensor_timeout_ms, o->target_sysid,
+            (double)o->pose_rate_hz, o->pose_timeout_ms, o->sensor_timeout_ms, o->max_lag_ms, o->target_sysid,
             o->target_compid, o->sysid, o->compid, o->fa.map_path != NULL ? "\"" : "",
             o->fa.map_path != NULL ? o->fa.map_path : "null", o->fa.map_path != NULL ? "\"" : "");
     print_depth(f, o, l->depth);
