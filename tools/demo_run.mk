@@ -32,7 +32,7 @@ DEMO_PY = $(PY) tools/demo_run.py --occmap $(BUILD)/occmap --ref $(BUILD)/demo_r
   --min-agree-seen $(DEMO_MIN_AGREE_SEEN) \
   --run-args "$(DEMO_RUN_ARGS)"
 
-$(BUILD)/demo_ref: tools/demo_ref.cpp
+$(BUILD)/demo_ref: tools/demo_ref.cpp | $(BUILD)/.deps-ok
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXWARN) -O2 -g -o $@ $< -loctomap -loctomath -lpng
 
