@@ -78,6 +78,6 @@ DEMO_MAP := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt
 demo-mavlink: $(BUILD)/occmap $(BUILD)/.deps-ok
 	@mkdir -p $(BUILD)/demo
 	$(PY) tools/mav_demo.py --occmap $(BUILD)/occmap --map $(DEMO_MAP) --out $(BUILD)/demo
-DEMO_STEPS += demo-mavlink
+# make demo-static (tools/demo_run.mk) runs it; make demo is the loop demo.
 
 .PHONY: mavgen test-mavlink-roundtrip test-mavlink-udp fuzz-mavlink test-mavlink-fuzz demo-mavlink
