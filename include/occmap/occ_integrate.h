@@ -258,7 +258,7 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  *
  * Scratch (caller's, any alignment): a fixed part (OCC_PROJ_FIXED_BYTES: alignment, an 8 KiB
  * repeat filter for end points, the radix sort's histograms, the call's context and the
- * walk's per-level constants (3 KiB, kept off the stack)), 4 bytes per pixel (the depths), 8 bytes per pyramid cell
+ * walk's per-level constants and stack (4 KiB, kept off the stack)), 4 bytes per pixel (the depths), 8 bytes per pyramid cell
  * (min and max, levels 1.. of halved sides: at most OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells) and the output, in 8-byte slots: the end
  * points' codes after the repeat filter (twice while they are sorted), then one per voxel
  * update and two per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it for n_out
@@ -278,7 +278,7 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
 #define OCC_PROJ_CELLS(w, h) \
     ((size_t)(w) * (size_t)(h) / 3u + (size_t)(w) + (size_t)(h) + 20u)
 #define OCC_PROJ_LEVELS_BYTES 2048u /* the walk's per-level constants (kept off the stack) */
-#define OCC_PROJ_CTX_BYTES 1024u    /* the call's context (kept off the stack) */
+#define OCC_PROJ_CTX_BYTES 2048u    /* the call's context and walk stack (kept off the stack) */
 #define OCC_PROJ_FIXED_BYTES                                                               \
     (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u + \
      OCC_PROJ_LEVELS_BYTES + OCC_PROJ_CTX_BYTES)
@@ -343,6 +343,9 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
  *   occ_map_insert_cloud, occ_map_insert_rays: stack <= 1,472 / 1,536 B; work: n_points rays x <= 3
  *       (ceil(max_ray / res) + 2) + 2 voxels, then one path per distinct voxel
+ *   occ_map_insert_projective: stack <= 1,344 / 1,344 B (its context, tables and walk stack are
+ *       in the scratch); work: O(pixels) for the pyramid and end points, the walk as stated above
+ *       (at most every voxel of the frustum within max range), then the tree update
  *   occ_ray_keys: stack <= 448 / 512 B; work: <= occ_ray_max_keys() keys, no map access
  *   occ_insert_scratch_bytes_scan: stack <= 256 / 320 B; work: O(n_points) (FAST_DISCRETE: + its
  *       coarse box)

@@ -14,6 +14,14 @@
 /* Entries of the end points' repeat filter (direct mapped, 8 bytes each). */
 #define OCC_PROJ_FILTER_N 1024u
 
+/* One level of the walk's explicit stack: a node being opened and its next child slot. */
+typedef struct {
+    uint32_t k[3];
+    occ_code_t code;
+    float cap;
+    uint8_t level, next;
+} occ_proj_frame_t;
+
 /* Per node level, the walk's constants (see occ_proj_t). */
 typedef struct {
     float side[OCC_MAX_DEPTH + 1u]; /* node edge length (m) */
@@ -55,6 +63,7 @@ typedef struct {
     size_t per_level[OCC_MAX_DEPTH + 1u];
     bool overflow;
     occ_proj_result_t *r;
+    occ_proj_frame_t walk[OCC_MAX_DEPTH + 1u]; /* the walk's stack (the context is in scratch) */
 } occ_proj_t;
 
 /* The surface threshold of a depth: a voxel centre nearer than this is in front (monotone in d,

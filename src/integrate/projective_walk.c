@@ -336,12 +336,7 @@ static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t co
 void occi_proj_walk(occ_proj_t *const x)
 {
     const unsigned depth = x->g.depth;
-    struct {
-        uint32_t k[3];
-        occ_code_t code;
-        float cap;
-        uint8_t level, next;
-    } st[OCC_MAX_DEPTH + 1u];
+    occ_proj_frame_t *const st = x->walk; /* in the scratch, not on the stack */
     foot_t f;
     planes_init(x);
     if (depth == 1u) {

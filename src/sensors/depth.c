@@ -149,7 +149,11 @@ static bool back_project(const occ_depth_image_t *im, const occ_depth_params_t *
 
 /* OCC_INSERT_PROJECTIVE: the image as the projective integrator's view of the step grid (pixel
  * (i, j) is the image's (i step, j step); intrinsics divided by the step) and the pose as a
- * rotation matrix. */
+ * rotation matrix. Kept out of line: inlined, its camera and result stayed on the stack under
+ * the ray-cast methods' whole integration too (make cross). */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
 static occ_err_t insert_projective(occ_map_t *map, const occ_depth_image_t *im,
                                    const occ_depth_params_t *dp, const occ_pose_t *pose,
                                    const occ_insert_params_t *insert, void *scratch,
