@@ -33,7 +33,7 @@ chrome=(chromium --headless --no-sandbox --use-angle=swiftshader --enable-unsafe
 url="file://$(realpath "$page")"
 shot=$(realpath -m "$work/shot.png")
 rm -f "$shot"
-timeout 60 "${chrome[@]}" --screenshot="$shot" --dump-dom "$url" >"$work/dom.html" 2>"$work/chromium.log" \
+timeout 180 "${chrome[@]}" --screenshot="$shot" --dump-dom "$url" >"$work/dom.html" 2>"$work/chromium.log" \
   || fail "chromium (log: $work/chromium.log)"
 status=$(grep -o '<div id="status"[^>]*>' "$work/dom.html")
 err=$(sed -n 's/.*data-error="\([^"]*\)".*/\1/p' <<<"$status")

@@ -6,7 +6,7 @@ from . import _structs as S
 
 UNKNOWN, FREE, OCCUPIED = 0, 1, 2  # occ_state_t
 FORMATS = {"bt": 1, "ot": 2, "occ": 3}  # occ_format_t by file extension
-METHODS = {"simple": 0, "discrete": 1, "fast_discrete": 2, "super_rays": 3}
+METHODS = {"simple": 0, "discrete": 1, "fast_discrete": 2, "super_rays": 3, "projective": 4}
 POLICIES = {"unsafe": 0, "safe": 1}  # occ_unknown_policy_t
 RAY_STOPS = ("hit", "max_range", "unknown", "map_edge")  # occ_ray_stop_t
 

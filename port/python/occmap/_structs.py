@@ -55,7 +55,7 @@ MapPriv = _s("occ_map_priv", [
     ("q_free_max", value_t), ("q_occ_min", value_t), ("arena", C.c_void_p),
     ("block_budget", C.c_uint32), ("geo_res", C.c_double), ("geo_inv", C.c_double),
     ("geo_res_f", C.c_float), ("geo_inv_f", C.c_float), ("root_child", C.c_uint32),
-    ("root_value", value_t), ("root_flags", C.c_uint8)])
+    ("root_value", value_t), ("root_flags", C.c_uint8), ("shared", C.c_void_p)])
 MapT = _s("occ_map_t", [
     ("cfg", MapConfig), ("arena_bytes", C.c_size_t), ("inner", Pool), ("leaf", Pool),
     ("oom_count", C.c_uint32), ("write_gen", C.c_uint32), ("priv", MapPriv)])
@@ -80,7 +80,8 @@ Pose = _s("occ_pose_t", [("p", Vec3), ("q", Quat)])
 # ---- occ_integrate.h ----
 InsertParams = _s("occ_insert_params_t", [
     ("method", enum_t), ("max_range_m", C.c_float), ("fast_n", C.c_uint8), ("fast_d", C.c_uint8),
-    ("super_k", C.c_uint16), ("auto_evict", C.c_void_p), ("auto_evict_state", C.c_void_p)])
+    ("super_k", C.c_uint16), ("auto_evict", C.c_void_p), ("auto_evict_state", C.c_void_p),
+    ("proj_noise_rel", C.c_float)])
 InsertResult = _s("occ_insert_result_t", [(n, C.c_size_t) for n in (
     "points_integrated", "points_skipped", "rays_clipped", "rays_no_hit", "rays_cast",
     "voxel_visits", "voxels_updated", "voxels_free", "voxels_occupied", "voxels_changed",

@@ -170,7 +170,9 @@ class Map:
         (metres = raw * depth_scale_m, 0 = no reading) or float32 metres (NaN = no reading,
         +Inf = no return). intrinsics (fx, fy, cx, cy) in pixels; the camera pose
         map_from_camera: position (metres) and quaternion (w, x, y, z) of the optical frame
-        (x right, y down, z forward). Returns occ_depth_result_t's counters as a dict."""
+        (x right, y down, z forward). method: as insert_cloud's, or 'projective' (the
+        projection integrator of occ_integrate.h, fastest for dense frames). Returns
+        occ_depth_result_t's counters as a dict."""
         img = np.asarray(depth)
         fmt = {np.dtype(np.uint16): 0, np.dtype(np.float32): 1}.get(img.dtype)
         if fmt is None or img.ndim != 2:

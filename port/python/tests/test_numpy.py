@@ -144,6 +144,18 @@ def test_depth_pose_quaternion_is_w_first():
         [occmap.OCCUPIED, occmap.FREE]
 
 
+def test_insert_depth_projective():
+    """method='projective' (OCC_INSERT_PROJECTIVE): a wall 2 m ahead of a 16 x 16 camera reads
+    occupied where the centre pixels end, free at 1 m in front of it, unknown 0.5 m behind."""
+    m = occmap.Map(RES, 8 << 20)
+    img = np.full((16, 16), 2.0, np.float32)
+    r = m.insert_depth(img, (20.0, 20.0, 7.5, 7.5), (0.05, 0.05, 0.05), (0.5, -0.5, 0.5, -0.5),
+                       max_range_m=3.0, method="projective")
+    assert r["points"] == 256 and r["insert"]["voxels_occupied"] > 0
+    assert m.state_at([[2.05, 0.05, 0.05], [1.05, 0.05, 0.05], [2.55, 0.05, 0.05]]).tolist() == \
+        [occmap.OCCUPIED, occmap.FREE, occmap.UNKNOWN]
+
+
 def test_sectors_yaw_equals_its_quaternion():
     m, _, _ = _wall_map()
     yaw = 0.3
