@@ -10,6 +10,7 @@
 #include "occmap/occ_port.h"
 #include "occmap/host/occ_file.h"
 
+#define NEAREST_CAP 16384u /* --3d: nodes waiting in the nearest-first search (24 B each) */
 #define HISTORY_CAP 8192u /* poses: 160 s at 50 Hz, the whole TUM ground truth at 100 Hz */
 
 /* The map in one arena of --arena-bytes, empty or loaded from --map. 0, or 1 after a message. */
@@ -155,6 +156,14 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
     (void)occ_mav_ranges_init(&l.ranges_tr, (uint8_t)o->sysid, (uint8_t)o->compid);
     l.tx.sysid = (uint8_t)o->sysid;
     l.tx.compid = (uint8_t)o->compid;
+    if (o->obstacle_3d) { /* the 3D search's heap: ample for --max-m 20 at 0.1 m */
+        l.nearest_cap = NEAREST_CAP;
+        l.nearest = malloc(NEAREST_CAP * sizeof *l.nearest);
+        if (l.nearest == NULL) {
+            cli_error("run", "cannot allocate the --3d search");
+            return 1;
+        }
+    }
     l.stats = open_out(o->stats_path, stderr);
     l.feed_log = open_out(o->feed_log_path, NULL);
     status = l.stats == NULL || (o->feed_log_path != NULL && l.feed_log == NULL) ? 1
@@ -176,6 +185,7 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
         (void)fclose(l.feed_log);
     }
     free(l.ft.interval_us);
+    free(l.nearest);
     run_mapguard_destroy(&guard);
     free_state(&st);
     return status;

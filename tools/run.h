@@ -40,6 +40,7 @@ typedef struct {
     const char *stats_path, *feed_log_path;
     bool exit_after_depth;
     bool mavlink_ranges;             /* integrate range messages of other components */
+    bool obstacle_3d;                /* --3d: OBSTACLE_DISTANCE_3D above / below (run_3d.h) */
     uint32_t replay_speed;           /* 1: recorded timing; 0: as fast as the poses allow */
     float keep_radius_m;             /* eviction: protected ball around the camera */
 } run_opts_t;

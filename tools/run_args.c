@@ -67,13 +67,17 @@ void run_args_usage(FILE *f)
         "  --sensor-timeout-ms 1000  nor while no frame was integrated for this long (with\n"
         "                          --depth-dir); either sends one STATUSTEXT (WARNING) when it\n"
         "                          starts and one (INFO) when it ends\n"
+        "  --3d                    after each OBSTACLE_DISTANCE, OBSTACLE_DISTANCE_3D (BODY_FRD, one\n"
+        "                          time_boot_ms per batch) of the nearest occupied point above the\n"
+        "                          band (obstacle_id 0) and below it (id 1), within --max-m\n"
         "Output:\n"
         "  --stats FILE            telemetry, one JSON line a second (default stderr); the first is\n"
         "                          {\"config\": ...}, the last {\"final\": ...} with map_check\n"
         "  --feed-log FILE         one JSON line per OBSTACLE_DISTANCE sent: time_usec, seq, version,\n"
         "                          frames / frames_dropped (depth.txt indices since the last line),\n"
         "                          frame_poses (map <- camera each frame was integrated with),\n"
-        "                          pose [x y z qw qx qy qz] (map ENU, body FLU), distances, ...\n"
+        "                          pose [x y z qw qx qy qz] (map ENU, body FLU), distances, ...;\n"
+        "                          with --3d obstacles_3d [[id, x, y, z (FRD m)], ...] as sent\n"
         "  --duration S            end after S seconds (0: until SIGINT/SIGTERM)\n"
         "  --exit-after-depth      end once every frame is integrated or dropped and one more\n"
         "                          OBSTACLE_DISTANCE was sent (or --sensor-timeout-ms passed)\n"
@@ -193,8 +197,6 @@ static int map_option(run_opts_t *o, const char *a, const char *v)
     return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
 }
 
-static bool want_3d;
-
 static int run_option(void *ctx, const char *a, const char *v)
 {
     run_opts_t *const o = ctx;
@@ -202,7 +204,7 @@ static int run_option(void *ctx, const char *a, const char *v)
         if (strcmp(a, "--exit-after-depth") == 0) {
             o->exit_after_depth = true;
         } else if (strcmp(a, "--3d") == 0) {
-            want_3d = true;
+            o->obstacle_3d = true;
         } else if (strcmp(a, "--mavlink-ranges") == 0) {
             o->mavlink_ranges = true;
         } else {
@@ -219,7 +221,6 @@ static int run_option(void *ctx, const char *a, const char *v)
 int run_args_parse(run_opts_t *o, int argc, char **argv)
 {
     defaults(o);
-    want_3d = false;
     const feed_cmd_t cmd = {"run", run_args_usage, run_flags, run_option, o};
     const int parsed = feed_args_parse(&o->fa, &cmd, argc, argv);
     if (parsed != FEED_ARGS_RUN) {
@@ -229,10 +230,6 @@ int run_args_parse(run_opts_t *o, int argc, char **argv)
     if (n_links != 1) {
         cli_error("run", "needs exactly one of --udp, --udp-listen, --serial");
         run_args_usage(stderr);
-        return 2;
-    }
-    if (want_3d) {
-        cli_error("run", "--3d (OBSTACLE_DISTANCE_3D) is not implemented yet");
         return 2;
     }
     if (o->depth_max_m <= o->depth_min_m || (o->exit_after_depth && o->depth_dir == NULL)) {
