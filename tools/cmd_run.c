@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "run_can.h"
 #include "run_link.h"
 #include "run_ranges.h"
 #include "occmap/occ_port.h"
@@ -171,11 +172,19 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
     if (status == 0) {
         run_mapper_t m = {o, depth, &st, &guard, occ_evict_policy_default()};
         m.policy.keep_radius_m = o->keep_radius_m;
+        static run_can_t can;
+        if (o->can != NULL) {
+            status = run_can_open(&can, o);
+            l.can = status == 0 ? &can : NULL;
+        }
         feed_stop_install();
         l.t0 = occ_port_clock_us();
         l.next_stats = l.t0 + 1000000u;
         run_stats_config(&l);
-        status = run_threads(&l, &m);
+        status = status == 0 ? run_threads(&l, &m) : status;
+        if (l.can != NULL) {
+            run_can_close(l.can);
+        }
         occ_link_close(&link);
     }
     if (l.stats != NULL && l.stats != stderr) {

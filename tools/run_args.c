@@ -22,6 +22,13 @@ void run_args_usage(FILE *f)
         "  --udp-listen [H:]PORT   wait for the autopilot to send first   --serial DEV:BAUD\n"
         "  --target-sysid 1 --target-compid 1   poses only from this autopilot (others counted)\n"
         "  --sysid 1 --compid 196  our ids (MAV_COMP_ID_OBSTACLE_AVOIDANCE)\n"
+        "  --can IFACE             DroneCAN on SocketCAN IFACE (or mcast:BUS, pydronecan's UDP bus):\n"
+        "                          range_sensor.Measurement in (placed by --can-range-mount, else\n"
+        "                          counted unknown_sensor), Proximity + NodeStatus out\n"
+        "  --can-node-id 100       our node id   --can-range-mount ID,x,y,z,roll,pitch,yaw,min,max\n"
+        "                          body FLU <- sensor (m, deg; beam = sensor +x), range m (up to 8)\n"
+        "  --config FILE           key = value lines, key an option without --, before the command\n"
+        "                          line (which wins); flags: key = true; # comments; keys repeat\n"
         "  --pose-rate 50          Hz asked for LOCAL_POSITION_NED and ATTITUDE with\n"
         "                          MAV_CMD_SET_MESSAGE_INTERVAL, once a second until they arrive\n"
         "                          (refusals logged); 0: never ask\n"
@@ -106,6 +113,37 @@ static void defaults(run_opts_t *o)
     o->max_lag_ms = 500;
     o->replay_speed = 1u;
     o->keep_radius_m = 3.0f;
+    o->can_node_id = 100;
+}
+
+/* --can-range-mount ID,x,y,z,roll,pitch,yaw,min,max: body FLU <- sensor (m, deg; the beam is
+ * the sensor's +x), valid range in metres. One per sensor_id (checked by the receiver). */
+static bool can_mount(run_opts_t *o, const char *v)
+{
+    float f[9];
+    if (o->n_can_mounts == RUN_CAN_MOUNTS || !cli_parse_floats(v, f, 9) || !(f[0] >= 0.0f) ||
+        f[0] > 255.0f || floorf(f[0]) < f[0] || !(f[7] >= 0.0f) || !(f[8] > f[7])) {
+        return false;
+    }
+    occ_dronecan_range_mount_t *const m = &o->can_mounts[o->n_can_mounts];
+    const float deg = 3.14159265358979f / 180.0f;
+    m->sensor_id = (uint8_t)f[0];
+    m->body_from_sensor.p = (occ_vec3_t){f[1], f[2], f[3]};
+    m->body_from_sensor.q = occ_quat_from_euler(f[4] * deg, f[5] * deg, f[6] * deg);
+    m->min_m = f[7];
+    m->max_m = f[8];
+    o->n_can_mounts++;
+    return true;
+}
+
+bool run_args_is_flag(const char *opt)
+{
+    for (size_t i = 0; run_flags[i] != NULL; i++) {
+        if (strcmp(opt, run_flags[i]) == 0) {
+            return true;
+        }
+    }
+    return false;
 }
 
 /* The link and the ids. */
@@ -132,6 +170,12 @@ static int link_option(run_opts_t *o, const char *a, const char *v)
         ok = cli_parse_u32(v, 1, 60000, &o->pose_timeout_ms);
     } else if (strcmp(a, "--sensor-timeout-ms") == 0) {
         ok = cli_parse_u32(v, 1, 600000, &o->sensor_timeout_ms);
+    } else if (strcmp(a, "--can") == 0) {
+        o->can = v;
+    } else if (strcmp(a, "--can-node-id") == 0) {
+        ok = cli_parse_u32(v, 1, 127, &o->can_node_id);
+    } else if (strcmp(a, "--can-range-mount") == 0) {
+        ok = can_mount(o, v);
     } else if (strcmp(a, "--rate") == 0) {
         ok = cli_parse_float_in(v, 0.1f, 100.0f, &o->fa.rate_hz);
     } else if (strcmp(a, "--duration") == 0) {
@@ -221,6 +265,9 @@ static int run_option(void *ctx, const char *a, const char *v)
 int run_args_parse(run_opts_t *o, int argc, char **argv)
 {
     defaults(o);
+    if (run_config_expand(argc, argv, &argc, &argv) != 0) {
+        return 2;
+    }
     const feed_cmd_t cmd = {"run", run_args_usage, run_flags, run_option, o};
     const int parsed = feed_args_parse(&o->fa, &cmd, argc, argv);
     if (parsed != FEED_ARGS_RUN) {

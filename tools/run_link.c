@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "run_can.h"
 #include "run_link.h"
 #include "run_ranges.h"
 #include "occmap/occ_port.h"
@@ -356,7 +357,8 @@ static void wait_next(run_link_t *l, uint64_t now)
     due = l->next_timesync < due ? l->next_timesync : due;
     due = l->next_stats < due ? l->next_stats : due;
     uint64_t wait = due > now ? due - now : 0u;
-    wait = wait > 20000u ? 20000u : wait;
+    const uint64_t most = l->can != NULL ? 2000u : 20000u; /* the CAN bus is polled */
+    wait = wait > most ? most : wait;
     if (wait > 0u) {
         (void)occ_link_wait(l->link, wait);
     }
@@ -376,6 +378,9 @@ int run_link_loop(run_link_t *l)
         poll_timesync(l, now);
         const bool map_ok = update_status(l, now);
         poll_feed(l, now, map_ok);
+        if (l->can != NULL) {
+            run_can_poll(l, l->can, occ_port_clock_us(), map_ok);
+        }
         log_requests(l);
         if (now >= l->next_stats) {
             l->next_stats += 1000000u;

@@ -16,7 +16,7 @@ typedef struct {
     size_t n, cap;
 } run_feed_timing_t;
 
-typedef struct {
+typedef struct run_link_s {
     const run_opts_t *opt;
     run_state_t *st;
     run_mapguard_t *guard;
@@ -40,6 +40,7 @@ typedef struct {
     size_t nearest_cap;
     run_3d_t last_3d;               /* --3d: what went out with the last OBSTACLE_DISTANCE */
     uint64_t sent_3d;               /* OBSTACLE_DISTANCE_3D sent */
+    struct run_can_s *can;          /* --can: the DroneCAN node (run_can.h), else NULL */
 } run_link_t;
 
 /* Until stop, --duration or --exit-after-depth. 0, or 1 after a link error. */

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "run_link.h"
+#include "run_can.h"
 #include "run_ranges.h"
 
 static const char *const drop_names[RUN_DROP_REASONS] = {
@@ -140,6 +141,13 @@ void run_stats_line(run_link_t *l, uint64_t now, const char *key, bool map_check
     (void)pthread_mutex_unlock(&l->st->lock);
     fprintf(f, ", ");
     print_feed(f, l);
+    if (l->can != NULL) {
+        fprintf(f, ", ");
+        run_can_print(f, l->can);
+    }
+    if (l->nearest != NULL) {
+        fprintf(f, ", \"obstacle_3d_sent\": %llu", (unsigned long long)l->sent_3d);
+    }
     fprintf(f, ", \"link\": {\"rx_bytes\": %llu, \"tx_dropped\": %u, \"bad_crc\": %u}",
             (unsigned long long)l->link->rx_bytes, l->link->tx_dropped,
             l->feed->parser.counters.bad_crc);
