@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "run_camera.h"
 #include "run_can.h"
 #include "run_link.h"
 #include "run_ranges.h"
@@ -170,7 +171,12 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
     status = l.stats == NULL || (o->feed_log_path != NULL && l.feed_log == NULL) ? 1
              : open_link(o, &link);
     if (status == 0) {
-        run_mapper_t m = {o, depth, &st, &guard, occ_evict_policy_default()};
+        static run_camera_t cam; /* the TUM replay; a live camera driver plugs in here */
+        static run_camera_tum_t tum;
+        if (depth != NULL) {
+            run_camera_tum(&cam, &tum, depth);
+        }
+        run_mapper_t m = {o, depth != NULL ? &cam : NULL, &st, &guard, occ_evict_policy_default()};
         m.policy.keep_radius_m = o->keep_radius_m;
         static run_can_t can;
         if (o->can != NULL) {

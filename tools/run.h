@@ -136,7 +136,7 @@ void run_list_free(run_list_t *l);
 /* ---- the mapping thread (run_mapper.c) --------------------------------------------------------- */
 typedef struct {
     const run_opts_t *opt;
-    run_depth_t *depth;              /* NULL: no depth input */
+    struct run_camera_s *cam;        /* NULL: no depth input (run_camera.h) */
     run_state_t *st;
     run_mapguard_t *guard;
     occ_evict_policy_t policy;
