@@ -91,6 +91,9 @@ def main():
     if not (can.get("readings", 0) > 0 and can.get("unknown_sensor", 0) > 0 and
             rng.get("integrated", 0) == can.get("readings")):
         bad.append("telemetry can %s ranges %s" % (can, rng))
+    mounts = lines[0].get("config", {}).get("can_mounts")
+    if not mounts or mounts[0][0] != 3 or abs(mounts[0][8] - 0.2) > 1e-6 or abs(mounts[0][9] - 10) > 1e-6:
+        bad.append("mounts in the config line %s (want sensor 3, 0.2..10 m)" % mounts)
     if rate is None or abs(float(rate) - 10.0) > 1e-6:
         bad.append("rate in the config line %s (want the command line's 10)" % rate)
     if bad:
