@@ -107,7 +107,9 @@ static bool sensors_fresh(run_link_t *l, uint64_t now)
     (void)pthread_mutex_lock(&l->st->lock);
     const uint64_t last = l->st->mc.last_integrated_local_us;
     (void)pthread_mutex_unlock(&l->st->lock);
-    return last != 0u && now - last <= (uint64_t)l->opt->sensor_timeout_ms * 1000u;
+    /* last may be after `now` (the mapper integrated since the loop read the clock): fresh,
+     * not a huge unsigned age */
+    return last != 0u && (last >= now || now - last <= (uint64_t)l->opt->sensor_timeout_ms * 1000u);
 }
 
 static void statustext(run_link_t *l, uint8_t severity, const char *text)
