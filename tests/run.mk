@@ -9,3 +9,10 @@ test-run-loop: $(BUILD)/occmap $(BUILD)/.deps-ok
 	  --tiny-arena 32K --test all
 TEST_STEPS += test-run-loop
 .PHONY: test-run-loop
+
+# occmap run --can (DroneCAN range sensors in, Proximity out) and --config, on pydronecan's
+# mcast: bus in a network namespace with only loopback (tests/run_can.sh, run_can_peer.py).
+test-run-can: $(BUILD)/occmap $(BUILD)/can/wall.occ $(BUILD)/.deps-ok
+	bash tests/run_can.sh $(PY) $(BUILD)/occmap $(BUILD)/can/wall.occ $(BUILD)/run
+TEST_STEPS += test-run-can
+.PHONY: test-run-can

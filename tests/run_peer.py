@@ -18,6 +18,8 @@ times faster so the tests take seconds). Tests (each prints PASS/FAIL):
             ends by itself (--exit-after-depth) with exit 0, eviction ran, occ_map_check holds.
   stale     sensors stale after the last frame (then pose stale with a prior --map): one
             STATUSTEXT each, no OBSTACLE_DISTANCE after it, HEARTBEAT ACTIVE before, CRITICAL after.
+  3d        --3d: OBSTACLE_DISTANCE_3D above / below after each OBSTACLE_DISTANCE, decoded by
+            pymavlink, at the points another component reported (within a voxel).
   jitter    mapping busy (full-resolution frames) while the feed runs: its period jitter is
             reported (p50/p99/max, printed), its median below half an integration's (the feed
             never waits for the writer), the feed saw new map versions while it ran.
@@ -510,7 +512,78 @@ def test_ranges(o, frames, gt):
                   r.get("integrated"))
 
 
-TESTS = {"ranges": test_ranges, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
+def test_3d(o, frames, gt):
+    """--3d: another component (1/158) reports two OBSTACLE_DISTANCE_3D points (BODY_FRD),
+    forward-right 1.2 m above and behind-left 1.4 m below a level vehicle turned 0.3 rad
+    (--mavlink-ranges integrates each as a beam): every OBSTACLE_DISTANCE is followed by our
+    OBSTACLE_DISTANCE_3D id 0 (above) and id 1 (below), decoded by pymavlink, BODY_FRD, stamped
+    with that OBSTACLE_DISTANCE's time; each point lies in the voxel of the point sent in
+    (within a voxel diagonal, not farther than it), as the feed log says."""
+    c = Check("3d")
+    port = free_port()
+    first = (gt[0][0], gt[0][1], gt[0][2], (0.0, 0.0, 0.3))
+    peer = Peer(port, [first], hold_last=True)
+    sensor = mavutil.mavlink.MAVLink(None, srcSystem=1, srcComponent=158)
+    pts = {0: (1.0, 0.5, -1.2), 1: (-0.8, -0.6, 1.4)}  # FRD m: above, below
+    got = []  # (time, msg) of OBSTACLE_DISTANCE and OBSTACLE_DISTANCE_3D in arrival order
+    handle = peer.handle
+
+    def grab(m):
+        if m.get_type() in ("OBSTACLE_DISTANCE", "OBSTACLE_DISTANCE_3D"):
+            got.append(m)
+        handle(m)
+    peer.handle = grab
+    fl = os.path.join(o.out, "3d_feed.json")
+    p = subprocess.Popen([o.occmap, "run", "--udp", "127.0.0.1:%d" % port, "--mavlink-ranges",
+                          "--3d", "--duration", "2.5", "--feed-log", fl,
+                          "--stats", os.path.join(o.out, "3d_stats.json")],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    nxt = 0.0
+    while p.poll() is None:
+        peer.step()
+        if peer.conn.clients and time.monotonic() > nxt and peer.sent_us:
+            nxt = time.monotonic() + 0.1
+            for x, y, z in pts.values():
+                peer.conn.write(sensor.obstacle_distance_3d_encode(
+                    peer.boot_us() // 1000, 0, 12, 65535, x, y, z, 0.2, 10.0).pack(sensor))
+    _, err = p.communicate()
+    peer.conn.close()
+    c.that(p.returncode == 0, "exit %s: %s" % (p.returncode, err[-300:]))
+    diag = 0.1 * math.sqrt(3.0) + 1e-4
+    batches, od = [], None
+    for m in got:
+        if m.get_type() == "OBSTACLE_DISTANCE":
+            od = m
+            batches.append((m, []))
+        elif batches:
+            batches[-1][1].append(m)
+    full = [(a, b) for a, b in batches if len(b) == 2]
+    c.that(len(full) >= 5, "%d OBSTACLE_DISTANCE with both 3D points of %d" % (len(full), len(batches)))
+    for a, b in full[-5:]:
+        for m in b:
+            want = pts.get(m.obstacle_id)
+            c.that(m.frame == 12 and want is not None, "frame %d id %d" % (m.frame, m.obstacle_id))
+            c.that(m.time_boot_ms == a.time_usec // 1000, "stamp %d vs %d" %
+                   (m.time_boot_ms, a.time_usec // 1000))
+            if want is None:
+                continue
+            d = math.dist((m.x, m.y, m.z), want)
+            c.that(d <= diag and math.hypot(m.x, m.y, m.z) <= math.hypot(*want) + 1e-4,
+                   "id %d at (%.3f %.3f %.3f), sent in (%.3f %.3f %.3f)" %
+                   ((m.obstacle_id, m.x, m.y, m.z) + want))
+            c.that(0.19 < m.min_distance < 0.21 and 19.9 < m.max_distance < 20.1,
+                   "range %.2f..%.2f" % (m.min_distance, m.max_distance))
+    lines = feed_log(fl) if os.path.exists(fl) else []
+    last = lines[-1].get("obstacles_3d") if lines else None
+    c.that(last is not None and [v[0] for v in last] == [0, 1], "feed log obstacles_3d %s" % last)
+    if last is not None and full:
+        c.that(all(math.dist(v[1:], pts[v[0]]) <= diag for v in last), "feed log %s" % last)
+    return c.done("%d OBSTACLE_DISTANCE each with OBSTACLE_DISTANCE_3D above and below; last: %s"
+                  % (len(full), ["(%.2f %.2f %.2f)" % (m.x, m.y, m.z) for m in full[-1][1]]
+                     if full else None))
+
+
+TESTS = {"3d": test_3d, "ranges": test_ranges, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
 
 
 def main():

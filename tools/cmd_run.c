@@ -5,11 +5,14 @@
 #include <string.h>
 
 #include "cli.h"
+#include "run_camera.h"
+#include "run_can.h"
 #include "run_link.h"
 #include "run_ranges.h"
 #include "occmap/occ_port.h"
 #include "occmap/host/occ_file.h"
 
+#define NEAREST_CAP 16384u /* --3d: nodes waiting in the nearest-first search (24 B each) */
 #define HISTORY_CAP 8192u /* poses: 160 s at 50 Hz, the whole TUM ground truth at 100 Hz */
 
 /* The map in one arena of --arena-bytes, empty or loaded from --map. 0, or 1 after a message. */
@@ -155,18 +158,39 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
     (void)occ_mav_ranges_init(&l.ranges_tr, (uint8_t)o->sysid, (uint8_t)o->compid);
     l.tx.sysid = (uint8_t)o->sysid;
     l.tx.compid = (uint8_t)o->compid;
+    if (o->obstacle_3d) { /* the 3D search's heap: ample for --max-m 20 at 0.1 m */
+        l.nearest_cap = NEAREST_CAP;
+        l.nearest = malloc(NEAREST_CAP * sizeof *l.nearest);
+        if (l.nearest == NULL) {
+            cli_error("run", "cannot allocate the --3d search");
+            return 1;
+        }
+    }
     l.stats = open_out(o->stats_path, stderr);
     l.feed_log = open_out(o->feed_log_path, NULL);
     status = l.stats == NULL || (o->feed_log_path != NULL && l.feed_log == NULL) ? 1
              : open_link(o, &link);
     if (status == 0) {
-        run_mapper_t m = {o, depth, &st, &guard, occ_evict_policy_default()};
+        static run_camera_t cam; /* the TUM replay; a live camera driver plugs in here */
+        static run_camera_tum_t tum;
+        if (depth != NULL) {
+            run_camera_tum(&cam, &tum, depth);
+        }
+        run_mapper_t m = {o, depth != NULL ? &cam : NULL, &st, &guard, occ_evict_policy_default()};
         m.policy.keep_radius_m = o->keep_radius_m;
+        static run_can_t can;
+        if (o->can != NULL) {
+            status = run_can_open(&can, o);
+            l.can = status == 0 ? &can : NULL;
+        }
         feed_stop_install();
         l.t0 = occ_port_clock_us();
         l.next_stats = l.t0 + 1000000u;
         run_stats_config(&l);
-        status = run_threads(&l, &m);
+        status = status == 0 ? run_threads(&l, &m) : status;
+        if (l.can != NULL) {
+            run_can_close(l.can);
+        }
         occ_link_close(&link);
     }
     if (l.stats != NULL && l.stats != stderr) {
@@ -176,6 +200,7 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
         (void)fclose(l.feed_log);
     }
     free(l.ft.interval_us);
+    free(l.nearest);
     run_mapguard_destroy(&guard);
     free_state(&st);
     return status;

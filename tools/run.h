@@ -13,11 +13,13 @@
 #include "feed_args.h"
 #include "run_mapguard.h"
 #include "occmap/occ_depth.h"
+#include "occmap/occ_dronecan.h"
 #include "occmap/occ_evict.h"
 #include "occmap/occ_mavlink_run.h"
 #include "occmap/host/occ_tum.h"
 
 /* ---- options (run_args.c) ------------------------------------------------------------------ */
+#define RUN_CAN_MOUNTS 8u
 typedef struct {
     feed_args_t fa;                  /* --map, --min-m, --max-m, --rate, --duration */
     occ_mav_feed_config_t feed;      /* sector settings (band, ground, angle, unknown) */
@@ -40,14 +42,27 @@ typedef struct {
     const char *stats_path, *feed_log_path;
     bool exit_after_depth;
     bool mavlink_ranges;             /* integrate range messages of other components */
+    bool obstacle_3d;                /* --3d: OBSTACLE_DISTANCE_3D above / below (run_3d.h) */
     uint32_t replay_speed;           /* 1: recorded timing; 0: as fast as the poses allow */
     float keep_radius_m;             /* eviction: protected ball around the camera */
+    const char *can;                 /* --can IFACE or mcast:BUS (run_can.h); NULL: off */
+    uint32_t can_node_id;            /* --can-node-id, 1..127 */
+    occ_dronecan_range_mount_t can_mounts[RUN_CAN_MOUNTS]; /* --can-range-mount, by sensor_id */
+    size_t n_can_mounts;
 } run_opts_t;
 
 /* Parse argv. RUN: go on; else the exit status (0 after --help, 2 after a message). */
 #define RUN_ARGS_GO (-1)
 int run_args_parse(run_opts_t *o, int argc, char **argv);
 void run_args_usage(FILE *f);
+/* A run option that takes no value (--3d ...). */
+bool run_args_is_flag(const char *opt);
+
+/* --config FILE (run_config.c): argv with each `key = value` line of FILE as "--key" "value"
+ * ("--key" alone for a flag set true; false leaves it out) placed before the command line's
+ * own options (the command line wins), --config FILE removed. 0, or 2 after a message
+ * (file:line). The new argv lives until exit. */
+int run_config_expand(int argc, char **argv, int *out_argc, char ***out_argv);
 
 /* ---- the depth directory (run_depth.c) ------------------------------------------------------- */
 typedef struct {
@@ -121,7 +136,7 @@ void run_list_free(run_list_t *l);
 /* ---- the mapping thread (run_mapper.c) --------------------------------------------------------- */
 typedef struct {
     const run_opts_t *opt;
-    run_depth_t *depth;              /* NULL: no depth input */
+    struct run_camera_s *cam;        /* NULL: no depth input (run_camera.h) */
     run_state_t *st;
     run_mapguard_t *guard;
     occ_evict_policy_t policy;

@@ -22,6 +22,13 @@ void run_args_usage(FILE *f)
         "  --udp-listen [H:]PORT   wait for the autopilot to send first   --serial DEV:BAUD\n"
         "  --target-sysid 1 --target-compid 1   poses only from this autopilot (others counted)\n"
         "  --sysid 1 --compid 196  our ids (MAV_COMP_ID_OBSTACLE_AVOIDANCE)\n"
+        "  --can IFACE             DroneCAN on SocketCAN IFACE (or mcast:BUS, pydronecan's UDP bus):\n"
+        "                          range_sensor.Measurement in (placed by --can-range-mount, else\n"
+        "                          counted unknown_sensor), Proximity + NodeStatus out\n"
+        "  --can-node-id 100       our node id   --can-range-mount ID,x,y,z,roll,pitch,yaw,min,max\n"
+        "                          body FLU <- sensor (m, deg; beam = sensor +x), range m (up to 8)\n"
+        "  --config FILE           key = value lines, key an option without --, before the command\n"
+        "                          line (which wins); flags: key = true; # comments; keys repeat\n"
         "  --pose-rate 50          Hz asked for LOCAL_POSITION_NED and ATTITUDE with\n"
         "                          MAV_CMD_SET_MESSAGE_INTERVAL, once a second until they arrive\n"
         "                          (refusals logged); 0: never ask\n"
@@ -68,13 +75,17 @@ void run_args_usage(FILE *f)
         "  --sensor-timeout-ms 1000  nor while no frame was integrated for this long (with\n"
         "                          --depth-dir); either sends one STATUSTEXT (WARNING) when it\n"
         "                          starts and one (INFO) when it ends\n"
+        "  --3d                    after each OBSTACLE_DISTANCE, OBSTACLE_DISTANCE_3D (BODY_FRD, one\n"
+        "                          time_boot_ms per batch) of the nearest occupied point above the\n"
+        "                          band (obstacle_id 0) and below it (id 1), within --max-m\n"
         "Output:\n"
         "  --stats FILE            telemetry, one JSON line a second (default stderr); the first is\n"
         "                          {\"config\": ...}, the last {\"final\": ...} with map_check\n"
         "  --feed-log FILE         one JSON line per OBSTACLE_DISTANCE sent: time_usec, seq, version,\n"
         "                          frames / frames_dropped (depth.txt indices since the last line),\n"
         "                          frame_poses (map <- camera each frame was integrated with),\n"
-        "                          pose [x y z qw qx qy qz] (map ENU, body FLU), distances, ...\n"
+        "                          pose [x y z qw qx qy qz] (map ENU, body FLU), distances, ...;\n"
+        "                          with --3d obstacles_3d [[id, x, y, z (FRD m)], ...] as sent\n"
         "  --duration S            end after S seconds (0: until SIGINT/SIGTERM)\n"
         "  --exit-after-depth      end once every frame is integrated or dropped and one more\n"
         "                          OBSTACLE_DISTANCE was sent (or --sensor-timeout-ms passed)\n"
@@ -103,6 +114,37 @@ static void defaults(run_opts_t *o)
     o->max_lag_ms = 500;
     o->replay_speed = 1u;
     o->keep_radius_m = 3.0f;
+    o->can_node_id = 100;
+}
+
+/* --can-range-mount ID,x,y,z,roll,pitch,yaw,min,max: body FLU <- sensor (m, deg; the beam is
+ * the sensor's +x), valid range in metres. One per sensor_id (checked by the receiver). */
+static bool can_mount(run_opts_t *o, const char *v)
+{
+    float f[9];
+    if (o->n_can_mounts == RUN_CAN_MOUNTS || !cli_parse_floats(v, f, 9) || !(f[0] >= 0.0f) ||
+        f[0] > 255.0f || floorf(f[0]) < f[0] || !(f[7] >= 0.0f) || !(f[8] > f[7])) {
+        return false;
+    }
+    occ_dronecan_range_mount_t *const m = &o->can_mounts[o->n_can_mounts];
+    const float deg = 3.14159265358979f / 180.0f;
+    m->sensor_id = (uint8_t)f[0];
+    m->body_from_sensor.p = (occ_vec3_t){f[1], f[2], f[3]};
+    m->body_from_sensor.q = occ_quat_from_euler(f[4] * deg, f[5] * deg, f[6] * deg);
+    m->min_m = f[7];
+    m->max_m = f[8];
+    o->n_can_mounts++;
+    return true;
+}
+
+bool run_args_is_flag(const char *opt)
+{
+    for (size_t i = 0; run_flags[i] != NULL; i++) {
+        if (strcmp(opt, run_flags[i]) == 0) {
+            return true;
+        }
+    }
+    return false;
 }
 
 /* The link and the ids. */
@@ -129,6 +171,12 @@ static int link_option(run_opts_t *o, const char *a, const char *v)
         ok = cli_parse_u32(v, 1, 60000, &o->pose_timeout_ms);
     } else if (strcmp(a, "--sensor-timeout-ms") == 0) {
         ok = cli_parse_u32(v, 1, 600000, &o->sensor_timeout_ms);
+    } else if (strcmp(a, "--can") == 0) {
+        o->can = v;
+    } else if (strcmp(a, "--can-node-id") == 0) {
+        ok = cli_parse_u32(v, 1, 127, &o->can_node_id);
+    } else if (strcmp(a, "--can-range-mount") == 0) {
+        ok = can_mount(o, v);
     } else if (strcmp(a, "--rate") == 0) {
         ok = cli_parse_float_in(v, 0.1f, 100.0f, &o->fa.rate_hz);
     } else if (strcmp(a, "--duration") == 0) {
@@ -194,8 +242,6 @@ static int map_option(run_opts_t *o, const char *a, const char *v)
     return ok ? FEED_OPT_OK : FEED_OPT_BAD_VALUE;
 }
 
-static bool want_3d;
-
 static int run_option(void *ctx, const char *a, const char *v)
 {
     run_opts_t *const o = ctx;
@@ -203,7 +249,7 @@ static int run_option(void *ctx, const char *a, const char *v)
         if (strcmp(a, "--exit-after-depth") == 0) {
             o->exit_after_depth = true;
         } else if (strcmp(a, "--3d") == 0) {
-            want_3d = true;
+            o->obstacle_3d = true;
         } else if (strcmp(a, "--mavlink-ranges") == 0) {
             o->mavlink_ranges = true;
         } else {
@@ -220,7 +266,9 @@ static int run_option(void *ctx, const char *a, const char *v)
 int run_args_parse(run_opts_t *o, int argc, char **argv)
 {
     defaults(o);
-    want_3d = false;
+    if (run_config_expand(argc, argv, &argc, &argv) != 0) {
+        return 2;
+    }
     const feed_cmd_t cmd = {"run", run_args_usage, run_flags, run_option, o};
     const int parsed = feed_args_parse(&o->fa, &cmd, argc, argv);
     if (parsed != FEED_ARGS_RUN) {
@@ -230,10 +278,6 @@ int run_args_parse(run_opts_t *o, int argc, char **argv)
     if (n_links != 1) {
         cli_error("run", "needs exactly one of --udp, --udp-listen, --serial");
         run_args_usage(stderr);
-        return 2;
-    }
-    if (want_3d) {
-        cli_error("run", "--3d (OBSTACLE_DISTANCE_3D) is not implemented yet");
         return 2;
     }
     if (o->depth_max_m <= o->depth_min_m || (o->exit_after_depth && o->depth_dir == NULL)) {

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "run_can.h"
 #include "run_link.h"
 #include "run_ranges.h"
 #include "occmap/occ_port.h"
@@ -106,7 +107,9 @@ static bool sensors_fresh(run_link_t *l, uint64_t now)
     (void)pthread_mutex_lock(&l->st->lock);
     const uint64_t last = l->st->mc.last_integrated_local_us;
     (void)pthread_mutex_unlock(&l->st->lock);
-    return last != 0u && now - last <= (uint64_t)l->opt->sensor_timeout_ms * 1000u;
+    /* last may be after `now` (the mapper integrated since the loop read the clock): fresh,
+     * not a huge unsigned age */
+    return last != 0u && (last >= now || now - last <= (uint64_t)l->opt->sensor_timeout_ms * 1000u);
 }
 
 static void statustext(run_link_t *l, uint8_t severity, const char *text)
@@ -185,6 +188,22 @@ static void list_shift(run_list_t *l, size_t n)
     l->n -= n;
 }
 
+/* --3d: the points sent with this line, "], \"obstacles_3d\": [[id, x, y, z], ...". */
+static void log_3d(FILE *o, const run_3d_t *r)
+{
+    const run_3d_side_t *const side[2] = {&r->above, &r->below};
+    fprintf(o, "], \"obstacles_3d_err\": %d, \"obstacles_3d\": [", (int)r->err);
+    bool first = true;
+    for (unsigned id = 0; id < 2u; id++) {
+        if (side[id]->found) {
+            fprintf(o, "%s[%u, %.9g, %.9g, %.9g]", first ? "" : ", ", id,
+                    (double)side[id]->frd_m.x, (double)side[id]->frd_m.y,
+                    (double)side[id]->frd_m.z);
+            first = false;
+        }
+    }
+}
+
 /* One feed-log line for the OBSTACLE_DISTANCE in `out`, sent at `now` from view version v. */
 static void log_obstacle(run_link_t *l, const uint8_t *out, size_t len, uint64_t now, uint32_t v)
 {
@@ -225,10 +244,50 @@ static void log_obstacle(run_link_t *l, const uint8_t *out, size_t len, uint64_t
     for (unsigned i = 0; i < 72u; i++) {
         fprintf(o, "%s%u", i > 0u ? ", " : "", m.distances[i]);
     }
+    if (l->nearest != NULL) {
+        log_3d(o, &l->last_3d);
+    }
     fprintf(o, "], \"increment_deg\": %.9g, \"angle_offset_deg\": %.9g, \"min_cm\": %u, "
             "\"max_cm\": %u, \"evictions\": %llu}\n", (double)m.increment_f,
             (double)m.angle_offset, m.min_distance, m.max_distance, (unsigned long long)evictions);
     fflush(o);
+}
+
+/* --3d: OBSTACLE_DISTANCE_3D above (id 0) and below (id 1) from the view the OBSTACLE_DISTANCE
+ * in `od` (len bytes) was computed from, at the same pose, stamped with its time (one batch). */
+static void send_3d(run_link_t *l, const occ_map_t *map, uint64_t now, const uint8_t *od,
+                    size_t len)
+{
+    occ_pose_t pose;
+    if (!occ_mav_feed_pose(l->feed, now, &pose)) {
+        return;
+    }
+    const occ_sectors_config_t *const c = &l->feed->cfg.sectors;
+    run_3d_nearest(map, &pose, c, l->nearest, l->nearest_cap, &l->last_3d);
+    occ_mav_parser_t p;
+    occ_mav_frame_t f;
+    occ_mav_obstacle_distance_t m;
+    occ_mav_parser_init(&p);
+    occ_mav_result_t r = OCC_MAV_NONE;
+    for (size_t i = 0; i < len && r == OCC_MAV_NONE; i++) {
+        r = occ_mav_parser_push(&p, od[i], &f);
+    }
+    const uint32_t ms = r == OCC_MAV_OK && occ_mav_decode_obstacle_distance(&f, &m) == OCC_OK
+                        ? (uint32_t)(m.time_usec / 1000u) : (uint32_t)(now / 1000u);
+    const run_3d_side_t *const side[2] = {&l->last_3d.above, &l->last_3d.below};
+    for (uint16_t id = 0; id < 2u; id++) {
+        if (!side[id]->found) {
+            continue;
+        }
+        const occ_mav_obstacle_3d_t o = {ms, 0u, OCC_MAV_FRAME_BODY_FRD, id, side[id]->frd_m.x,
+                                         side[id]->frd_m.y, side[id]->frd_m.z,
+                                         (float)c->min_distance_cm / 100.0f,
+                                         (float)c->max_distance_cm / 100.0f};
+        uint8_t out[OCC_MAV_FRAME_MAX];
+        const size_t n = occ_mav_encode_obstacle_3d(&l->tx, &o, out, sizeof out);
+        send_frame(l, out, n);
+        l->sent_3d += n > 0u;
+    }
 }
 
 /* Whatever the feed has due, from a view of the map (none while the sensors are stale). */
@@ -251,6 +310,9 @@ static void poll_feed(run_link_t *l, uint64_t now, bool map_ok)
         if (l->feed->counters.obstacle_tx != before) {
             l->ever_sent = true;
             note_period(&l->ft, now);
+            if (l->nearest != NULL) {
+                send_3d(l, view.map, now, out, n);
+            }
             if (l->feed_log != NULL) {
                 log_obstacle(l, out, n, now, view.version);
             }
@@ -297,7 +359,8 @@ static void wait_next(run_link_t *l, uint64_t now)
     due = l->next_timesync < due ? l->next_timesync : due;
     due = l->next_stats < due ? l->next_stats : due;
     uint64_t wait = due > now ? due - now : 0u;
-    wait = wait > 20000u ? 20000u : wait;
+    const uint64_t most = l->can != NULL ? 2000u : 20000u; /* the CAN bus is polled */
+    wait = wait > most ? most : wait;
     if (wait > 0u) {
         (void)occ_link_wait(l->link, wait);
     }
@@ -317,6 +380,9 @@ int run_link_loop(run_link_t *l)
         poll_timesync(l, now);
         const bool map_ok = update_status(l, now);
         poll_feed(l, now, map_ok);
+        if (l->can != NULL) {
+            run_can_poll(l, l->can, occ_port_clock_us(), map_ok);
+        }
         log_requests(l);
         if (now >= l->next_stats) {
             l->next_stats += 1000000u;

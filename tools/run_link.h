@@ -6,6 +6,7 @@
 #define OCC_TOOLS_RUN_LINK_H_INCLUDED
 
 #include "run.h"
+#include "run_3d.h"
 #include "occmap/occ_mavlink_ranges.h"
 
 typedef struct {
@@ -15,7 +16,7 @@ typedef struct {
     size_t n, cap;
 } run_feed_timing_t;
 
-typedef struct {
+typedef struct run_link_s {
     const run_opts_t *opt;
     run_state_t *st;
     run_mapguard_t *guard;
@@ -35,6 +36,11 @@ typedef struct {
     run_feed_timing_t ft;
     bool done_seen;                 /* the mapper finished: */
     uint64_t done_sent, done_us;    /* obstacle count and time then (--exit-after-depth) */
+    occ_nearest_entry_t *nearest;   /* --3d: the search's scratch (NULL without --3d) */
+    size_t nearest_cap;
+    run_3d_t last_3d;               /* --3d: what went out with the last OBSTACLE_DISTANCE */
+    uint64_t sent_3d;               /* OBSTACLE_DISTANCE_3D sent */
+    struct run_can_s *can;          /* --can: the DroneCAN node (run_can.h), else NULL */
 } run_link_t;
 
 /* Until stop, --duration or --exit-after-depth. 0, or 1 after a link error. */

@@ -7,6 +7,7 @@
 
 #include "cli.h"
 #include "run.h"
+#include "run_camera.h"
 #include "run_ranges.h"
 #include "occmap/occ_port.h"
 #include "occmap/host/occ_file.h"
@@ -126,7 +127,7 @@ static occ_err_t insert(run_mapper_t *m, occ_map_t *map, frame_buf_t *b,
         src = b->part;
     }
     const occ_depth_image_t img = {src, OCC_DEPTH_U16, b->w, b->h, (size_t)b->w * 2u,
-                                   m->depth->depth_scale_m};
+                                   m->cam->depth_scale_m};
     occ_insert_params_t ip = occ_insert_params_default();
     ip.auto_evict = &m->policy;
     occ_evict_out_t ev;
@@ -134,7 +135,7 @@ static occ_err_t insert(run_mapper_t *m, occ_map_t *map, frame_buf_t *b,
     ev = m->st->evict;
     (void)pthread_mutex_unlock(&m->st->lock);
     ip.auto_evict_state = &ev;
-    const occ_err_t e = occ_map_insert_depth(map, &img, &m->depth->params, map_from_cam, &ip,
+    const occ_err_t e = occ_map_insert_depth(map, &img, &m->cam->params, map_from_cam, &ip,
                                              b->scratch, b->scratch_bytes, r);
     (void)pthread_mutex_lock(&m->st->lock);
     m->st->evict = ev;
@@ -181,17 +182,15 @@ static bool grow(frame_buf_t *b, uint32_t w, uint32_t h, size_t scratch_bytes)
     return b->part != NULL && b->tmp != NULL && b->scratch != NULL;
 }
 
-/* Load the frame's PNG and the scratch for its size. OCC_OK or the reader's error. */
+/* The frame's pixels from the camera and the scratch for its size. OCC_OK or the camera's
+ * error. */
 static occ_err_t load(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
 {
-    char path[4096], msg[256] = "";
     uint32_t w = 0, h = 0;
-    (void)snprintf(path, sizeof path, "%s/%s", m->depth->dir, f->file);
     free(b->px);
     b->px = NULL;
-    const occ_err_t e = occ_depth_read_png_image(path, &b->px, &w, &h, msg, sizeof msg);
+    const occ_err_t e = m->cam->pixels(m->cam->ctx, f, &b->px, &w, &h);
     if (e != OCC_OK) {
-        fprintf(stderr, "occmap run: %s\n", msg);
         return e;
     }
     const occ_insert_params_t ip = occ_insert_params_default();
@@ -281,7 +280,7 @@ static void do_frame(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
         return;
     }
     const uint64_t t0 = occ_port_clock_us(); /* integrate time: the write section, not the PNG */
-    const occ_pose_t map_from_cam = occ_pose_compose(&map_from_body, &m->depth->body_from_camera);
+    const occ_pose_t map_from_cam = occ_pose_compose(&map_from_body, &m->cam->body_from_camera);
     bool partial = false;
     size_t points = 0;
     occ_map_t *const map = run_write_begin(m->guard);
@@ -326,8 +325,9 @@ void *run_mapper_main(void *arg)
     frame_buf_t b;
     memset(&b, 0, sizeof b);
     uint64_t next_save = occ_port_clock_us() + (uint64_t)(m->opt->save_every_s * 1e6f);
-    for (size_t i = 0; m->depth != NULL && i < m->depth->n && !m->st->stop; i++) {
-        do_frame(m, &m->depth->frames[i], &b);
+    run_frame_t f;
+    while (m->cam != NULL && m->cam->next(m->cam->ctx, &m->st->stop, &f)) {
+        do_frame(m, &f, &b);
         run_ranges_service(m);
         maybe_save(m, &next_save);
     }

@@ -17,10 +17,18 @@ bool run_ranges_take(run_state_t *st, run_ranges_t *r, occ_mav_ranges_t *tr,
     if (!is_range_msg(f->msgid)) {
         return false;
     }
-    static run_range_msg_t m; /* link thread only */
-    if (occ_mav_ranges_decode(tr, f, &m.beams) != OCC_OK) {
-        return true; /* counted by the translator */
+    static occ_mav_beams_t b; /* link thread only */
+    if (occ_mav_ranges_decode(tr, f, &b) == OCC_OK) { /* else counted by the translator */
+        run_ranges_queue(st, r, &b, now);
     }
+    return true;
+}
+
+void run_ranges_queue(run_state_t *st, run_ranges_t *r, const occ_mav_beams_t *beams,
+                      uint64_t now)
+{
+    static run_range_msg_t m; /* link thread only */
+    m.beams = *beams;
     (void)pthread_mutex_lock(&st->lock);
     int64_t off = 0;
     const char *src = NULL;
@@ -36,7 +44,6 @@ bool run_ranges_take(run_state_t *st, run_ranges_t *r, occ_mav_ranges_t *tr,
         r->queued++;
     }
     (void)pthread_mutex_unlock(&st->lock);
-    return true;
 }
 
 /* The oldest queued message and its pose once the history reaches past its time; false when

@@ -28,6 +28,11 @@ typedef struct run_ranges_s {
 bool run_ranges_take(run_state_t *st, run_ranges_t *r, occ_mav_ranges_t *tr,
                      const occ_mav_frame_t *f, uint64_t now);
 
+/* Link thread: queue beams (another front end's, e.g. DroneCAN) that arrived at local `now`,
+ * stamped with the autopilot's time then. Takes st->lock. */
+void run_ranges_queue(run_state_t *st, run_ranges_t *r, const occ_mav_beams_t *beams,
+                      uint64_t now);
+
 /* Mapping thread: integrate every queued message whose pose is known (or give it up after
  * --pose-timeout-ms). */
 void run_ranges_service(run_mapper_t *m);

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "run_link.h"
+#include "run_can.h"
 #include "run_ranges.h"
 
 static const char *const drop_names[RUN_DROP_REASONS] = {
@@ -43,6 +44,24 @@ static void print_depth(FILE *f, const run_opts_t *o, const run_depth_t *d)
             (double)b->q.y, (double)b->q.z, o->replay_speed);
 }
 
+/* --3d and --can: on or off, the bus, the node id, each range sensor's mount (body FLU <- sensor:
+ * id, x, y, z, qw, qx, qy, qz, min_m, max_m). */
+static void print_can(FILE *f, const run_opts_t *o)
+{
+    fprintf(f, ", \"obstacle_3d\": %s, \"can\": %s%s%s, \"can_node_id\": %u, \"can_mounts\": [",
+            o->obstacle_3d ? "true" : "false", o->can != NULL ? "\"" : "",
+            o->can != NULL ? o->can : "null", o->can != NULL ? "\"" : "", o->can_node_id);
+    for (size_t i = 0; i < o->n_can_mounts; i++) {
+        const occ_dronecan_range_mount_t *const m = &o->can_mounts[i];
+        const occ_pose_t *const p = &m->body_from_sensor;
+        fprintf(f, "%s[%u, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g]",
+                i > 0u ? ", " : "", m->sensor_id, (double)p->p.x, (double)p->p.y, (double)p->p.z,
+                (double)p->q.w, (double)p->q.x, (double)p->q.y, (double)p->q.z, (double)m->min_m,
+                (double)m->max_m);
+    }
+    fprintf(f, "]");
+}
+
 void run_stats_config(run_link_t *l)
 {
     const run_opts_t *const o = l->opt;
@@ -59,6 +78,7 @@ void run_stats_config(run_link_t *l)
     print_depth(f, o, l->depth);
     fprintf(f, ", ");
     print_sectors(f, &l->feed->cfg.sectors);
+    print_can(f, o);
     fprintf(f, "}}\n");
     fflush(f);
 }
@@ -140,6 +160,13 @@ void run_stats_line(run_link_t *l, uint64_t now, const char *key, bool map_check
     (void)pthread_mutex_unlock(&l->st->lock);
     fprintf(f, ", ");
     print_feed(f, l);
+    if (l->can != NULL) {
+        fprintf(f, ", ");
+        run_can_print(f, l->can);
+    }
+    if (l->nearest != NULL) {
+        fprintf(f, ", \"obstacle_3d_sent\": %llu", (unsigned long long)l->sent_3d);
+    }
     fprintf(f, ", \"link\": {\"rx_bytes\": %llu, \"tx_dropped\": %u, \"bad_crc\": %u}",
             (unsigned long long)l->link->rx_bytes, l->link->tx_dropped,
             l->feed->parser.counters.bad_crc);

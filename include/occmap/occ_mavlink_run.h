@@ -48,6 +48,24 @@ occ_err_t occ_mav_decode_timesync(const occ_mav_frame_t *f, occ_mav_timesync_t *
 size_t occ_mav_encode_statustext(occ_mav_sender_t *tx, uint8_t severity, const char *text,
                                  uint8_t *out, size_t cap);
 
+/* ---- OBSTACLE_DISTANCE_3D (11037): one obstacle point ------------------------------------------
+ * x, y, z: metres from the vehicle in `frame` (OCC_MAV_FRAME_BODY_FRD: x forward, y right,
+ * z down); min/max_distance: the sensor's range in metres. obstacle_id lets the receiver replace
+ * an earlier point of the same id (ArduPilot keeps the latest per id until its timeout). */
+typedef struct {
+    uint32_t time_boot_ms;
+    uint8_t sensor_type;     /* MAV_DISTANCE_SENSOR: 0 laser, 4 unknown */
+    uint8_t frame;           /* MAV_FRAME: 12 = BODY_FRD */
+    uint16_t obstacle_id;
+    float x, y, z;           /* m */
+    float min_distance, max_distance; /* m */
+} occ_mav_obstacle_3d_t;
+
+/* One MAVLink 2 frame into out (cap >= OCC_MAV_FRAME_MAX suffices); length or 0 (NULL, cap too
+ * small, or a coordinate that is not finite: nothing is encoded). O(payload). */
+size_t occ_mav_encode_obstacle_3d(occ_mav_sender_t *tx, const occ_mav_obstacle_3d_t *m,
+                                  uint8_t *out, size_t cap);
+
 /* ---- the clock offset (TIMESYNC) ------------------------------------------------------------
  * A request carries ts1 = local time (ns); the autopilot answers tc1 = its time, ts1 echoed.
  * For a reply received at local time r: rtt = r - ts1, and assuming the two legs take equally
