@@ -46,6 +46,8 @@ void run_args_usage(FILE *f)
         "  --depth-mount x,y,z,roll,pitch,yaw   body FLU <- camera mount, m and deg; 0,0,0,0,0,0:\n"
         "                          at the body origin looking forward (optical x right, y down, z fwd)\n"
         "  --depth-stride 1        every N-th pixel in u and v\n"
+        "  --depth-method projective  projective (occ_integrate.h: by projection, fastest) or\n"
+        "                          simple (ray casting, OctoMap's insertPointCloud exactly)\n"
         "  --depth-max-frames N    replay only the first N frames that have a PNG (default all)\n"
         "  --depth-min-m 0 --depth-max-m 4   range kept; beyond max clears to max (OctoMap's rule)\n"
         "  --mavlink-ranges        also integrate DISTANCE_SENSOR / OBSTACLE_DISTANCE(_3D) from other\n"
@@ -104,6 +106,7 @@ static void defaults(run_opts_t *o)
     o->target_sysid = 1;
     o->target_compid = 1;
     o->stride = 1;
+    o->depth_projective = true;
     o->depth_min_m = 0.0f;
     o->depth_max_m = 4.0f;
     o->res_m = 0.1f;
@@ -202,6 +205,9 @@ static int depth_option(run_opts_t *o, const char *a, const char *v)
         ok = cli_parse_floats(v, o->mount, 6);
     } else if (strcmp(a, "--depth-max-frames") == 0) {
         ok = cli_parse_u32(v, 1, UINT32_MAX, &o->max_frames);
+    } else if (strcmp(a, "--depth-method") == 0) {
+        ok = strcmp(v, "projective") == 0 || strcmp(v, "simple") == 0;
+        o->depth_projective = ok && strcmp(v, "projective") == 0;
     } else if (strcmp(a, "--depth-stride") == 0) {
         ok = cli_parse_u32(v, 1, 64, &o->stride);
     } else if (strcmp(a, "--depth-min-m") == 0) {

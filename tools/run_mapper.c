@@ -114,6 +114,14 @@ typedef struct {
     size_t scratch_bytes;
 } frame_buf_t;
 
+/* The depth integration's parameters: --depth-method (projective by default). */
+static occ_insert_params_t depth_params(const run_mapper_t *m)
+{
+    occ_insert_params_t ip = occ_insert_params_default();
+    ip.method = m->opt->depth_projective ? OCC_INSERT_PROJECTIVE : OCC_INSERT_SIMPLE;
+    return ip;
+}
+
 /* One write call: the frame (or its pixels up to `cutoff`, 0 = all) with automatic eviction. */
 static occ_err_t insert(run_mapper_t *m, occ_map_t *map, frame_buf_t *b,
                         const occ_pose_t *map_from_cam, uint16_t cutoff, occ_depth_result_t *r)
@@ -128,15 +136,24 @@ static occ_err_t insert(run_mapper_t *m, occ_map_t *map, frame_buf_t *b,
     }
     const occ_depth_image_t img = {src, OCC_DEPTH_U16, b->w, b->h, (size_t)b->w * 2u,
                                    m->cam->depth_scale_m};
-    occ_insert_params_t ip = occ_insert_params_default();
+    occ_insert_params_t ip = depth_params(m);
     ip.auto_evict = &m->policy;
     occ_evict_out_t ev;
     (void)pthread_mutex_lock(&m->st->lock);
     ev = m->st->evict;
     (void)pthread_mutex_unlock(&m->st->lock);
     ip.auto_evict_state = &ev;
-    const occ_err_t e = occ_map_insert_depth(map, &img, &m->cam->params, map_from_cam, &ip,
-                                             b->scratch, b->scratch_bytes, r);
+    occ_err_t e = occ_map_insert_depth(map, &img, &m->cam->params, map_from_cam, &ip,
+                                       b->scratch, b->scratch_bytes, r);
+    if (e == OCC_ERR_NOMEM && ip.method == OCC_INSERT_PROJECTIVE) {
+        /* The projective integrator does not evict by itself: make room (a quarter of the
+         * arena, robot-centric) and try once more. */
+        occ_map_stats_t s;
+        occ_map_pool_stats(map, &s);
+        (void)occ_map_evict(map, &map_from_cam->p, &m->policy, s.leaf_capacity / 4u, &ev);
+        e = occ_map_insert_depth(map, &img, &m->cam->params, map_from_cam, &ip, b->scratch,
+                                 b->scratch_bytes, r);
+    }
     (void)pthread_mutex_lock(&m->st->lock);
     m->st->evict = ev;
     (void)pthread_mutex_unlock(&m->st->lock);
@@ -193,7 +210,7 @@ static occ_err_t load(run_mapper_t *m, const run_frame_t *f, frame_buf_t *b)
     if (e != OCC_OK) {
         return e;
     }
-    const occ_insert_params_t ip = occ_insert_params_default();
+    const occ_insert_params_t ip = depth_params(m);
     const size_t need = occ_depth_scratch_bytes(m->guard->map, w, h, m->opt->stride,
                                                 m->opt->depth_max_m, &ip);
     return need > 0u && grow(b, w, h, need) ? OCC_OK : OCC_ERR_NOMEM;

@@ -31,12 +31,13 @@ static void print_depth(FILE *f, const run_opts_t *o, const run_depth_t *d)
     const occ_pinhole_t *const c = &d->params.intrinsics;
     const occ_pose_t *const b = &d->body_from_camera;
     fprintf(f, "\"depth\": {\"dir\": \"%s\", \"frames_listed\": %zu, \"frames_present\": %zu, "
-            "\"stride\": %u, \"method\": \"simple\", \"intrinsics\": [%.9g, %.9g, %.9g, %.9g], "
+            "\"stride\": %u, \"method\": \"%s\", \"intrinsics\": [%.9g, %.9g, %.9g, %.9g], "
             "\"depth_scale_m\": %.9g, \"min_range_m\": %.9g, \"max_range_m\": %.9g, "
             "\"mount\": [%.9g, %.9g, %.9g, %.9g, %.9g, %.9g], "
             "\"body_from_camera\": [%.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g], "
             "\"replay_speed\": %u, \"t_ref_rule\": \"first depth.txt time - 1 s\"}",
-            d->dir, d->n_listed, d->n, d->params.pixel_step, (double)c->fx, (double)c->fy,
+            d->dir, d->n_listed, d->n, d->params.pixel_step,
+            o->depth_projective ? "projective" : "simple", (double)c->fx, (double)c->fy,
             (double)c->cx, (double)c->cy, (double)d->depth_scale_m, (double)d->params.min_range_m,
             (double)d->params.max_range_m, (double)o->mount[0], (double)o->mount[1],
             (double)o->mount[2], (double)o->mount[3], (double)o->mount[4], (double)o->mount[5],
