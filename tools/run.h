@@ -30,7 +30,7 @@ typedef struct {
     float intrinsics[4];             /* fx, fy, cx, cy (pixels) */
     float mount[6];                  /* x, y, z (m), roll, pitch, yaw (deg): body FLU <- mount */
     uint32_t stride;
-    bool depth_projective; /* --depth-method projective (default) or simple */
+    bool depth_projective; /* --depth-method projective, or simple (default) */
     uint32_t max_frames;             /* 0: all */
     float depth_min_m, depth_max_m;
     float res_m;

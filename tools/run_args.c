@@ -46,8 +46,9 @@ void run_args_usage(FILE *f)
         "  --depth-mount x,y,z,roll,pitch,yaw   body FLU <- camera mount, m and deg; 0,0,0,0,0,0:\n"
         "                          at the body origin looking forward (optical x right, y down, z fwd)\n"
         "  --depth-stride 1        every N-th pixel in u and v\n"
-        "  --depth-method projective  projective (occ_integrate.h: by projection, fastest) or\n"
-        "                          simple (ray casting, OctoMap's insertPointCloud exactly)\n"
+        "  --depth-method simple   simple (ray casting: OctoMap's insertPointCloud exactly) or\n"
+        "                          projective (occ_integrate.h: by projection, ~10x faster; its\n"
+        "                          sectors do not yet match OctoMap's in the demo's thin band)\n"
         "  --depth-max-frames N    replay only the first N frames that have a PNG (default all)\n"
         "  --depth-min-m 0 --depth-max-m 4   range kept; beyond max clears to max (OctoMap's rule)\n"
         "  --mavlink-ranges        also integrate DISTANCE_SENSOR / OBSTACLE_DISTANCE(_3D) from other\n"
@@ -106,7 +107,7 @@ static void defaults(run_opts_t *o)
     o->target_sysid = 1;
     o->target_compid = 1;
     o->stride = 1;
-    o->depth_projective = true;
+    o->depth_projective = false;
     o->depth_min_m = 0.0f;
     o->depth_max_m = 4.0f;
     o->res_m = 0.1f;

@@ -114,7 +114,7 @@ typedef struct {
     size_t scratch_bytes;
 } frame_buf_t;
 
-/* The depth integration's parameters: --depth-method (projective by default). */
+/* The depth integration's parameters: --depth-method (simple by default). */
 static occ_insert_params_t depth_params(const run_mapper_t *m)
 {
     occ_insert_params_t ip = occ_insert_params_default();
