@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # occmap - one entry point.
 #   make          build/libocc.a and build/occmap (release, -O2)
 #   make test     install what is missing, then every test under ASan+UBSan, cross, symbol check

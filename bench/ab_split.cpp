@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // ab_split.cpp - the library built from AB_BASE (its symbols renamed old_*, bench/ab_split.mk)
 // against this tree's, in one process, on the same inputs, in interleaved rounds (the order
 // flips every round, so drift and cache warmth hit both alike):

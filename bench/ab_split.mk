@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # ab_split.mk - `make bench-ab-split` (in neither `make test` nor `make bench`): the library as
 # of AB_BASE (default: main before the long functions were split) against this tree's, linked
 # into one program (bench/ab_split.cpp) with the old library's symbols renamed old_*, run in

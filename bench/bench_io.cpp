@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // bench_io.cpp - load/save times of geb079.bt (and the other formats) for occmap against
 // OctoMap's readBinary/writeBinary in the same run; median of N runs; bytes per file.
 #include <octomap/OcTree.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // insert.cpp - point-cloud integration: occmap against OctoMap 1.9.7 in the same run.
 // Prints a table (median ms per scan of >= 5 repetitions, ratio to the matching OctoMap call,
 // memory vs OctoMap's memoryUsage(), whether the maps are equal) and writes build/bench/insert.json.

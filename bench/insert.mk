@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # insert.mk - `make bench` step: point-cloud integration against OctoMap (bench/insert.cpp).
 BENCH_INSERT_PORT := port/posix/scan_xyz.c port/posix/scan_graph.c port/posix/depth_png.c
 $(BUILD)/bench/insert: bench/insert.cpp $(BENCH_INSERT_PORT:%.c=$(BUILD)/relhost/%.o) $(BUILD)/libocc.a

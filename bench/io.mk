@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # bench/io.mk - file load/save times for geb079.bt against OctoMap's readBinary/writeBinary in
 # the same run (median of 7), plus .ot/.occ times and bytes per file. OctoMap's progress lines
 # on stderr are filtered out.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // bench/memory.cpp - memory per stored voxel: occmap vs OctoMap for the same content.
 //
 // Content 1: the endpoints of OctoMap's real scan.dat marked occupied (updateNode(key, true) in

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # bench/memory.mk - bytes per stored voxel, occmap vs OctoMap's memoryUsage(), on the real scan.
 BENCH_MEMORY_BIN := $(BUILD)/bench/memory
 

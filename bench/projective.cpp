@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // projective.cpp - OCC_INSERT_PROJECTIVE against OctoMap's insertPointCloud and our SUPER_RAYS
 // in one process (issue 19): the 10 TUM pioneer frames at 0.05 m, every valid pixel, the same
 // poses; interleaved repetitions (OctoMap, SUPER_RAYS, PROJECTIVE per round), medians and

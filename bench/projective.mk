@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # projective.mk - `make bench` step: OCC_INSERT_PROJECTIVE against OctoMap and SUPER_RAYS on the
 # TUM depth frames (bench/projective.cpp, issue 19). Skips (prints SKIP) without ../shared.
 BENCH_PROJ_PORT := port/posix/scan_xyz.c port/posix/scan_graph.c port/posix/depth_png.c \

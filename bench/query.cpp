@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // query.cpp - queries: occmap against OctoMap 1.9.7 in the same run, the way OctoMap users do it
 // (search() per point, the leaf iterator over a bounding box, castRay).
 // Maps: geb079.bt (OctoMap's example) and the maps in ../shared/data/maps/ when present, each

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # query.mk - `make bench` step: collision checks, ray casts, line of sight and information gain
 # against OctoMap in the same run (bench/query.cpp) on geb079.bt, ../shared/data/maps/* and maps
 # built from the real scans by `occmap build` (5 cm, written as .bt so that OctoMap reads the same

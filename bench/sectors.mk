@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # sectors.mk - cost of one 72-sector update (src/sectors/sectors.c) on OctoMap's geb079.bt:
 # wall-clock median over corridor poses, and callgrind instructions per update.
 SECT_BENCH := $(BUILD)/bench/sectors_bench

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* sectors_bench.c - the cost of one 72-sector update on a real map (OctoMap's geb079.bt).
  * usage: sectors_bench MAP.bt [--callgrind]
  * Poses walk the corridor (x -5..26 m) with a turning heading. Per pose the update runs 7 times

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * shared.c - `make bench` step for the shared map (issue 20, occ_shared.h). The writer replays
  * the real TUM frames and scan.dat (tests/support/shared_replay.h: eviction in a small arena)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # shared.mk - `make bench` step for the shared map (issue 20): writer throughput plain / shared /
 # shared with 4 readers, interleaved, and reader latency (bench/shared.c).
 SHARED_BENCH := $(BUILD)/bench/shared

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # firmware.mk - the firmware build (issue 8), on top of `make cross`:
 #   - port/baremetal (weak CAN hooks, the example main) for Cortex-M4F and Cortex-M0+;
 #   - build/fw/example_m4.elf: the example image (startup, linker script, static arena, test cloud,

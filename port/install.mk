@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # install.mk - `make install PREFIX=/usr/local DESTDIR=` (issue 23): for hosts (a ROS 2 node, a
 # companion-computer service). Firmware does not install: it includes src/sources.mk
 # (port/baremetal/README).

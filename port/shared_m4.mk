@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # shared_m4.mk - the shared map (issue 20) on an emulated Cortex-M4F: a writer in thread mode and
 # a reader in the SysTick interrupt preempting it at pseudo-random points
 # (port/baremetal/shared_isr_main.c, its own vector table). The image's exit status is the number

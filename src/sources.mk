@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # The library's file lists. A firmware Makefile sets OCC_ROOT and includes this file.
 OCC_ROOT ?= .
 # One folder per concern (README "Architecture"); dependencies point one way:

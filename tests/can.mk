@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # can.mk - the DroneCAN front end's test steps (issue 8):
 #   test-can-golden  pydronecan encodes thousands of field values; ours must equal byte for byte,
 #                    and pydronecan must decode ours (tests/can/golden.py + golden_dump.c)

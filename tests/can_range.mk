@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # can_range.mk - the DroneCAN range-sensor input's peer data (issue 18): pydronecan builds
 # uavcan.equipment.range_sensor.Measurement transfers (tests/can/range_frames.py) that
 # tests/test_dronecan_range.c reassembles and decodes (it skips, counted, without the file).

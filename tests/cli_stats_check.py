@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Checks `occmap stats --json` on the real scan against an independent computation in Python:
 distinct endpoint voxels (OctoMap's key rule for OcTree(res) with the decimal res, double
 arithmetic), the pruned leaf count, the inner node count, the occupied volume and the bounding

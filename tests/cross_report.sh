@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Size of every cross-compiled core object and the worst stack frame, per target; then the worst
 # call-chain stack of every public entry point against port/baremetal/stack_budgets.txt (fails
 # the build when one is over; tests/stack_budget.py).

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """deps_calls.py - the module graph of src/ from the calls the compiled objects make.
 
 deps_check.py reads #include lines; a call can still go the wrong way through a prototype

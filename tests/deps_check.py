@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """deps_check.py - the module graph of src/ from its #include lines, and the allowed direction.
 
 Every src/<module>/*.c|h is read; each #include "..." is resolved the way the compiler does it

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # depth.mk - `occmap build --depth-dir` on the two TUM layouts (issue 18): the groundtruth
 # sequence (tum_fr1_rpy: 500 frames, 4 in the motion-capture gap dropped, freiburg1 intrinsics)
 # and the association layout (pioneer_slam2, nothing dropped); a sequence dir without its

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/foundation.mk - extras of the foundation tests (issue 3):
 #  * build/data/foundation/scan.dat: OctoMap's real scan for test_tree_octomap (its own copy, so
 #    this fragment does not depend on another fragment's rule; the test prefers build/data/scan.dat).

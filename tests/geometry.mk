@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # geometry.mk - test_geometry.c a second time in the firmware's float key arithmetic
 # (-DOCC_RAY_DOUBLE=0, issue 16 section 1): every occmap call must still name the same voxel on
 # border points (keys may differ from OctoMap's only within ~1e-7 of a border). Reuses the

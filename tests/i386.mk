@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/i386.mk - every module's unit tests with a 32-bit size_t (issue 16, section 2).
 # The library, the test support, the POSIX port and every tests/test_*.c are built again with
 # -m32 into $(BUILD)/asan32 with the same ASan + UBSan flags as build/asan, and each binary runs in

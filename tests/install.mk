@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # install.mk - `make install` into a staging prefix and a consumer built against it with
 # pkg-config and with CMake (tests/install_consumer/run.sh). Seconds.
 APT_PKGS += pkg-config cmake

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # integrate.mk - point-cloud integration: test data and the OctoMap comparison steps.
 # scan.dat (OctoMap's example laser scan) is decompressed once for tests, tools and the bench.
 SCAN_DAT_BZ2 := /usr/share/doc/liboctomap-dev/examples/data/scan.dat.bz2

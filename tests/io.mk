@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/io.mk - the files issue: OctoMap .bt/.ot and snapshot tests, fuzzing, float build.
 APT_PKGS += libclang-rt-14-dev
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # io_tools.sh BUILD - `occmap convert` against OctoMap's own command-line tools (octomap-tools):
 #  geb079.bt -> .occ -> .bt is byte-identical to the original; occmap's .ot converted back by
 #  OctoMap's convert_octree is byte-identical too; compare_octrees finds occmap's .ot equal to

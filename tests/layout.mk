@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # layout.mk - the dependency checks (issue 17).
 # deps-check: every #include of src/<module>/*.c|h resolved and tested against the one allowed
 # direction geom <- core <- {integrate, query, io, evict} <- front ends (public headers only);

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # lint.mk - `make lint`: cppcheck and gcc -fanalyzer over src/ (issue 17), a step of `make test`.
 # Clean means no report at all: a real finding is fixed; a false positive is silenced only at its
 # site, with the reason beside it (cppcheck: a `cppcheck-suppress id ; why` comment; -fanalyzer:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # mavlink.mk - the MAVLink front end: generated C headers, tests, fuzzing, the demo.
 #
 # The MAVLink C headers are generated at build time by pymavlink's mavgen (pinned in the venv)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # mavranges.mk - MAVLink range messages (DISTANCE_SENSOR, OBSTACLE_DISTANCE, _3D) as beams: the
 # frames pymavlink builds for test_mavlink_ranges.c.
 $(MAV_REF)/ranges_frames.bin: tools/mav_ranges_golden.py $(BUILD)/.deps-ok

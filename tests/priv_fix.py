@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """priv_fix.py - after fields of a public instance struct move into its internal `priv` member
 (issue 17, Headers: "nothing a caller must never touch looks public"), rewrite every use the
 compiler rejects: `m->root_child` -> `m->priv.root_child`.

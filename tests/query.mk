@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/query.mk - the query tests (issue 5): test_query, test_collide, test_castray are picked up
 # by the top Makefile as tests/test_*.c. Their brute-force oracle (tests/support/oracle_query.cpp)
 # runs millions of cell tests: it is in ORACLE_SRC (top Makefile), built with ORACLE_FLAGS.

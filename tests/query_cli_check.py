@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """query_cli_check.py - `occmap query` on geb079.bt: every answer is valid JSON with the documented
 keys; one query gives the same object alone and inside --batch; the unknown policy behaves as
 documented (far outside the scanned space: unknown voxels, so unsafe by default and safe with

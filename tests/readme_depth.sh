@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The README's "Depth camera" snippet must compile under the core's warnings and work: extract the
 # first ```c block after "### Depth camera", put its statics at file scope and the rest in main()
 # after a map, a pose history (body at the origin, level, looking east) and a frame (a wall

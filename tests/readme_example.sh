@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The README's embedding example must compile under the core's warnings and run: extract the
 # first ```c block after "## Embedding", wrap its statements in main(), build against libocc.a.
 set -euo pipefail

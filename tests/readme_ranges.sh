@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The README's "Rangefinder" snippet must compile under the core's warnings and work: extract the
 # first ```c block after "### Rangefinder", put its statics at file scope and the rest in main()
 # after a map and a pose history (body 1 m above the origin, level), with a 2.05 m reading and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # readme_snippet.sh - sourced by the README snippet checks (readme_depth.sh, readme_ranges.sh).
 # readme_snippet HEADING OUTFILE: the first ```c block after the line "### HEADING" of README.md
 # into OUTFILE; fails when there is none or when it has 15 lines or more (the README promises

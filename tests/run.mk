@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # run.mk - `occmap run`, the onboard loop (issue 21), against a pymavlink autopilot stand-in over
 # UDP loopback on the real TUM fr1_rpy sequence (tests/run_peer.py): SET_MESSAGE_INTERVAL
 # retries and the pose filter, frames without a pose dropped (the pose history's rule) and the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Runs every CMocka binary and every extra test step, counts results, prints one summary line
 # "N passed, N failed, N skipped" and exits non-zero on any failure.
 #

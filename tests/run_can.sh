@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Run tests/run_can_peer.py (occmap run --can on pydronecan's mcast: bus) inside a network
 # namespace made for the test with only loopback (multicast routed to lo): no packet leaves the
 # machine. The pattern of tests/can/mcast_netns.sh (no vcan here: the kernel module may be absent).

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """run_can_peer.py OCCMAP WALL_MAP OUTDIR - `occmap run --can` (issue 21) on pydronecan's mcast:
 bus, with a pymavlink autopilot stand-in on UDP loopback (tests/run_peer.py's Peer) holding the
 vehicle at the origin of the wall map (tests/can/make_wall_map.c: free disc of 5 m, a wall 3 m

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """run_peer.py --occmap BIN --data DIR [--test NAME|all] [--out DIR]
 
 `occmap run` (issue 21) over UDP loopback against a pymavlink autopilot stand-in (listening like

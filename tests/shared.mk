@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # shared.mk - one writer, many readers (issue 20). tests/test_shared.c and
 # tests/test_shared_stress.c run as ordinary CMocka binaries (ASan+UBSan); this fragment adds
 # the stress test under ThreadSanitizer (its own build of the library in build/tsan/: 0 races,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # soak.mk - the long-flight soak (issue 9): `make soak` replays an hour of real sensor data
 # at 10 Hz in a fixed arena (robot-centric and coarsening eviction) and measures the
 # instructions per insert with callgrind; `make test` runs a one-minute version under ASan.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """stack_budget.py - worst call-chain stack of every public entry point on the cross targets.
 
 Sources: GCC 12's -fcallgraph-info=su (.ci files: one node per function with its -fstack-usage

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """stack_budget_check.py - tests/stack_budget.py against hand-made call graphs (GCC 12's .ci
 format) with hand-computed answers: a chain sum through a static helper and a library call
 (memset, whose frame comes from newlib's disassembly), an indirect call listed with '+', an

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """stack_measured_check.py - the stack an entry point really used on the emulated target
 (port/baremetal/m0_selftest.c paints the stack, makes the call and finds the lowest word
 written; lines "stack-measured TARGET NAME WRAPPER BYTES") against the static call-chain bound of

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/symbols.mk - the export check (issue 17, "Symbols"): libocc.a exports the public API
 # (declared under include/occmap/) and, besides it, only occi_ internals; every public declaration
 # is defined in the library or, for host-only APIs, in port/. The self-test first proves the check

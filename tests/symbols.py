@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """The public symbol contract of libocc.a (issue 17, "Symbols").
 
 The library exports the documented API (every function and object declared in a header under

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The core must not call the heap, stdio or process exit: nm -u of every core object. Nor the
 # test build's assert hook: release and cross objects have OCC_ASSERT compiled out.
 set -u

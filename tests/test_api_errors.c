@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_api_errors.c - caller mistakes: NaN/Inf/out-of-volume coordinates and keys, bad configs,
  * NULL pointers, malformed batches. Each must return its documented code and leave the map

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_asserts.c - OCC_ASSERT is live in the test build of the core (ASAN_CFLAGS maps it to
  * CMocka's mock_assert through tests/support/occ_test_config.h). Each test damages a small map

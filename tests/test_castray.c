@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_castray.c - occ_cast_ray against OctoMap's own castRay on geb079.bt (loaded through
  * liboctomap and copied leaf by leaf into occmap with occ_map_set_key): >= 10,000 random rays,

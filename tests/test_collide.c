@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_collide.c - "is this volume safe?" for spheres, boxes, oriented boxes, capsules, frusta and
  * segments against the brute-force oracle (every voxel the shape touches, Eigen geometry), with

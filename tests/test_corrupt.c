@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_corrupt.c - damage the pools and the tree on purpose (through tree_internal.h) and prove
  * occ_map_check() returns OCC_ERR_CORRUPT for each kind of damage, OCC_OK on the undamaged map,

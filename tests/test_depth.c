@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_depth.c - occ_map_insert_depth() on synthetic frames: an 8x8 time-of-flight frame worked
  * out by hand (uint16 and float), rays that overflow float, every bad input (error, map
  * unchanged), pools short at every small arena size, the scratch formula on a static buffer.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_depth_tum.c - occ_map_insert_depth() on the real TUM frames, voxel for voxel against
  * back-projection + occ_map_insert_cloud() (SIMPLE, DISCRETE, SUPER_RAYS) and against OctoMap's
  * insertPointCloud: the pioneer_slam2 frames with their association poses, and tum_fr1_rpy with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_dronecan.c - DroneCAN transfer layer, messages and CAN-over-UDP packets against
  * hand-checked bytes (the node: test_dronecan_node.c). */
 #include <stdarg.h>

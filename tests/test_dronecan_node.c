@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_dronecan_node.c - the DroneCAN node (occ_dronecan_*): init, transfer ids and toggles,
  * a full queue, GetNodeInfo, the publication schedule, sectors, and the node fed from a real
  * map. The transfer layer and messages: test_dronecan.c. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_dronecan_range.c - uavcan.equipment.range_sensor.Measurement in: transfers built by
  * pydronecan (tests/can/range_frames.py -> build/can/range_frames.txt) reassembled and decoded
  * field for field, reading types to beams through the mount table, broken transfers dropped

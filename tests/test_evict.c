@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_evict.c - eviction (robot-centric window and coarsening) against a shadow model.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_evict_auto.c - eviction in automatic mode (issue 9):
  *  - Automatic mode (need -> evict_for -> observe, in Morton chunks) along a straight path in

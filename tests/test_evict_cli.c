@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_evict_cli.c - the `occmap build --arena-bytes/--evict/--keep-radius` helper
  * (tools/evict_cli.c, compiled in): flag parsing and errors, the JSON members, and inserting

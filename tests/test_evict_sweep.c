@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_evict_sweep.c - how an eviction sweep carries over between calls (occ_evict.h, "Slices"):
  * a budgeted call that stops early says so (resumable, sweep_active) and the next continues;
  * the call that ends the sweep says exhausted and no sweep is left; and a call without a budget

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_failclosed.c - issue 16, "fail closed": a caller that ignores an error code reads
  * "unsafe", never "clear". Every collision entry point answers unsafe on bad input; the obstacle

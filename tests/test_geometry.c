@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_geometry.c - one voxel geometry for every call (issue 16, section 1).
  *

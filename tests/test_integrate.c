@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_integrate.c - occ_map_insert_cloud() against OctoMap's insertPointCloud, voxel for voxel,
  * on real data (scan.dat, spherical_scan.graph, TUM depth frames), plus the error paths. */
 #include <stdarg.h>

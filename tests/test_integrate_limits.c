@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_integrate_limits.c - occ_map_insert_cloud() at its limits: bad points, a full arena
  * (nothing changes), the scratch bound (formula, compile-time macro, 32-bit size_t, what a call
  * writes) and automatic eviction before OCC_ERR_NOMEM. */

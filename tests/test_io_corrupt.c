@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_io_corrupt.c - .bt / .ot input occmap must refuse: every kind of corrupt input (truncated,
  * wrong magic or id, bad header fields, impossible trees, NaN values, byte flips) and a map that

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_io_header.c - the OctoMap text header as AbstractOcTree::readHeader reads it, entry by
  * entry, through occ_io_probe on a real tree's data behind hand-written headers: numbers the way
  * istream >> double reads them (signs, exponents either way, more digits than a float holds),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_io_octomap.c - .bt / .ot against OctoMap 1.9.7 as the oracle: OctoMap writes, occmap
  * reads and writes again, bytes identical (or, where OctoMap's file is not canonical, the trees

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_io_snapshot.c - the native snapshot (.occ): exact round trips (every node, every pool
  * counter), CRC-32 against zlib's check value, every kind of corruption refused with the map

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_mavlink.c - the MAVLink parser, encoders and decoders, and the serial link (the feed state
  * machine: test_mavlink_feed.c).
  * References: frames pymavlink encoded (build/mavlink/py_frames.*, tools/mav_golden.py), what

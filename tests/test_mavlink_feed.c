@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_mavlink_feed.c - the MAVLink feed state machine (occ_mav_feed_*): what it sends for a
  * pose and a map, as ArduPilot reads it (faces, arming, unknown space), whose poses it takes and
  * the stream requests it makes. The wire itself: test_mavlink.c. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_mavlink_pose.c - the MAVLink feed's pose is the library's occ_pose_t: LOCAL_POSITION_NED
  * with ATTITUDE (roll, pitch, yaw) or ATTITUDE_QUATERNION gives occ_pose_from_ned() of the
  * autopilot's NED pose (ENU map) or the NED <- FRD pose itself (NED map); an attitude with NaN

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_mavlink_poses.c - which pose messages the MAVLink feed takes, message by message: each of
  * LOCAL_POSITION_NED, ATTITUDE, ATTITUDE_QUATERNION and ODOMETRY sets exactly its part of the
  * pose (read back through occ_mav_feed_pose in a NED map frame) and its counters; a message that

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_mavlink_ranges.c - MAVLink range messages as beams (occ_mavlink_ranges.h).
  * Frames are built by pymavlink (tools/mav_ranges_golden.py -> build/mavlink/ranges_frames.*),
  * decoded by our parser and translator; each case's beams were worked out by hand: body FLU for

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_morton.c - Morton codes against a brute-force bit-by-bit interleave: edge values, single
  * bits, random keys and codes, round trips, and the octree properties the tree relies on.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_pool.c - the block pools: alloc/free/stats through the internal pool calls and the map
  * API, double free and foreign indices rejected, arena sizing helpers, and exhaustion at every

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_pose.c - the pose algebra (occ_pose.h, src/sensors/pose.c) against hand-computed values:
  * compose / invert / apply / rotate, Euler angles (gimbal lock, yaw wrap), axis-angle, the
  * refusals, NED/FRD <-> ENU/FLU (where body forward / left / up go in the map), the yaw of a

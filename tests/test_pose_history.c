@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_pose_history.c - the timed pose history (occ_pose.h, src/sensors/pose_history.c) against
  * hand-computed values: init refusals, pushes out of order / duplicate / bad (counted, the
  * history unchanged), the ring dropping its oldest, exact sample times, interpolation between

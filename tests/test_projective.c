@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_projective.c - OCC_INSERT_PROJECTIVE (occ_map_insert_projective and
  * occ_map_insert_depth with that method): voxel for voxel against the brute-force oracle of the
  * header's rule (tests/support/projective_ref.c) on the real TUM pioneer frames at 0.2, 0.1 and

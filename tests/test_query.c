@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_query.c - the volume iterator, voxel counts, nearest-first search and information gain
  * against brute-force references (tests/support/oracle_query.cpp: Eigen geometry, every cell

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_ranges.c - occ_map_insert_ranges() (range beams) and occ_map_insert_rays() (per-point hit
  * flags): hand-computed voxels, insert_cloud where the two coincide, brute force over the exact
  * ray keys for mixed scans and every method, OctoMap's insertRay(), cones, the scratch formula

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_raycast.c - occ_ray_keys() against OctoMap's computeRayKeys, key by key. */
 #include <stdarg.h>
 #include <stddef.h>

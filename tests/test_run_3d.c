@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_run_3d.c - `occmap run --3d`'s search (tools/run_3d.c, compiled in) against brute force:
  * random occupied voxels (some in 2x2x2 blocks the map prunes into bigger nodes), random poses

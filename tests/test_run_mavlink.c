@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_run_mavlink.c - the MAVLink parts of `occmap run` (occ_mavlink_run.h): the TIMESYNC
  * offset against hand-computed values (min-RTT sample of the window, refusals), the codecs
  * through the parser, and the pose receiver's filter (another system or component ignored,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_scan_readers.c - the ScanGraph and depth-PNG readers on the real files and on corrupted
  * copies (truncated at every kind of field, bad counts, bad ids, trailing bytes, not a PNG). */
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_sectors.c - occ_sectors_compute() against the brute-force reference of
  * tests/support/sectors_ref.c on random maps and poses; plus hand-computed cases (behind = +-180
  * degrees, yaw wrap, the vehicle in unknown space, the edges of the map volume) and the NED map

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_sectors_floor.c - occ_sectors_compute() on a room with a floor (the ground rule, the band
  * below and above) against the reference of tests/support/sectors_ref.c and hand-computed
  * values; every error fails closed; the argument checks of occ_sectors_config_check(). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_sectors_pose.c - the sectors take the library's one pose type (occ_pose_t):
  *  - a rolled and pitched vehicle gets exactly the sectors of the level vehicle with the same
  *    heading (the band is about the vehicle's z, the sectors are horizontal);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_sectors_stack.c - the sector walk's full-stack path. This binary compiles sectors.c with
  * a walk limit of 9 entries (instead of OCC_SECTORS_STACK, which the depth bound makes
  * unreachable), so a map with detail near the vehicle overflows it: the call must return

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_shared.c - one writer, many readers (issue 20, occ_shared.h), single-threaded: versions
  * (a view keeps its version's answers after later writes; a new view has the new ones), every

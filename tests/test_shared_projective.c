@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_shared_projective.c - a depth frame by projection on a shared map is ONE version: a view
  * opened before the frame sees none of it, a view opened after sees all of it (the writes of the
  * projective integrator, coarse nodes then voxels, are one write section). */

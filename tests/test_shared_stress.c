@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_shared_stress.c - one writer, four readers on one shared map (issue 20). The writer
  * integrates the real TUM frames and scan.dat in a loop in a small arena (eviction frees and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_stale_handles.c - issue 16, "fail closed", stale handles: handles that keep block indices
  * between calls (lookup cursor, volume iterator, nearest iterator, walk, node handle) answer

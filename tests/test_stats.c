@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_stats.c - occ_map_stats() (src/core/stats.c) against OctoMap's own numbers and against
  * values worked out by hand:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_tlog_ranges.c - the real ArduSub log (../shared/data/mavlink, 919 downward sonar
  * readings) through the tlog reader, the translator, the log's poses and
  * occ_map_insert_ranges(), against what pymavlink alone says about each reading

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* test_tlog_reader.c - the .tlog reader (port/posix/tlog.c): a hand-built log (big-endian
  * stamps, a corrupt frame, a truncated tail) and the real ArduSub log against pymavlink's
  * counts (build/mavlink/tlog_ref.txt, tools/mav_tlog_ref.py). */

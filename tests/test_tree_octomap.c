@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_tree_octomap.c - occmap against OctoMap itself (Debian's liboctomap through
  * tests/support/oracle_tree.cpp): the same voxel updates (OcTree::updateNode(key, occupied),

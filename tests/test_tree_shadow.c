@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * test_tree_shadow.c - the tree against a dense shadow grid (tests/support/shadow_grid.c).
  * Tens of thousands of random writes (observe hit/miss, update by arbitrary log-odds, set at

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # test-view (tools/view.mk): `occmap view` on a real map, opened in headless Chromium offline.
 #  - the page is one file: no src/href to anything outside it, and Chromium runs with every host
 #    name unresolvable;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """view_png.py - is a screenshot of `occmap view` a drawing of a map? (tests/view_check.sh)
 
 Decodes the PNG with the standard library only (8-bit RGB/RGBA, not interlaced: what Chromium

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """autopilot_standin.py - plays ArduPilot on a UDP link for `occmap run` (make demo).
 
 Listens like SITL's udpin and, as a companion port of ArduPilot does:

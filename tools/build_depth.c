@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* build_depth.c - `occmap build --depth-dir DIR`: picks the TUM layout and the camera, reads the
  * frames (port/posix), reports the frames dropped for want of a pose. */
 #include <string.h>

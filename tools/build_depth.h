@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* build_depth.h - `occmap build --depth-dir DIR`: the two TUM RGB-D directory layouts. */
 #ifndef OCC_TOOLS_BUILD_DEPTH_H_INCLUDED
 #define OCC_TOOLS_BUILD_DEPTH_H_INCLUDED

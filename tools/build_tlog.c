@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* build_tlog.c - `occmap build --tlog FILE`: DISTANCE_SENSOR / OBSTACLE_DISTANCE(_3D) readings
  * of a telemetry log into the map with the log's poses (port/posix/tlog_ranges.c). */
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* build_tlog.h - `occmap build --tlog FILE` (build_tlog.c): the range readings of a MAVLink
  * telemetry log into the map, with the log's own poses. */
 #ifndef OCC_TOOLS_BUILD_TLOG_H_INCLUDED

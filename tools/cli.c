@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cli.c - helpers shared by the subcommands: argument parsing and statistics output. */
 #include <errno.h>
 #include <math.h>

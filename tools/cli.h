@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cli.h - what the occmap subcommands share: the command table, argument helpers, JSON output. */
 #ifndef OCC_TOOLS_CLI_H_INCLUDED
 #define OCC_TOOLS_CLI_H_INCLUDED

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_build.c - `occmap build`: integrate recorded scans (scan.dat text, ScanGraph binary, TUM
  * depth frames) with one of the integrators and print the map statistics; -o saves the map. */
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_can_feed.c - occmap can-feed: a DroneCAN node that publishes a map's obstacles.
  * The options it shares with feed (--map, --map-frame, --min-m, --max-m, --rate-hz,
  * --duration-s) and the MAVLink link, map and stop signal: feed_args.c. */

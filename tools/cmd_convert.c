@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_convert.c - `occmap convert IN OUT`: between .bt, .ot and .occ (IN by content, OUT by
  * extension), saved atomically. */
 #include <stdlib.h>

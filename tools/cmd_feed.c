@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_feed.c - occmap feed: OBSTACLE_DISTANCE over MAVLink from a map and the autopilot's pose.
  * The options it shares with can-feed (--map, --map-frame, --min-m, --max-m, --rate-hz,
  * --duration-s) and the link, map and stop signal: feed_args.c. */

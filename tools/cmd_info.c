@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_info.c - `occmap info MAP [--json]`: the file's format, header and reader warnings, and
  * the map statistics of the loaded map. */
 #include <stdlib.h>

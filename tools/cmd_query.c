@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_query.c - occmap query: collision checks, ray casts and obstacle distances on a map file,
  * one query or a batch. */
 #include <math.h>

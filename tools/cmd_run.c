@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_run.c - `occmap run`, the onboard loop (issue 21): the map, the threads, the end.
  * Options: run_args.c; the depth directory: run_depth.c; the mapping thread: run_mapper.c;
  * the link, feed and feed log: run_link.c; telemetry: run_stats.c; map access: run_mapguard.c. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_stats.c - `occmap stats --scan FILE --res R [--json]`: mark a scan's endpoints occupied
  * (one hit per distinct voxel, no ray clearing) and print the map statistics. */
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* cmd_view.c - `occmap view MAP -o map.html [--assets DIR] [--title T]`: the map as one
  * self-contained HTML page (view_page.c) that opens offline in a browser. */
 #include <stdlib.h>

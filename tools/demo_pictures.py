@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """demo_pictures.py - the loop demo's pictures (PNG written by hand, no plotting library).
 
 loop_map.png: one panel per chosen moment (left to right, top to bottom): the OctoMap reference

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // demo_ref.cpp - the loop demo's independent checker (make demo): OctoMap rebuilds the map of
 // `occmap run` from its feed log and computes every OBSTACLE_DISTANCE's 72 sectors itself.
 //

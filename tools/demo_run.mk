@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # demo_run.mk - `make demo`: the onboard loop (`occmap run`, issue 21) on real data, checked by OctoMap.
 #
 # tools/demo_run.py starts tools/autopilot_standin.py (pymavlink playing ArduPilot on UDP loopback,

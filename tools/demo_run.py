@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """demo_run.py - `make demo`: the onboard loop (`occmap run`) on real data, checked by OctoMap.
 
   1. tools/autopilot_standin.py plays ArduPilot on UDP loopback (HEARTBEAT, TIMESYNC, streams

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* evict_cli.c - `occmap build` flags for a fixed arena with eviction, and their JSON. */
 #include <errno.h>
 #include <math.h>

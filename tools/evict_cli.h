@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * evict_cli.h - the `occmap build` flags for a fixed arena with eviction (issue 9):
  *   --arena-bytes N          build inside one arena of exactly N bytes (K/M/G suffixes), allocated

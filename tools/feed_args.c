@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* feed_args.c - the argument loop, options, link, map and stop signal of the feed commands. */
 #include <math.h>
 #include <signal.h>

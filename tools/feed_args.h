@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* feed_args.h - what the two feed commands share, `occmap feed` (MAVLink, cmd_feed.c) and
  * `occmap can-feed` (DroneCAN, cmd_can_feed.c): the argument loop and the options both take,
  * the MAVLink link they open, the map they load, the stop signal and the end of the run.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_check_c_frames.py FRAMES.bin VALUES.txt - pymavlink decodes the frames our C encoder wrote
 (tests/mavlink/mav_dump.c) and every field must equal the value the C side meant to send."""
 import os

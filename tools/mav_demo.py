@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_demo.py --occmap BIN --map MAP.bt --out DIR   (make demo)
 
 A replayed flight through a real map. pymavlink plays the autopilot (listening like SITL's

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_feed_peer.py --occmap BIN [--map MAP] --test
 
 End-to-end test of `occmap feed` over UDP loopback with pymavlink playing ArduPilot (listening

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_golden.py FRAMES.bin VALUES.txt - pose and sensor frames encoded by pymavlink, for the C
 decoder test (test_mavlink.c). Each frame's expected values go on one line of VALUES.txt:
 "MSGID VERSION SYSID COMPID SEQ SIGNED field...", floats with 9 significant digits."""

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_ranges_golden.py FRAMES.bin LABELS.txt - range messages encoded by pymavlink (the real
 peer) for test_mavlink_ranges.c: DISTANCE_SENSOR in every orientation case, OBSTACLE_DISTANCE in
 body and north frames, OBSTACLE_DISTANCE_3D, malformed ones and our own echoes. One label per

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_tlog_ref.py TLOG OUT - what pymavlink reads in a telemetry log, for test_mavlink.c.
 
 Writes one line per message id ("count MSGID OK BAD_CRC"), one line per DISTANCE_SENSOR frame

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_tlog_sonar_ref.py TLOG OUT - where each DISTANCE_SENSOR reading of a telemetry log says the
 surface is, worked out with pymavlink alone, for test_tlog_ranges.c (the C reader, translator
 and pose history must put the beams there).

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mav_tlog_synth.py OUT.tlog - a small telemetry log of pymavlink-packed frames (8-byte
 big-endian stamps; read back by pymavlink's tlog reader before it is kept) for test_tlog_ranges.c: an autopilot (1/1) at LOCAL_POSITION_NED
 (2.05, 1.05, -3.05) heading east, level, ATTITUDE every 100 ms for 2 s; a DISTANCE_SENSOR before the

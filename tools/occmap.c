@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* occmap - the command-line tool: dispatches to one file per subcommand. */
 #include <stdio.h>
 #include <string.h>

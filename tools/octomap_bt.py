@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """octomap_bt.py - a small independent reader of OctoMap's compact .bt files (pure Python), for
 the demo's cross-check of occmap's sector distances. Not used by occmap itself.
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run.h - what the parts of `occmap run` share (issue 21): the options, the state the link
  * thread (main: MAVLink in and out, telemetry) and the mapping thread (sensor replay, the map's
  * one writer) exchange, and each part's entry points. Host only (POSIX threads, stdio, malloc).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_3d.c - nearest occupied space above and below the band (run_3d.h). */
 #include "run_3d.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_3d.h - `occmap run --3d`: the nearest occupied space above and below the sectors' band,
  * sent as OBSTACLE_DISTANCE_3D (one message per side, MAV_FRAME_BODY_FRD) after each
  * OBSTACLE_DISTANCE, from the same map view and pose. Host only (a heap buffer for the search). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_args.c - `occmap run`'s options: the loop loop of feed_args.c with the feed's shared and
  * sector options, plus the sensor, map, timing and output options of the onboard loop. */
 #include <math.h>

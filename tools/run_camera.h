@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_camera.h - where a depth camera driver plugs into `occmap run`: the mapping thread pulls
  * frames through these two calls and knows nothing else about the source. The TUM directory
  * replay (run_camera_tum.c, --depth-dir) is one implementation; a live driver (V4L2, librealsense,

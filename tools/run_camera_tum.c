@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_camera_tum.c - the TUM directory replay behind the camera hook (run_camera.h). */
 #include <stdlib.h>
 

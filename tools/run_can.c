@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_can.c - the DroneCAN front end of `occmap run` (run_can.h). */
 #include <stdlib.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_can.h - `occmap run --can`: the DroneCAN front end of the loop (link thread).
  * In: uavcan.equipment.range_sensor.Measurement from any node, placed by the --can-range-mount
  * table (by sensor_id) and queued like the MAVLink range messages (run_ranges.h: stamped with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_config.c - `occmap run --config FILE`: sensor mounts and options as key = value lines,
  * turned into command-line options placed before the real ones (see run.h). */
 #include <ctype.h>

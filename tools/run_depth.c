@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_depth.c - the depth directory `occmap run` replays: depth.txt's entries that have their
  * PNG, stamped with autopilot time, and the camera (intrinsics, range, step, mount). */
 #include <stdlib.h>

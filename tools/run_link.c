@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_link.c - `occmap run`'s link thread (see run_link.h). */
 #include <stdlib.h>
 #include <string.h>

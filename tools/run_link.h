@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_link.h - the link side of `occmap run` (main thread): MAVLink in (poses into the history,
  * TIMESYNC, the feed's autopilot bookkeeping), out (OBSTACLE_DISTANCE from the live map,
  * HEARTBEAT with the loop's status, SET_MESSAGE_INTERVAL, TIMESYNC, STATUSTEXT), the feed log

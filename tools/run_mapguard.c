@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_mapguard.c - the map's one writer and its readers on the shared map (occ_shared.h). */
 #include <stdlib.h>
 

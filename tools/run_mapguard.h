@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_mapguard.h - every map access of `occmap run` goes through these calls.
  *
  * One writer (the mapping thread) and readers (the feed; the telemetry's pool counters) on the

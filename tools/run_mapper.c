@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_mapper.c - the mapping thread of `occmap run`: releases each depth frame at its time,
  * finds its pose in the history (on the autopilot's clock), integrates it as the map's one
  * writer, and never stops for memory: evict, then the nearest part of the frame, then count. */

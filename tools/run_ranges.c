@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_ranges.c - range messages from other components into `occmap run`'s map (run_ranges.h). */
 #include <stdlib.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_ranges.h - range messages other components send on the link (DISTANCE_SENSOR,
  * OBSTACLE_DISTANCE, OBSTACLE_DISTANCE_3D; occ_mavlink_ranges.h) into `occmap run`'s map: the
  * link thread translates them and queues them stamped with the autopilot's time of their

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_state.c - the state `occmap run`'s two threads share: the clock offset, frame lists. */
 #include <stdlib.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* run_stats.c - `occmap run`'s telemetry: the config line, one JSON line a second, the final
  * line (--stats FILE, default stderr). */
 #include <stdlib.h>

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """sector_ref.py - an independent reference for occmap's sector distances (pure Python, double).
 
 A map slice is a 2D grid of voxel columns over the vertical band [z - below, z + above): a column

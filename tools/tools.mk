@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # The command-line tool's data and the first demo step.
 # $(BUILD)/data/scan.dat (OctoMap's real scan, decompressed) is made by tests/integrate.mk.
 SCAN_DAT := $(BUILD)/data/scan.dat

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* view.h - `occmap view MAP -o map.html` (cmd_view.c): the map as one self-contained HTML page.
  * view_voxels.c collects the nodes to draw, view_page.c writes the page (the rendering library
  * and the page's script inlined from an assets folder, the voxels as base64). */

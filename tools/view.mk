@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # view.mk - `occmap view` (issue 23): the rendering library, pinned and checked, fetched from the
 # npm registry at build time, and the viewer test.
 #   make view-assets   $(VIEW_ASSETS)/{three.min.js,OrbitControls.js,view_app.js}: what

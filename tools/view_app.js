@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /* view_app.js - the script of the page `occmap view` writes (tools/view_page.c inlines it after
  * three.js r147 and its OrbitControls). OCC_MAP holds the map's facts and three node arrays
  * (occupied, free, unknown), each base64 of x[n] y[n] z[n] (keys minus the set's min, kw bytes,

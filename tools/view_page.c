@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* view_page.c - the HTML page of `occmap view`: one file that opens offline. The rendering
  * library (three.js, pinned and fetched by tools/view.mk) and the page's script (view_app.js)
  * are inlined; the voxels are a base64 array per kind, decoded by view_app.js. */

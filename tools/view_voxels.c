@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* view_voxels.c - the nodes `occmap view` draws, from one walk over the map. */
 #include <stdlib.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_core.h - the map (chapter 1 of occmap.h): a pool-backed tri-state occupancy octree. This header is the manual.
  *

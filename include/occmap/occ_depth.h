@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* occ_depth.h - depth images (depth cameras, multizone time-of-flight arrays) into the map.
  *
  * occ_map_insert_depth() takes a depth image as the sensor gives it, the camera's pinhole

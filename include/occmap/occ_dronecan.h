@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_dronecan.h - the CAN front end: a minimal DroneCAN (UAVCAN v0) node that tells an autopilot
  * where the obstacles are. This header is the manual.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_evict.h - bounded memory in flight: making room in a fixed arena by evicting map content
  * far from the vehicle. Part of the manual; include it directly (occmap.h does not).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_integrate.h - integrating point clouds (ray casting) into the map. Part of the manual.
  *

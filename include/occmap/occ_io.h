@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_io.h - map serialization on caller byte buffers and write callbacks (never files; see
  * occ_file.h for the POSIX helpers). Part of the manual; included by occmap.h.

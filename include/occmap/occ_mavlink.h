@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_mavlink.h - MAVLink front end: a frame parser, encoders for OBSTACLE_DISTANCE (330) and
  * HEARTBEAT (0), decoders for the pose messages an autopilot streams, and a feed state machine

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* occ_mavlink_ranges.h - MAVLink range messages other components send (rangefinders, sonar,
  * proximity sensors) as range beams for occ_map_insert_ranges() (occ_ranges.h).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_mavlink_run.h - the MAVLink parts of the onboard loop (`occmap run`, issue 21) that the
  * static feed (occ_mavlink.h) does not need: TIMESYNC (111) and its clock-offset filter,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_port.h - the portable hooks a platform provides to the front ends' glue: a monotonic
  * microsecond clock and a non-blocking UART write. The core (src/) never includes this header;

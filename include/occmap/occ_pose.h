@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* occ_pose.h - the one pose type of occmap: frames, sensor mounts, a timed pose history.
  *
  * Frames (right-handed, metres, radians):

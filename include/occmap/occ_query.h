@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_query.h - reading the map through volumes: iteration with state predicates, voxel counts,
  * nearest-first search, collision checks, ray casts, line of sight, information gain.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* occ_ranges.h - range beams (rangefinders, sonar, proximity arrays, time-of-flight zones) into
  * the map: one beam per reading, in the sensor's frame, integrated with the sensor's pose.
  *

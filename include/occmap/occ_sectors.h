@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_sectors.h - what the vehicle is told: the nearest obstacle per horizontal sector (src/sectors/sectors.c).
  * Pure C99, no OS, no heap; uses the public map API only.

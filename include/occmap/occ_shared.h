@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_shared.h - one writer, many readers on the same map (issue 20).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occmap.h - the whole portable map API, one include. It holds no declarations: each chapter is
  * a header of its own, and each chapter includes only occ_core.h (or nothing), so no header

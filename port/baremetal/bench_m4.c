@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* bench_m4.c - instructions per call on an emulated Cortex-M4F (`make bench-m4`): qemu's
  * mps2-an386 with -icount shift=0 advances virtual time by one nanosecond per instruction; the
  * CMSDK dual timer (free-running, 32 bits) is read before and after each call, and the ticks are

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* can_hooks.c - weak defaults of the bare-metal CAN hooks (see occ_bm_can.h). */
 #include "occ_bm_can.h"
 

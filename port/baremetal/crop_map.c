@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* crop_map.c - host helper of `make bench-m4`: the part of a map inside an axis-aligned box,
  * as a snapshot (.occ) small enough for a microcontroller's RAM. Every childless node (voxel or
  * pruned uniform node) whose cube meets the box is copied whole with its log-odds, so pruned

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """embed_bytes.py - a file as a C array for a firmware image (make bench-m4 embeds the geb079
 crop this way; the output goes to build/, never into the tree).
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* example_main.c - an example flight-controller image: a static arena, a built-in test cloud
  * (a room of 8 x 6 m seen from its middle) integrated with occ_map_insert_cloud(), and a main loop
  * that publishes the obstacles as DroneCAN Proximity (8 sectors, 10 Hz) plus NodeStatus through a

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """fw_report.py - what the firmware image costs: size per module from the link map (text =
 .text + .rodata + ARM tables, data = .data, bss = .bss/COMMON), the core's total, the worst
 -fstack-usage frames of the image's own objects, and a recursion check on the image's direct

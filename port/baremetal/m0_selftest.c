@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* m0_selftest.c - the core on ARMv6-M (built for Cortex-M0+, run on qemu's microbit board:
  * Cortex-M0, 16 KB RAM, semihosting): map init / update / read / prune / stats on an 8 KB
  * arena, a ray cast and sphere checks against a hand-built block, pool exhaustion on a tiny

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink_hooks.c - the platform hooks of occ_port.h as weak defaults for a flight controller
  * image: the firmware links its own strong versions (a hardware timer, a UART TX FIFO). */
 #include "occmap/occ_port.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_bm_can.h - bare-metal hooks for the CAN front end (port/baremetal/can_hooks.c).
  * Every hook is a weak function: a board file defines the real one with the same name and the

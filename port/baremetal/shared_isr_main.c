@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * shared_isr_main.c - one writer, one interrupt reader on a shared map (issue 20), on qemu's
  * mps2-an386 (Cortex-M4F, semihosting). main() is the writer: it integrates a synthetic moving

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* startup_m4.c - Cortex-M reset code for the example image and the qemu self-tests (M4F; the
  * same file serves ARMv6-M, which has no FPU to enable): vector table, FPU on, .data copied,
  * .bss cleared, main() called. With OCC_BM_SEMIHOSTING the

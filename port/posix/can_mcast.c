@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* can_mcast.c - CAN frames over UDP multicast, pydronecan `mcast:` / ArduPilot SITL format. */
 #include <arpa/inet.h>
 #include <errno.h>

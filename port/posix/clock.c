@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* clock.c - the monotonic microsecond clock on POSIX. */
 #include <time.h>
 

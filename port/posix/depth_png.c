@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* depth_png.c - 16-bit depth PNGs (libpng) back-projected to points; TUM RGB-D directories. */
 #include <errno.h>
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* fd_wait.c - what a non-blocking receive does after a failed read. */
 #include <errno.h>
 #include <poll.h>

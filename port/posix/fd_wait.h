@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* fd_wait.h - the non-blocking receive loops of the POSIX ports share one rule for a failed read. */
 #ifndef OCC_PORT_FD_WAIT_H_INCLUDED
 #define OCC_PORT_FD_WAIT_H_INCLUDED

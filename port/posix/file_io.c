@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* file_io.c - map files on POSIX: whole-file reads, format by extension, atomic saves. */
 #include <errno.h>
 #include <fcntl.h>

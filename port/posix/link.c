@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* link.c - read, write, wait and close for every POSIX link kind. */
 #include <errno.h>
 #include <poll.h>

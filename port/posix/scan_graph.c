@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* scan_graph.c - OctoMap's binary ScanGraph reader (scans with 6-D poses). */
 #include <errno.h>
 #include <math.h>

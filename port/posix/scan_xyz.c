@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* scan_xyz.c - the plain "x y z" point file reader (OctoMap's scan.dat). */
 #include <errno.h>
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* serial.c - a raw, non-blocking termios serial link (8N1, no flow control). */
 #include <errno.h>
 #include <fcntl.h>

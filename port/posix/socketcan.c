@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* socketcan.c - Linux SocketCAN port: one non-blocking CAN_RAW socket, classic and FD frames. */
 #include <errno.h>
 #include <net/if.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* tlog.c - reading MAVLink telemetry logs (see occ_tlog.h). */
 #include <stdarg.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* tlog_ranges.c - a log's range readings into a map with the log's own poses (occ_tlog.h). */
 #include <math.h>
 #include <stdlib.h>

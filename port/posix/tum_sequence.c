@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* tum_sequence.c - TUM RGB-D sequence directories: depth.txt, groundtruth.txt, and depth frames
  * posed by the interpolating pose history. */
 #include <errno.h>

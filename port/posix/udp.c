@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* udp.c - non-blocking UDP links: client (fixed destination) and udpin-style server. */
 #include <errno.h>
 #include <fcntl.h>

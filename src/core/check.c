@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * check.c - occ_map_check(): an O(n) audit of pools and tree that never writes.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* map.c - configuration, init/clear, and the public coordinate <-> key calls (geom_internal.h). */
 #include "shared_internal.h"
 #include "tree_internal.h"

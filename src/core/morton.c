@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* morton.c - 3 x 21-bit key <-> 63-bit Morton code (x in bit 0, y in bit 1, z in bit 2). */
 #include "occmap/occmap.h"
 

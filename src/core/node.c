@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* node.c - top-down node handles: one block read per child, no descent from the root. */
 #include "tree_internal.h"
 

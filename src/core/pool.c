@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * pool.c - the two block pools in one arena. Leaf blocks are carved upwards from the bottom,
  * inner blocks downwards from the top, so the split between them follows the map's content

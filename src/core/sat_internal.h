@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * sat_internal.h - saturating size arithmetic for the map (scratch sizes, brick counts, strides,
  * n * sizeof, capacity sums, arena splits). A result that does not fit is SIZE_MAX, which no

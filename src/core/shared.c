@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * shared.c - single writer / many readers by published snapshots (occ_shared.h has the design).
  * The writer owns its arena; a version is copied into a snapshot no reader pins and published

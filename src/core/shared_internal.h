@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * shared_internal.h - the hooks every write path calls for the single-writer / many-reader mode
  * (occ_shared.h), and the atomics port: the only place the library touches atomics.

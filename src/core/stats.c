@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* stats.c - pool counters and content statistics. */
 #include "tree_internal.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * tree.c - reading and writing the octree: descent, expansion, refresh/prune, batch updates.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * tree_internal.h - the octree's storage, shared by the map modules under src/ only
  * (integrate, query, io, evict). Feeds and tools use the public header.

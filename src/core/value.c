@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* value.c - log-odds <-> node values, states, and OctoMap's clamped update rule. */
 #include "tree_internal.h"
 

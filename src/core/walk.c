@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* walk.c - depth-first walk over observed nodes in Morton preorder, with a fixed stack. */
 #include "tree_internal.h"
 

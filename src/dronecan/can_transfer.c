@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* can_transfer.c - DroneCAN v0 transfer layer: ids, CRC, DSDL bit packing, frame split. */
 #include <string.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* dronecan.c - DroneCAN messages (Proximity, NodeStatus, GetNodeInfo) and the obstacle node. */
 #include <math.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* dronecan_map.c - the DroneCAN node fed from a map and a pose through the sector module. */
 #include "occmap/occ_dronecan.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* range_rx.c - uavcan.equipment.range_sensor.Measurement in: transfer reassembly (tail bytes,
  * toggles, CRC seeded by the signature), the DSDL decode, and the beam with its mount. */
 #include <math.h>

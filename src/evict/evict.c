@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * evict.c - making room in a fixed arena: sweeps that collapse subtrees far from the vehicle
  * (forgetting them, or coarsening them to one conservative value), in budgeted slices.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* geom.c - the map's decimal resolution (once, at init) and key ranges; see geom_internal.h. */
 #include "geom_internal.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * geom_internal.h - the one voxel geometry of the map: coordinate -> key, key -> centre, key
  * ranges, and the 3D-DDA set-up every ray walk starts from (integration and castRay alike).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * coarse.c - one log-odds delta applied to whole nodes above the voxels (FAST_DISCRETE's coarse
  * free space): every voxel below a node gets the delta; uniform nodes stay uniform (O(1)), nodes

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* coarse_internal.h - whole-node updates for FAST_DISCRETE (coarse.c), src/integrate only. */
 #ifndef OCC_COARSE_INTERNAL_H_INCLUDED
 #define OCC_COARSE_INTERNAL_H_INCLUDED

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * fastdiscrete.c - UFOMap's fast discrete integrator (Duberg & Jensfelt 2020, IV-B3): march from
  * the origin in steps of a level-d node's edge, marking the level-d nodes the samples fall in,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * integrate.c - occ_map_insert_cloud(): OctoMap's per-scan semantics (each voxel updated once,
  * hit wins over free) with the sets kept as Morton codes in the caller's scratch: rays emit

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * integrate_internal.h - what raycast.c, keyset.c, integrate.c and superray.c share (src/integrate
  * only): OctoMap's key arithmetic, the exact DDA writing Morton codes, the key-set sort.

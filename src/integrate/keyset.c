@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * keyset.c - per-scan key sets as sorted Morton codes: LSD radix sort (digits that are equal in
  * every code are skipped) and run collapsing. Sorting is what makes the later tree update

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* projective.c - occ_map_insert_projective(): check the call, lay out the scratch, build the
  * pyramid, walk, then the all-or-nothing pool check and the writes (whole free nodes through
  * the coarse applier, voxels through the batch applier). */

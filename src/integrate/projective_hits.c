@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* projective_hits.c - the frame's end points: each pixel with a reading within range marks the
  * voxel of its back-projected point (hits win over the walk's free voxels). Codes are filtered
  * (repeats from neighbouring pixels), radix sorted and collapsed at the start of the output. */

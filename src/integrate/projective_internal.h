@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * projective_internal.h - what projective.c (entry, apply), projective_pyramid.c (depths and
  * their min/max pyramid) and projective_walk.c (the virtual octree walk) share. src/integrate

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* projective_pyramid.c - the frame's depths (one float per pixel, "no reading" as -inf) and
  * their min/max pyramid, and the footprint query the walk asks it. */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* projective_walk.c - the top-down walk of a virtual octree over the camera frustum: each
  * node's box is projected (8 corners) and compared with the pyramid over its footprint; whole
  * free nodes and voxel updates are written to the output in Morton order. No tree reads. */

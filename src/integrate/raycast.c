@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * raycast.c - OctoMap's computeRayKeys (Amanatides & Woo 3D-DDA), bit for bit: float direction
  * and length, the DDA set-up and tie rule every ray walk shares (geom_internal.h: occ_dda_start,

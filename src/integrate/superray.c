@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * superray.c - super rays (Kim et al. 2017), exact: points ending in the same voxel whose rays
  * cross the voxel grid in the same order share one traversal. The order of an a-plane and a

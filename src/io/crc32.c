@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* crc32.c - CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320), table driven, as zlib. */
 #include "occmap/occmap.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * io.c - the public entry points of occ_io.h: detect, probe (validating dry run), load/read
  * (dry run, fit check on a scratch copy of the map struct, then the same parse building for

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * io_build.c - builds a tree from a preorder description, or (map == NULL) counts what that
  * build allocates and frees, so readers can check fit before touching the destination.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * io_header.c - OctoMap's text header: parsed as AbstractOcTree::readHeader does (whitespace
  * tokens, '#' comments, unknown keywords skipped to the end of the line, "data" ends it), and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * io_internal.h - what the readers and writers in src/io/io_*.c share: the tree builder (one
  * code path for the validating dry run and the real build), the buffered byte sink, the

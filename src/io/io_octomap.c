@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * io_octomap.c - the tree data of OctoMap's .bt and .ot files: parsers that drive a builder
  * (validating every byte: lengths, impossible child patterns, node count, values) and emitters

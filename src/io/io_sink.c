@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * io_sink.c - the writers' buffered byte sink (chunks of OCC_SINK_BUF bytes to the caller's
  * callback, sticky first error, optional running CRC) and little-endian byte helpers.

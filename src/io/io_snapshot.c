@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * io_snapshot.c - occmap's native snapshot (.occ). Layout (little endian):
  *   0 "OCCMAPSN"   8 u16 version (1)   10 u16 header bytes (64)   12 u8 value kind (0: int16

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink.c - MAVLink frame parser, encoders and pose decoders (see occ_mavlink.h).
  * Message definitions come from the mavgen-generated headers (build/gen/mavlink, -isystem). */
 #include "occmap/occ_mavlink.h"

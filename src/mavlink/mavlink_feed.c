@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink_feed.c - poses in, OBSTACLE_DISTANCE + HEARTBEAT out, on the caller's clock. */
 #include "occmap/occ_mavlink.h"
 #include "occmap/occ_mavlink_run.h"

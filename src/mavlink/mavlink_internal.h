@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink_internal.h - what the MAVLink front end's files share (not public). */
 #ifndef OCC_MAVLINK_INTERNAL_H_INCLUDED
 #define OCC_MAVLINK_INTERNAL_H_INCLUDED

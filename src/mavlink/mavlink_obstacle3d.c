@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink_obstacle3d.c - the OBSTACLE_DISTANCE_3D encoder (occ_mavlink_run.h). */
 #include "occmap/occ_mavlink_run.h"
 

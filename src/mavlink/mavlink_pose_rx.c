@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink_pose_rx.c - poses from one autopilot, stamped on its clock (occ_mavlink_run.h). */
 #include "occmap/occ_mavlink_run.h"
 

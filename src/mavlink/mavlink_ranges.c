@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink_ranges.c - DISTANCE_SENSOR, OBSTACLE_DISTANCE and OBSTACLE_DISTANCE_3D as range beams
  * (see occ_mavlink_ranges.h). Public headers only, plus the generated dialect for 11037. */
 #include "occmap/occ_mavlink_ranges.h"

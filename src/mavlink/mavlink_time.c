@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mavlink_time.c - TIMESYNC and STATUSTEXT codecs and the clock-offset filter
  * (occ_mavlink_run.h). */
 #include "occmap/occ_mavlink_run.h"

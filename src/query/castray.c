@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * castray.c - OctoMap's castRay (3D-DDA, Amanatides & Woo) and line of sight.
  * The voxel sequence, the tie rule and the arithmetic are OctoMap's (double on hosts when

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * collide.c - "is this volume safe?": a depth-first walk in Morton order that opens only the
  * blocks whose entries hold a blocking state (occupied, and unknown under OCC_UNKNOWN_UNSAFE) and

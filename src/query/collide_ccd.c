@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * collide_ccd.c - convex shapes against the map with libccd (host only, see sources.mk).
  */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * infogain.c - information gain of a sensor volume: the unknown cells at a chosen level, found by
  * the volume iterator (branches without unknown space are skipped through the indicators).

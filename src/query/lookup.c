@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * lookup.c - point lookups: occ_map_state_at (one descent from the root) and the cursor with a
  * path cache for streams of nearby points (a trajectory, a sensor footprint), which walks again

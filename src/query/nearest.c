@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * nearest.c - nearest-first (best-first) search: a binary min-heap of nodes keyed by the squared
  * distance from the query point to the node cube, in a caller buffer. A node is reported when it

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * query.c - the volume iterator and voxel counts. The iterator is a depth-first walk in Morton
  * order on a fixed stack; a branch is skipped as soon as its cube misses the volume (volume.c) or

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * query_internal.h - helpers shared by the query modules (query, nearest, collide, castray,
  * infogain): node geometry from keys and the state of a stored value, inline for speed.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * volume.c - bounding volumes: construction, exact tests of node cubes against them, the key
  * range a volume can touch and which children of a node it touches. Shared by the iterator

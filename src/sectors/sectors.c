@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* sectors.c - nearest occupied / unknown footprint per horizontal sector (see occ_sectors.h). */
 #include "occmap/occ_sectors.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* depth.c - depth images: validate, back-project the valid pixels into the scratch, and hand
  * them to occ_map_insert_cloud() with the rest of the scratch. */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* pose.c - pose algebra: quaternions, compose/invert/apply, Euler angles, NED <-> ENU. */
 #include <math.h>
 

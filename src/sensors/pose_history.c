@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* pose_history.c - a caller-owned ring of timestamped poses, answered at any sample's time. */
 #include "occmap/occ_pose.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* ranges.c - range beams (rangefinders, sonar, ToF zones) as rays of one occ_map_insert_rays()
  * scan: a return is a hit at d, "no return" clears to the beam's own max without a hit. */
 #include <math.h>

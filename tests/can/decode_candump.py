@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """decode_candump.py - pydronecan decodes what candump captured on the guest's vcan0.
 
 usage: decode_candump.py CANDUMP_LOG [--can-feed-node N]   (candump -L: "(time) vcan0 ID#DATA")

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """golden.py - occmap's DroneCAN encoder against pydronecan, byte for byte.
 
 usage: golden.py DUMP_BINARY [N_RANDOM]

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* golden_dump.c - reads DroneCAN test cases (one per line, hex fields) from stdin and prints the
  * frames occmap's encoder makes for each, one line per case: "ID:DATA ID:DATA ...". Driven by
  * tests/can/golden.py, which compares them with pydronecan's frames byte for byte. */

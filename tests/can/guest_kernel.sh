@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Fetch a stock Debian kernel and its CAN modules for the qemu guest, without installing the
 # package (an install would run bootloader hooks and upgrade host packages). Cached in $1.
 # usage: guest_kernel.sh CACHE_DIR   -> CACHE_DIR/vmlinuz, CACHE_DIR/modules/{can,can-raw,can-dev,vcan}.ko

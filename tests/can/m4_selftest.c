@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* m4_selftest.c - the core's behaviour on an emulated Cortex-M4F (qemu mps2-an386, semihosting):
  * map init / update / read / check / clear on a static arena, pool exhaustion, the sector module
  * against a hand-built wall, and the DroneCAN encoder against the golden bytes of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* make_wall_map.c - a small known map for the can-feed tests: observed free space in a disc of
  * radius 5 m around the origin (z in [-0.6, 0.6] m), and an occupied wall 3 m north of the origin
  * (map y = 3.0 .. 3.1, x in [-2, 2]). usage: make_wall_map OUT.occ|OUT.bt */

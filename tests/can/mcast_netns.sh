@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Run tests/can/mcast_peer.py inside a network namespace made for the test, with only loopback
 # (multicast routed to lo), so no packet can leave the machine.
 # usage: mcast_netns.sh OCCMAP MAP PYTHON

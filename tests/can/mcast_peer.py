@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mcast_peer.py - occmap can-feed on pydronecan's `mcast:` bus, with pydronecan as the peer.
 
 usage: mcast_peer.py OCCMAP MAP      (run inside a network namespace that has only loopback:

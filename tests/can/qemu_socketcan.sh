@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The SocketCAN port on a real kernel CAN bus: boots a stock Debian kernel under qemu (software
 # emulation) with a tiny initramfs that loads the CAN modules, creates vcan0, runs the test binary
 # against the kernel's CAN stack while can-utils' candump captures the bus; the host then checks

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """range_frames.py - uavcan.equipment.range_sensor.Measurement transfers built by pydronecan
 (dronecan 1.0.27), the peer for tests/test_dronecan_range.c.
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* socketcan_guest.c - the SocketCAN port and the DroneCAN node against a real kernel CAN stack.
  * Runs inside the qemu guest (tests/can/qemu_socketcan.sh) on vcan0; prints one line per check
  * and "OCC-SOCKETCAN checks=N failed=M", exits 0 only if nothing failed. Linked statically. */

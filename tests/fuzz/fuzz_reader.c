@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * fuzz_reader.c - libFuzzer harness for one reader (FUZZ_FORMAT = OCC_FORMAT_BT, _OT or
  * _SNAPSHOT, set by tests/io.mk). Properties: no crash or sanitizer report on any input; an

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* make_seeds.c - the fuzz seed corpus: small crops of real maps (geb079.bt, and the shared
  * .ot when present) written as .bt, .ot and .occ. usage: make_seeds OUTDIR */
 #include <stdio.h>

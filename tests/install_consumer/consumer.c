@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* consumer.c - a program outside the tree that uses an installed occmap (tests/install.mk):
  * one scan of a wall 2 m ahead, then the answers worked out by hand, then a save and a load
  * through the host port (libocc_posix; not with -DCONSUMER_CORE_ONLY). Exit 0 and "consumer ok" when every answer holds. */

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # test-install (tests/install.mk): `make install` into a staging DESTDIR, then a consumer outside
 # the tree built both ways against what was installed - pkg-config (shared libocc.so.0 and the
 # static host port) and CMake's find_package (static occmap::occmap) - and run; its answers are

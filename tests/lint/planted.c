@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* planted.c - a defect `make lint` must report (tests/lint.mk checks that both cppcheck and
  * gcc -fanalyzer fail on it, so a lint step that silently checks nothing cannot pass). Never
  * built into anything. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* fuzz_mavlink.c - libFuzzer harness for the MAVLink frame parser and the decoders.
  * Invariants checked on every input: the parser never reads or writes outside its buffer
  * (ASan), every byte is accounted for in exactly one place, a frame handed out lies inside

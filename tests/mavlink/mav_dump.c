@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mav_dump.c OUT.bin OUT.txt - frames from our C encoder for pymavlink to decode
  * (tools/mav_check_c_frames.py): OBSTACLE_DISTANCE with random fields, including payloads whose
  * trailing zeros MAVLink 2 trims, and HEARTBEATs. Expected values go to OUT.txt, one line each. */

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: BSD-3-Clause
 # callgrind.sh SOAK_BIN OUTDIR [soak args...] - instructions per occ_map_insert_cloud() call in
 # the soak's steady state: 20 s of sensor time in a 4 MB arena (eviction running after ~5 s),
 # counted by callgrind inside soak_insert() only (--toggle-collect), divided by the calls.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * soak.c - a simulated long flight in a fixed arena (issue 9).
  *

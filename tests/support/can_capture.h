@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* can_capture.h - DroneCAN test fixtures shared by test_dronecan.c (the transfer layer and
  * messages) and test_dronecan_node.c (the node): a capturing transmit hook with a settable queue
  * limit, its CMocka setup, and exact float equality. One capture per test binary (static). */

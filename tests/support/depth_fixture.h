@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* depth_fixture.h - what the depth tests share (header-only, one include per test binary): two
  * maps on malloc'd arenas, one scratch, OctoMap's sensor model, the leak check in teardown. */
 #ifndef OCC_DEPTH_FIXTURE_H_INCLUDED

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* evict_fixture.c - what the eviction tests share (test_evict.c, test_evict_auto.c): a seeded
  * random source, a map configuration and OctoMap's per-scan sort of key codes. */
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* evict_fixture.h - what the eviction tests share (tests/support/evict_fixture.c). */
 #ifndef EVICT_FIXTURE_H
 #define EVICT_FIXTURE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* failclosed_map.c - the map the fail-closed tests share (see failclosed_map.h). */
 #include <stdarg.h>
 #include <stddef.h>

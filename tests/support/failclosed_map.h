@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* failclosed_map.h - the map the fail-closed tests share (test_failclosed.c,
  * test_stale_handles.c; tests/support/failclosed_map.c): 0.1 m, depth 16, one occupied voxel
  * x in [1.0, 1.1), y and z in [0, 0.1); a free 10 x 10 slab of voxels x, y in [-0.5, 0.5),

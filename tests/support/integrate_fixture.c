@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* integrate_fixture.c - what the integration tests (test_integrate.c, test_integrate_limits.c)
  * share: OctoMap's sensor model, the real clouds, exact map comparisons and a CPU timer. */
 #include <stdarg.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* integrate_fixture.h - what the integration tests share (tests/support/integrate_fixture.c). */
 #ifndef INTEGRATE_FIXTURE_H
 #define INTEGRATE_FIXTURE_H

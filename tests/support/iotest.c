@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* iotest.c - helpers shared by the file tests (see iotest.h). */
 #include "iotest.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* iotest.h - helpers shared by the file tests and fuzz regression tests (prefix iotest_). */
 #ifndef OCC_IOTEST_H_INCLUDED
 #define OCC_IOTEST_H_INCLUDED

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * leak_check.h - the no-leak check every fixture teardown runs (lwIP memp's used == 0 per pool).
  * Header-only, so every test binary and every build variant of the tests has it without new

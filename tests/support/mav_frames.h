@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* mav_frames.h - MAVLink test fixtures shared by test_mavlink.c (the wire) and
  * test_mavlink_feed.c (the feed): exact float equality, a byte-wise parse and an ATTITUDE frame.
  * static inline, so a test that uses only some of them builds without warnings. */

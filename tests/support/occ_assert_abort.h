@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_assert_abort.h - OCC_ASSERT's hook for a program that links a test build of the core (live
  * asserts: tests/support/occ_test_config.h) but is not a CMocka test: the soak, the fuzz

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_test_config.h - the OCC_CONFIG_HEADER of the test build of the core (ASAN_CFLAGS in the
  * Makefile): OCC_ASSERT is live and reports through CMocka's mock_assert(), so a broken internal

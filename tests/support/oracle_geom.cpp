@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_geom.cpp - OctoMap 1.9.7's coordToKeyChecked / keyToCoord for the geometry tests.
 #include <octomap/OcTree.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* oracle_geom.h - OctoMap's voxel geometry for the C tests (oracle_geom.cpp): the resolution a
  * user writes for a float one, and OcTree(that).coordToKeyChecked / keyToCoord. */
 #ifndef OCC_ORACLE_GEOM_H_INCLUDED

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_io.cpp - OctoMap as the reference for the file tests (see oracle_io.h).
 #include "oracle_res.hpp"
 #include "oracle_io.h"

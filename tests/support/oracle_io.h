@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * oracle_io.h - OctoMap (Debian liboctomap 1.9.7) as the reference for the file tests and the
  * I/O bench: its readers and writers on memory buffers, trees built from updates or from

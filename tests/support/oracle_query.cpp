@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_query.cpp - brute-force references for the query tests: Eigen geometry in double,
 // one cell at a time, and OctoMap's castRay. Shares no code with the core's query math.
 #include "oracle_res.hpp"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * oracle_query.h - brute-force references for the query tests (tests/support/oracle_query.cpp).
  * Shapes are built and tested with Eigen in double precision, sharing no code with the core's

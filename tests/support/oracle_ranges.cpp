@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_ranges.cpp - OctoMap 1.9.7's insertRay() for the range-beam tests (oracle_ranges.h).
 #include <octomap/OcTree.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* oracle_ranges.h - OctoMap's single-ray insert as the reference for range beams (C API of
  * oracle_ranges.cpp; trees from oracle_rays.h's oracle_ins_new). */
 #ifndef OCC_ORACLE_RANGES_H_INCLUDED

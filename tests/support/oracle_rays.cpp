@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_rays.cpp - OctoMap 1.9.7 (Debian liboctomap) as the reference for ray keys and point-cloud
 // integration. extern "C" API for the C tests (tests/support/oracle_rays.h).
 #include <octomap/OcTree.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* oracle_rays.h - OctoMap as the reference for ray keys and point-cloud integration (C API of
  * oracle_rays.cpp). Resolution: pass (double)cfg.resolution_m; the tree is built with the decimal
  * a user writes for that float (OcTree(0.1) for 0.1f, tests/support/oracle_res.hpp). */

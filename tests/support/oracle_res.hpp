@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_res.hpp - the resolution an OctoMap oracle is built with: the decimal a user writes.
 // A C test holds the resolution as the float cfg.resolution_m (0.1f); the user who wrote 0.1f
 // writes OcTree(0.1), not OcTree((double)0.1f). This is the shortest "%.*g" text that reads

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_stats.cpp - OctoMap's own statistics of a tree (see oracle_stats.h).
 #include "oracle_stats.h"
 

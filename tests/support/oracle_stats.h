@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * oracle_stats.h - OctoMap's own statistics of a tree, the reference for occ_map_stats():
  * the node and leaf counts of octomap::OcTree and the occupied / free volumes as OctoMap's leaf

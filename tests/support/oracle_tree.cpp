@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // oracle_tree.cpp - octomap::OcTree behind the C API of oracle_tree.h (test/bench reference).
 #include "oracle_res.hpp"
 #include "oracle_tree.h"

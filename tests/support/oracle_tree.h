@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * oracle_tree.h - an octomap::OcTree behind a C API, the reference the tree tests and the memory
  * bench compare occmap against. Host only (links Debian's liboctomap). Keys are OctoMap keys

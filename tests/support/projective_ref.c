@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* projective_ref.c - the brute-force oracle of the projective rule (see projective_ref.h). */
 #include "projective_ref.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* projective_ref.h - brute-force oracle of OCC_INSERT_PROJECTIVE's per-voxel rule
  * (occ_integrate.h): no pyramid, no walk; every voxel of the cube of half-edge max range around
  * the camera is classified by projecting its centre, every pixel's end point is a hit. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* query_shapes.c - random volumes in two implementations (see query_shapes.h). */
 #include "query_shapes.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * query_shapes.h - random bounding volumes for the query tests, built twice from the same
  * numbers: as an occ_volume_t (the core's constructors) and as an Eigen oracle shape.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* sectors_ref.c - the sectors tests' fixture and brute-force reference (see sectors_ref.h). */
 #include <stdarg.h>
 #include <stddef.h>

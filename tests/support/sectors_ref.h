@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* sectors_ref.h - what the sectors tests share (tests/support/sectors_ref.c, prefix sref_): the
  * fixture (one static map, its arena and one output) and the brute-force reference of
  * occ_sectors_compute(): every voxel column in the search box, each footprint clipped against

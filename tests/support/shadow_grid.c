@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* shadow_grid.c - the dense reference model of shadow_grid.h. */
 #include "shadow_grid.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * shadow_grid.h - a dense reference model of an occmap map over a cubic volume of voxels, for
  * the randomized tree tests. It applies the same operations as the map with the arithmetic the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* shared_replay.c - see shared_replay.h. */
 #include "shared_replay.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* shared_replay.h - the real-data writer and the probe set the shared-map stress test
  * (tests/test_shared_stress.c) and bench (bench/shared.c) share (tests/support/shared_replay.c):
  * the 10 TUM depth frames and OctoMap's scan.dat replayed along a path in a small arena with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_can_mcast.h - CAN frames over UDP multicast for the DroneCAN node (port/posix/can_mcast.c),
  * the transport of pydronecan's `mcast:` driver and ArduPilot SITL. Host only: sockets.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_collide_ccd.h - collision of any convex shape with the map through libccd (GJK or MPR on a
  * support function). Host builds only: src/map/collide_ccd.c links -lccd and is listed apart

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_file.h - map files on a POSIX host (port/posix/file_io.c), on top of occ_io.h.
  * Formats: .bt (OctoMap compact), .ot (OctoMap full), .occ (occmap snapshot). Loading detects

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_link_posix.h - byte links to the autopilot on a POSIX host (port/posix/udp.c, serial.c,
  * link.c): UDP (client and udpin-style server) and serial (termios), all non-blocking. Host only:

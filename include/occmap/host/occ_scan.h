@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_scan.h - reading recorded point clouds on a POSIX host (port/posix). Host side only:
  * these functions allocate the returned arrays with malloc; free them with free().

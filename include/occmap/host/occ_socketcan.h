@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_socketcan.h - Linux SocketCAN for the DroneCAN node (port/posix/socketcan.c). Host only:
  * a CAN_RAW socket; a firmware build gives the node its own transmit hook (occ_can_iface_t in

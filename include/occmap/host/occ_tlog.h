@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* occ_tlog.h - MAVLink telemetry logs (.tlog, as QGroundControl, MAVProxy and pymavlink write
  * them) on a POSIX host (port/posix/tlog.c; the range readings of a log into a map:
  * occ_tlog_ranges.h).

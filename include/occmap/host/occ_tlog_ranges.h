@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /* occ_tlog_ranges.h - the range readings of a MAVLink telemetry log into a map, with the log's
  * own poses (port/posix/tlog_ranges.c; host only: malloc). Clock: the log stamps (occ_tlog.h).
  */

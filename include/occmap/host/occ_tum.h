@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * occ_tum.h - TUM RGB-D sequence directories on a POSIX host (port/posix/tum_sequence.c):
  * DIR/depth.txt ("timestamp depth/file.png") and DIR/groundtruth.txt ("timestamp tx ty tz qx qy
