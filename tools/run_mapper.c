@@ -357,6 +357,7 @@ void *run_mapper_main(void *arg)
         maybe_save(m, &next_save);
         sleep_us(5000);
     }
+    run_ranges_finish(m); /* what the link queued before it stopped: integrated or counted */
     free(b.px);
     free(b.part);
     free(b.tmp);

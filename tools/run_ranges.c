@@ -149,3 +149,13 @@ void run_ranges_print(FILE *f, const run_ranges_t *r, const occ_mav_ranges_t *tr
             (unsigned long long)r->nomem, (unsigned long long)r->errors, c->own_refused,
             c->malformed, c->unsupported);
 }
+
+void run_ranges_finish(run_mapper_t *m)
+{
+    run_ranges_service(m);
+    (void)pthread_mutex_lock(&m->st->lock);
+    run_ranges_t *const r = m->st->ranges;
+    r->no_pose += r->n;
+    r->n = 0;
+    (void)pthread_mutex_unlock(&m->st->lock);
+}

@@ -37,6 +37,9 @@ void run_ranges_queue(run_state_t *st, run_ranges_t *r, const occ_mav_beams_t *b
 /* Mapping thread: integrate every queued message whose pose is known (or give it up after
  * --pose-timeout-ms). */
 void run_ranges_service(run_mapper_t *m);
+/* Mapping thread, at the end of the run (the link stopped): integrate what has its pose, and
+ * count what is still waiting for a pose after its time as dropped (no_pose): none left queued. */
+void run_ranges_finish(run_mapper_t *m);
 
 /* Telemetry members ("ranges": {...}); caller holds st->lock. */
 void run_ranges_print(FILE *f, const run_ranges_t *r, const occ_mav_ranges_t *tr);
