@@ -129,6 +129,46 @@ static int run_threads(run_link_t *l, run_mapper_t *m)
     return check_ok ? status : 1;
 }
 
+/* The link's MAVLink state: parser, the autopilot's pose filter, range translator, our ids. */
+static void init_mavlink(run_link_t *l, const run_opts_t *o)
+{
+    occ_mav_parser_init(&l->parser);
+    occ_mav_pose_rx_config_t pc = occ_mav_pose_rx_config_default();
+    pc.sysid = (uint8_t)o->target_sysid;
+    pc.compid = (uint8_t)o->target_compid;
+    (void)occ_mav_pose_rx_init(&l->prx, &pc);
+    (void)occ_mav_ranges_init(&l->ranges_tr, (uint8_t)o->sysid, (uint8_t)o->compid);
+    l->tx.sysid = (uint8_t)o->sysid;
+    l->tx.compid = (uint8_t)o->compid;
+}
+
+/* The link is open: camera, mapper and CAN set up, the two threads run. 0 or 1. */
+static int run_open(run_link_t *l, run_opts_t *o, run_depth_t *depth)
+{
+    static run_camera_t cam; /* the TUM replay; a live camera driver plugs in here */
+    static run_camera_tum_t tum;
+    if (depth != NULL) {
+        run_camera_tum(&cam, &tum, depth);
+    }
+    run_mapper_t m = {o, depth != NULL ? &cam : NULL, l->st, l->guard, occ_evict_policy_default()};
+    m.policy.keep_radius_m = o->keep_radius_m;
+    static run_can_t can;
+    int status = 0;
+    if (o->can != NULL) {
+        status = run_can_open(&can, o);
+        l->can = status == 0 ? &can : NULL;
+    }
+    feed_stop_install();
+    l->t0 = occ_port_clock_us();
+    l->next_stats = l->t0 + 1000000u;
+    run_stats_config(l);
+    status = status == 0 ? run_threads(l, &m) : status;
+    if (l->can != NULL) {
+        run_can_close(l->can);
+    }
+    return status;
+}
+
 /* Everything opened, the loop run; what was opened closed. */
 static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
 {
@@ -151,14 +191,7 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
     l.depth = depth;
     l.link = &link;
     l.feed = &feed;
-    occ_mav_parser_init(&l.parser);
-    occ_mav_pose_rx_config_t pc = occ_mav_pose_rx_config_default();
-    pc.sysid = (uint8_t)o->target_sysid;
-    pc.compid = (uint8_t)o->target_compid;
-    (void)occ_mav_pose_rx_init(&l.prx, &pc);
-    (void)occ_mav_ranges_init(&l.ranges_tr, (uint8_t)o->sysid, (uint8_t)o->compid);
-    l.tx.sysid = (uint8_t)o->sysid;
-    l.tx.compid = (uint8_t)o->compid;
+    init_mavlink(&l, o);
     if (o->obstacle_3d) { /* the 3D search's heap: ample for --max-m 20 at 0.1 m */
         l.nearest_cap = NEAREST_CAP;
         l.nearest = malloc(NEAREST_CAP * sizeof *l.nearest);
@@ -172,26 +205,7 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
     status = l.stats == NULL || (o->feed_log_path != NULL && l.feed_log == NULL) ? 1
              : open_link(o, &link);
     if (status == 0) {
-        static run_camera_t cam; /* the TUM replay; a live camera driver plugs in here */
-        static run_camera_tum_t tum;
-        if (depth != NULL) {
-            run_camera_tum(&cam, &tum, depth);
-        }
-        run_mapper_t m = {o, depth != NULL ? &cam : NULL, &st, &guard, occ_evict_policy_default()};
-        m.policy.keep_radius_m = o->keep_radius_m;
-        static run_can_t can;
-        if (o->can != NULL) {
-            status = run_can_open(&can, o);
-            l.can = status == 0 ? &can : NULL;
-        }
-        feed_stop_install();
-        l.t0 = occ_port_clock_us();
-        l.next_stats = l.t0 + 1000000u;
-        run_stats_config(&l);
-        status = status == 0 ? run_threads(&l, &m) : status;
-        if (l.can != NULL) {
-            run_can_close(l.can);
-        }
+        status = run_open(&l, o, depth);
         occ_link_close(&link);
     }
     if (l.stats != NULL && l.stats != stderr) {
