@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 
@@ -158,5 +159,18 @@ void cli_print_stats_text(FILE *f, const occ_map_t *map, const occ_map_stats_t *
         fprintf(f, "bbox              (%.3f, %.3f, %.3f) .. (%.3f, %.3f, %.3f) m\n",
                 (double)st->bbox_min.x, (double)st->bbox_min.y, (double)st->bbox_min.z,
                 (double)st->bbox_max.x, (double)st->bbox_max.y, (double)st->bbox_max.z);
+    }
+}
+
+void cli_host_unique_id(uint8_t id[16], const uint32_t node_id)
+{
+    uint32_t h = 2166136261u;
+    char host[64] = "";
+    (void)gethostname(host, sizeof host - 1u);
+    const size_t hl = strlen(host);
+    for (size_t k = 0; k < 16u; k++) {
+        const unsigned ch = k < hl ? (unsigned)(unsigned char)host[k] : (unsigned)(k + node_id);
+        h = (h ^ ch) * 16777619u;
+        id[k] = (uint8_t)(h >> 24);
     }
 }

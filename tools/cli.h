@@ -44,4 +44,8 @@ void cli_print_stats_json(FILE *f, const occ_map_t *map, const occ_map_stats_t *
 /* The same as human-readable lines. */
 void cli_print_stats_text(FILE *f, const occ_map_t *map, const occ_map_stats_t *st);
 
+/* A DroneCAN unique id stable per host and node: FNV-1a of the host name and the node id
+ * (can-feed and run). */
+void cli_host_unique_id(uint8_t id[16], uint32_t node_id);
+
 #endif

@@ -183,20 +183,6 @@ static void bus_close(bus_t *bus)
     }
 }
 
-/* A unique id stable per host and node: FNV-1a of the host name and the node id. */
-static void host_unique_id(uint8_t id[16], const uint32_t node_id)
-{
-    uint32_t h = 2166136261u;
-    char hostname[64] = "";
-    (void)gethostname(hostname, sizeof hostname - 1u);
-    const size_t hl = strlen(hostname);
-    for (size_t k = 0; k < 16u; k++) {
-        const unsigned c = k < hl ? (unsigned)(unsigned char)hostname[k] : (unsigned)(k + node_id);
-        h = (h ^ c) * 16777619u;
-        id[k] = (uint8_t)(h >> 24);
-    }
-}
-
 /* The DroneCAN node on `iface`; 0, or 1 after a message. */
 static int node_open(occ_dronecan_node_t *node, const can_opts_t *o, const feed_args_t *fa,
                      const occ_can_iface_t *iface)
@@ -206,7 +192,7 @@ static int node_open(occ_dronecan_node_t *node, const can_opts_t *o, const feed_
     ncfg.sensor_id = (uint8_t)o->sensor_id;
     ncfg.priority = (uint8_t)o->priority;
     ncfg.proximity_period_us = (uint32_t)lroundf(1e6f / fa->rate_hz);
-    host_unique_id(ncfg.unique_id, o->node_id);
+    cli_host_unique_id(ncfg.unique_id, o->node_id);
     const occ_err_t e = occ_dronecan_init(node, &ncfg, iface);
     if (e != OCC_OK) {
         cli_error(CMD, "node init: %s", occ_err_str(e));

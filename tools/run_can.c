@@ -11,19 +11,6 @@
 
 #define RX_PER_TURN 256u /* frames taken per loop turn: the rest waits for the next (~20 ms) */
 
-static void unique_id(uint8_t id[16], uint32_t node_id)
-{
-    uint32_t h = 2166136261u; /* FNV-1a of the host name and the node id, as can-feed */
-    char host[64] = "";
-    (void)gethostname(host, sizeof host - 1u);
-    const size_t hl = strlen(host);
-    for (size_t k = 0; k < 16u; k++) {
-        const unsigned ch = k < hl ? (unsigned)(unsigned char)host[k] : (unsigned)(k + node_id);
-        h = (h ^ ch) * 16777619u;
-        id[k] = (uint8_t)(h >> 24);
-    }
-}
-
 static occ_err_t bus_open(run_can_t *c, const char *spec, char *msg, size_t len)
 {
     uint32_t bus = 0;
@@ -59,7 +46,7 @@ int run_can_open(run_can_t *c, const run_opts_t *o)
     nc.node_id = (uint8_t)o->can_node_id;
     nc.proximity_period_us = (uint32_t)(1e6 / (double)o->fa.rate_hz);
     nc.stale_after_us = o->pose_timeout_ms * 1000u;
-    unique_id(nc.unique_id, o->can_node_id);
+    cli_host_unique_id(nc.unique_id, o->can_node_id);
     if (occ_dronecan_init(&c->node, &nc, &c->iface) != OCC_OK ||
         occ_dronecan_range_rx_init(&c->rx, o->can_mounts, o->n_can_mounts) != OCC_OK) {
         cli_error("run", "bad --can-node-id or --can-range-mount");
