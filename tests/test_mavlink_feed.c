@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "occmap/occ_mavlink.h"
+#include "occmap/occ_mavlink_run.h"
 #include "ardupilotmega/mavlink.h"
 #include "support/mav_frames.h"
 
@@ -493,6 +494,50 @@ static bool is_request(const occ_mav_command_long_t *c, uint32_t msgid)
 
 /* SET_MESSAGE_INTERVAL for LOCAL_POSITION_NED and ATTITUDE: sent once the autopilot is known,
  * every second until the streams arrive, again when they stop; refusals counted. */
+/* A status change is told at once: one HEARTBEAT with the new MAV_STATE at the next poll, then
+ * the 1 Hz period restarts from there (a 0.3 s window of BOOT must not end unseen). */
+static void test_feed_status_change(void **state)
+{
+    (void)state;
+    occ_map_t map;
+    occ_map_config_t mc = occ_map_config_default();
+    assert_int_equal(occ_map_init(&map, &mc, arena, sizeof arena), OCC_OK);
+    occ_mav_feed_config_t cfg = occ_mav_feed_config_default();
+    static occ_mav_feed_t feed;
+    assert_int_equal(occ_mav_feed_init(&feed, &cfg), OCC_OK);
+    occ_mav_feed_set_status(&feed, 0); /* before the first poll: no effect on the schedule */
+    uint8_t out[OCC_MAV_FRAME_MAX];
+    uint8_t seen[8];
+    unsigned n_seen = 0;
+    static const uint64_t t_set[3] = {1300000, 1500000, 1500000};
+    static const uint8_t st_set[3] = {3 /* STANDBY */, 4 /* ACTIVE */, 4 /* unchanged */};
+    for (uint64_t t = 1000000; t <= 3000000; t += 100000) {
+        for (unsigned i = 0; i < 3; i++) {
+            if (t == t_set[i]) {
+                occ_mav_feed_set_status(&feed, st_set[i]);
+            }
+        }
+        size_t n;
+        while ((n = occ_mav_feed_poll(&feed, &map, t, out, sizeof out)) > 0) {
+            occ_mav_parser_t p;
+            occ_mav_parser_init(&p);
+            occ_mav_result_t r = OCC_MAV_NONE;
+            occ_mav_frame_t fr;
+            assert_int_equal(parse_all(&p, out, n, &r, &fr), 1);
+            occ_mav_heartbeat_t hb;
+            if (fr.msgid == 0 && occ_mav_decode_heartbeat(&fr, &hb) == OCC_OK && n_seen < 8u) {
+                seen[n_seen++] = (uint8_t)(hb.system_status | (uint8_t)((t / 100000u) << 4));
+            }
+        }
+    }
+    /* t=1.0 s (status 0), 1.3 s STANDBY at once, 1.5 s ACTIVE at once, 2.5 s, period from 1.5 s */
+    assert_int_equal(n_seen, 4);
+    assert_int_equal(seen[0] & 15, 0);
+    assert_int_equal(seen[1], (uint8_t)(3 | (13 << 4)));
+    assert_int_equal(seen[2], (uint8_t)(4 | (15 << 4)));
+    assert_int_equal(seen[3], (uint8_t)(4 | (25 << 4)));
+}
+
 static void test_feed_requests(void **state)
 {
     (void)state;
@@ -585,6 +630,7 @@ int main(void)
         cmocka_unit_test(test_feed_unknown_encoding),
         cmocka_unit_test(test_feed_sysid),
         cmocka_unit_test(test_feed_requests),
+        cmocka_unit_test(test_feed_status_change),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

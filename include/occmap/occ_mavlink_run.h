@@ -148,7 +148,9 @@ bool occ_mav_pose_rx_take(occ_mav_pose_rx_t *rx, const occ_mav_frame_t *f, occ_p
 bool occ_mav_is_pose_msg(uint32_t msgid);
 
 /* The feed's HEARTBEAT system_status (MAV_STATE; default ACTIVE): the loop sets BOOT, ACTIVE or
- * CRITICAL as its inputs are. Defined in mavlink_feed.c. No effect for NULL. */
+ * CRITICAL as its inputs are. A change makes a HEARTBEAT due at once (the next
+ * occ_mav_feed_poll sends it), then the 1 Hz period resumes from there. Defined in
+ * mavlink_feed.c. No effect for NULL or for the status it already has. */
 void occ_mav_feed_set_status(occ_mav_feed_t *f, uint8_t system_status);
 
 /* ---- Budgets (issue 24) -------------------------------------------------------------------

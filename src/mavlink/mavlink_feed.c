@@ -70,8 +70,13 @@ occ_err_t occ_mav_feed_init(occ_mav_feed_t *f, const occ_mav_feed_config_t *cfg)
 
 void occ_mav_feed_set_status(occ_mav_feed_t *f, uint8_t system_status)
 {
-    if (f != NULL) {
+    if (f != NULL && f->priv.system_status != system_status) {
         f->priv.system_status = system_status;
+        /* A change is told at once, not up to a heartbeat period later: the autopilot (and
+         * a GCS) should see BOOT -> ACTIVE -> CRITICAL as it happens. */
+        if (f->priv.started) {
+            f->priv.next_heartbeat_us = 0;
+        }
     }
 }
 
@@ -363,7 +368,11 @@ size_t occ_mav_feed_poll(occ_mav_feed_t *f, const occ_map_t *map, uint64_t now_u
         f->priv.next_obstacle_us = now_us;
     }
     if (now_us >= f->priv.next_heartbeat_us) {
-        f->priv.next_heartbeat_us = advance(f->priv.next_heartbeat_us, f->cfg.heartbeat_period_us, now_us);
+        const uint32_t hb_period = f->cfg.heartbeat_period_us;
+        /* 0 = made due by a status change: the period restarts from now */
+        f->priv.next_heartbeat_us = f->priv.next_heartbeat_us == 0u
+                                        ? now_us + hb_period
+                                        : advance(f->priv.next_heartbeat_us, hb_period, now_us);
         occ_mav_heartbeat_t hb;
         hb.custom_mode = 0;
         hb.type = MAV_TYPE_ONBOARD_CONTROLLER_;
