@@ -189,7 +189,12 @@ symcheck: $(BUILD)/libocc.a cross-objs
 
 # ---- other entry points (fragments add steps) -----------------------------------------------------
 demo: all $(DEMO_STEPS)
-bench: all $(BENCH_STEPS)
+# bench: a fresh build/bench/rows, every step, then the one table made of their rows
+# (bench/table.mk): after the steps, whatever -j runs them in parallel.
+bench: all
+	@rm -rf $(BENCH_ROWS_DIR) && mkdir -p $(BENCH_ROWS_DIR)
+	@$(MAKE) --no-print-directory $(BENCH_STEPS)
+	@$(MAKE) --no-print-directory bench-table
 fuzz: $(DEPS_STAMP) $(FUZZ_STEPS)
 
 clean:
