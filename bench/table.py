@@ -7,8 +7,9 @@ Every bench writes its rows (bench/bench_rows.hpp) to build/bench/rows/<bench>.j
     that is not a JSON list of such rows is an error naming the file, and nothing is written);
   - joins them with EXPECTED below (the rows issue 22 asks for, grouped as its table): a bench's
     id matches an expected id when it is that id or continues it ("query/lookup_random/geb079"
-    takes ".../geb079/cursor" and ".../geb079/root"), segments compared without case, '_', '-'
-    or '.', numbers as numbers ("0.1" is "0.10"); what matched another spelling is printed;
+    takes ".../geb079/cursor" and ".../geb079/root"), compared without case, '/', '_', '-' or
+    '.', numbers as numbers ("0.1" is "0.10") - takes() below; what matched another spelling is
+    printed;
   - an expected row no bench wrote stays in the table as "not measured"; a row no expected id
     takes goes to a last group "other rows", so nothing is dropped silently;
   - writes OUT/table.json (the joined rows, the date, commit and machine) and OUT/table.md, and
@@ -167,22 +168,45 @@ def load_rows(rows_dir):
     return out, names
 
 
-def canon(segment):
-    """One id segment as compared: a number by value, else lower case without '_', '-', '.'."""
+def tokens(rid):
+    """An id as compared: split at '/', '_' and '-', lower case, numbers by value ("0.1" is
+    "0.10", "16" is "16.0"), '.' dropped inside words ("scan.dat" is "scandat")."""
+    out = []
+    for t in re.split(r"[/_\-]+", rid.lower()):
+        if is_number(t):
+            out.append("%.12g" % float(t))
+        elif t.replace(".", ""):
+            out.append(t.replace(".", ""))
+    return out
+
+
+def is_number(token):
     try:
-        v = float(segment)
-        if math.isfinite(v):
-            return repr(v)
+        return math.isfinite(float(token))
     except ValueError:
-        pass
-    return re.sub(r"[_.\-]", "", segment.lower())
+        return False
+
+
+def token_takes(e, b):
+    """A number only its value; a word also a longer word ("superray" takes "superrays")."""
+    return e == b or (not is_number(e) and b.startswith(e))
 
 
 def takes(expected, bench_id):
-    """Whether expected id takes bench_id: equal, or bench_id continues it by segments."""
-    e = [canon(s) for s in expected.split("/")]
-    b = [canon(s) for s in bench_id.split("/")]
-    return len(b) >= len(e) and b[:len(e)] == e
+    """Whether an expected id takes a bench's id: token by token (token_takes), the bench's id
+    may go on (".../geb079" takes ".../geb079/cursor"); or the same text without separators
+    ("query/lookuprandom/geb079" for "query/lookup_random/geb079")."""
+    e, b = tokens(expected), tokens(bench_id)
+    if len(b) >= len(e) and all(token_takes(x, y) for x, y in zip(e, b)):
+        return True
+    joined, acc = "".join(e), ""
+    for t in b:
+        acc += t
+        if acc == joined:
+            return True
+        if not joined.startswith(acc):
+            break
+    return False
 
 
 def join(rows):
@@ -195,7 +219,8 @@ def join(rows):
                 used.add(r["id"])
                 if r["id"] != eid:
                     matched.append((eid, r["id"], r["source"]))
-                lines.append(dict(r, group=group, expected=eid, status="measured"))
+                lines.append(dict(r, group=group, expected=eid, status="measured",
+                                  target=r["target"] or target))
             if not hits:
                 lines.append({"group": group, "expected": eid, "status": NOT_MEASURED,
                               "work": work, "target": target})

@@ -74,6 +74,37 @@ GROUPS = ["integration", "lookups", "collision / ray", "memory / scratch", "proj
           "other rows (not in the issue's list)"]
 
 
+# (expected id, a bench's id, whether the first takes the second): bench/table.py's takes().
+MATCH_CASES = [
+    ("query/lookup_random/geb079", "query/lookup_random/geb079/cursor", True),
+    ("query/lookup_random/geb079", "query/lookup_random/geb079.bt", True),
+    ("query/lookup_random/geb079", "query/lookuprandom/geb079", True),
+    ("query/lookup_random/geb079", "query/lookup_random/fr_079", False),
+    ("query/sphere_0.25", "query/sphere/0.250/unknown_unsafe", True),
+    ("query/sphere_0.25", "query/sphere_0.255", False),
+    ("insert/scan.dat/0.10/simple", "insert/scan_dat/0.1/simple", True),
+    ("insert/scan.dat/0.10/simple", "insert/scan.dat/0.05/simple", False),
+    ("insert/tum/0.10/superray_vs_simple", "insert/tum/0.1/superrays_vs_simple", True),
+    ("memory/scan.dat/0.05/16bit", "memory/scan.dat/0.05/16-bit", True),
+    ("memory/scan.dat/0.05/8bit", "memory/scan.dat/0.05/16bit", False),
+    ("scratch/scan.dat/0.05/8MB", "scratch/scan.dat/0.05/8_mb", True),
+    ("projective/fr1_rpy/frame_p50", "projective/fr1_rpy/frame_p99", False),
+    ("query/raycast_10m", "query/ray_cast_10m", True),
+]
+
+
+def matching():
+    sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+    sys.path.insert(0, os.path.dirname(TABLE))
+    import table  # noqa: E402 - bench/table.py itself
+    for e, b, want in MATCH_CASES:
+        check(table.takes(e, b) == want, "takes(%s, %s) is %s" % (e, b, want))
+    ids = table.expected_ids()
+    overlap = [(x, y) for x in ids for y in ids if x != y and table.takes(x, y)]
+    check(len(ids) == 21 and len(set(ids)) == 21 and not overlap,
+          "21 distinct expected ids, none takes another's (%s)" % overlap)
+
+
 def run(*args):
     p = subprocess.run([sys.executable, TABLE] + list(args), capture_output=True, text=True)
     return p.returncode, p.stdout, p.stderr
@@ -177,6 +208,7 @@ def readme(out):
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
+    matching()
     good_rows(out)
     malformed(out)
     readme(out)
