@@ -331,6 +331,10 @@ def make_table(rows_dir, out_dir):
         f.write(text)
     for eid, bid, src in matched:
         print("table: %s <- %s (%s)" % (eid, bid, src))
+    other = ["%s (%s)" % (l["id"], l["source"]) for l in lines if l["group"] == OTHER_GROUP]
+    if other:
+        print("table: rows no expected id takes (shown under \"%s\"): %s" % (
+            OTHER_GROUP, ", ".join(other)))
     missing = [l["expected"] for l in lines if l["status"] == NOT_MEASURED]
     print("table: %d rows from %s; not measured: %s" % (
         len(rows), ", ".join(files) or "no rows file", ", ".join(missing) or "none"))

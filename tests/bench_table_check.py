@@ -136,6 +136,8 @@ def good_rows(out):
     check(md in so, "stdout ends with the table")
     check("table: insert/scan.dat/0.10/discrete <- insert/scan_dat/0.1/discrete (a.json)" in so,
           "stdout says which id matched another spelling")
+    check("table: rows no expected id takes (shown under \"other rows (not in the issue's list)\")"
+          ": query/something_new (b.json)" in so, "stdout names the row no expected id takes")
     check(lines[0].startswith("Made by `make bench` on ") and lines[0].endswith(
         ". Rows measured: 6 (target met: 1); expected rows not measured: 17."),
         "header line: %s" % lines[0])
