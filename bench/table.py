@@ -321,6 +321,8 @@ def make_table(rows_dir, out_dir):
     lines, matched = join(rows)
     joined = {"date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
               "commit": commit_line(), "machine": machine_line(), "files": files,
+              "file_times": {n: time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime(
+                  os.path.getmtime(os.path.join(rows_dir, n)))) for n in files},
               "expected": expected_ids(), "rows": lines}
     text = render(joined)
     os.makedirs(out_dir, exist_ok=True)
@@ -391,7 +393,11 @@ def readme(path, results, write):
     if write:
         with open(path, "w", encoding="utf-8") as f:
             f.write(before + want + after)
-        print("table: %s: Performance section rewritten from %s" % (path, results))
+        times = joined.get("file_times", {})
+        print("table: %s: Performance section rewritten from %s, made %s from %s" % (
+            path, results, joined["date"], ", ".join(
+                "%s (written %s)" % (n, times.get(n, "?")) for n in joined.get("files", []))
+            or "no rows file"))
         return 0
     if joined["expected"] != expected_ids():
         print("FAIL: %s was joined with another list of expected rows than bench/table.py's: "
