@@ -2,7 +2,11 @@
 // insert.cpp - point-cloud integration: occmap against OctoMap 1.9.7 in the same run.
 // Prints a table (median ms per scan of >= 5 repetitions, ratio to the matching OctoMap call,
 // memory vs OctoMap's memoryUsage(), whether the maps are equal) and writes build/bench/insert.json.
-// usage: insert [--reps N] [--quick] [--json PATH]
+// Every configuration runs in interleaved rounds (OctoMap, OctoMap discretize, each occmap
+// method, then the next round), so the per-round ratios pair runs made under the same load; the
+// rows of issue 22's table (bench_rows.hpp) go to build/bench/rows/insert.json.
+// usage: insert [--reps N] [--quick] [--json PATH] [--rows PATH] [--only DATA] [--res R]
+//               [--frames N]
 #include <octomap/OcTree.h>
 #include <octomap/octomap.h>
 
@@ -17,6 +21,7 @@
 #include <vector>
 
 #include "../tests/support/oracle_res.hpp"
+#include "bench_rows.hpp"
 
 extern "C" {
 #include "occmap/occmap.h"
@@ -165,6 +170,7 @@ struct Row {
 };
 
 static std::vector<Row> rows;
+static std::vector<BenchRow> bench_rows_out; // the rows of the issue-22 table
 static std::vector<uint8_t> arena, scratch;
 
 // OctoMap's sensor model exactly (logodds of 0.7, 0.4, 0.1192, 0.971).
@@ -204,50 +210,22 @@ static double run_occ_once(const Dataset &d, float res, const occ_insert_params_
     return total / (double)d.scans.size();
 }
 
-static double run_occ(const Dataset &d, float res, const occ_insert_params_t &p, int reps,
-                      occ_map_t &m, occ_insert_result_t &last)
+// One OctoMap pass over the dataset into a fresh tree (kept in `keep`): CPU ms per scan.
+static double run_octo_once(const Dataset &d, float res, bool discretize, OcTree *&keep)
 {
-    std::vector<double> times;
-    for (int r = 0; r < reps; r++) times.push_back(run_occ_once(d, res, p, m, last));
-    return median(times);
-}
-
-// SUPER_RAYS against SIMPLE in interleaved pairs, so that the machine's drift hits both alike:
-// the median of the per-pair time ratios.
-static double superrays_vs_simple(const Dataset &d, float res, int reps)
-{
-    occ_insert_params_t ps = occ_insert_params_default(), pr = occ_insert_params_default();
-    ps.method = OCC_INSERT_SIMPLE;
-    pr.method = OCC_INSERT_SUPER_RAYS;
-    occ_map_t m;
-    occ_insert_result_t out;
-    std::vector<double> ratios;
-    for (int r = 0; r < reps; r++) {
-        const double ts = run_occ_once(d, res, ps, m, out);
-        ratios.push_back(ts / run_occ_once(d, res, pr, m, out));
+    delete keep;
+    keep = new OcTree(oracle_user_resolution((double)res)); // OcTree(0.1) for 0.1f
+    double total = 0;
+    for (const Scan &s : d.scans) {
+        octomap::Pointcloud pc;
+        pc.reserve(s.pts.size());
+        for (const occ_vec3_t &p : s.pts) pc.push_back(p.x, p.y, p.z);
+        const double t0 = now_ms();
+        keep->insertPointCloud(pc, point3d(s.origin.x, s.origin.y, s.origin.z), -1.0, false,
+                               discretize);
+        total += now_ms() - t0;
     }
-    return median(ratios);
-}
-
-static double run_octo(const Dataset &d, float res, bool discretize, int reps, OcTree *&keep)
-{
-    std::vector<double> times;
-    for (int r = 0; r < reps; r++) {
-        delete keep;
-        keep = new OcTree(oracle_user_resolution((double)res)); // OcTree(0.1) for 0.1f
-        double total = 0;
-        for (const Scan &s : d.scans) {
-            octomap::Pointcloud pc;
-            pc.reserve(s.pts.size());
-            for (const occ_vec3_t &p : s.pts) pc.push_back(p.x, p.y, p.z);
-            const double t0 = now_ms();
-            keep->insertPointCloud(pc, point3d(s.origin.x, s.origin.y, s.origin.z), -1.0, false,
-                                   discretize);
-            total += now_ms() - t0;
-        }
-        times.push_back(total / (double)d.scans.size());
-    }
-    return median(times);
+    return total / (double)d.scans.size();
 }
 
 static const char *method_name(occ_insert_method_t m)
@@ -262,72 +240,171 @@ static const char *method_name(occ_insert_method_t m)
     return "?";
 }
 
-static void bench_dataset(const Dataset &d, float res, int reps, int octo_reps)
+// One occmap method of one configuration: its times per round and, from the last round, its map's
+// check against the matching OctoMap tree.
+struct MethodRun {
+    occ_insert_method_t meth;
+    occ_insert_params_t p;
+    std::vector<double> t;  // CPU ms per scan, one per round
+    std::string eq;         // the printed equality note
+    bool equal = false;     // map equal to the reference tree (every leaf within tol)
+    occ_insert_result_t out = {};
+    occ_map_stats_t st = {};
+};
+
+static bool vs_discrete(occ_insert_method_t m)
+{
+    return m == OCC_INSERT_DISCRETE || m == OCC_INSERT_FAST_DISCRETE;
+}
+
+// The last round's map against the matching OctoMap tree (DISCRETE, FAST: discretize = true).
+static void check_run(MethodRun &mr, const occ_map_t &m, const OcTree &ref, float tol, unsigned dfast)
+{
+    occ_map_pool_stats(&m, &mr.st);
+    const Diff df = compare(m, ref, tol);
+    mr.equal = df.bad == 0;
+    char buf[160];
+    if (mr.meth == OCC_INSERT_FAST_DISCRETE && dfast > 0) {
+        std::snprintf(buf, sizeof buf, "d=%u: +%zu free, %zu occ missed (voxels)", dfast,
+                      df.extra_free, df.missed_occ);
+        mr.equal = false; // approximate by design
+    } else {
+        std::snprintf(buf, sizeof buf, "%s (%zu of %zu leaves differ)", df.bad == 0 ? "yes" : "NO",
+                      df.bad, df.checked);
+    }
+    mr.eq = buf;
+}
+
+// One row of the issue-22 table from paired rounds (a[i]: OctoMap or the base, b[i]: occmap).
+static void add_bench_row(const std::string &id, const std::string &work,
+                          const std::vector<double> &a, const std::vector<double> &b,
+                          bool octomap_side, const std::string &target, double want,
+                          const std::string &equal)
+{
+    BenchRow r;
+    r.id = id;
+    r.work = work;
+    r.unit = "ms";
+    r.occmap = bench_median(b);
+    if (octomap_side) r.octomap = bench_median(a);
+    else {
+        r.base_label = "SIMPLE";
+        r.base = bench_median(a);
+    }
+    bench_row_ratios(r, a, b);
+    r.target = target;
+    r.met = r.ratio >= want;
+    r.equal = equal;
+    bench_rows_out.push_back(r);
+}
+
+// The issue-22 rows this configuration gives (scan.dat 0.1 / 0.05, TUM 0.05 / 0.1 / 0.2).
+static void table_rows(const Dataset &d, const char *res_s, const std::vector<MethodRun> &runs,
+                       const std::vector<double> &t_os, const std::vector<double> &t_od)
+{
+    const bool scan = d.name == "scan.dat", tum = d.name == "tum_fr2_pioneer";
+    const std::string r = res_s, base = "insert/" + (tum ? std::string("tum") : d.name) + "/" + r + "/";
+    const char *want_s = r == "0.05" ? "ratio >= 45" : "ratio >= 35";
+    const double want = r == "0.05" ? 45.0 : 35.0;
+    const std::string ms_per = " (CPU ms per scan, " + std::to_string(d.scans.size()) + " scan" +
+                               (d.scans.size() == 1 ? "" : "s") + ")";
+    if (scan && (r == "0.10" || r == "0.05")) {
+        add_bench_row(base + "simple", "scan.dat " + r + " m, SIMPLE (exact) vs insertPointCloud" + ms_per,
+                      t_os, runs[0].t, true, want_s, want, runs[0].equal ? "yes" : "no");
+        add_bench_row(base + "discrete",
+                      "scan.dat " + r + " m, DISCRETE (exact) vs insertPointCloud discretize" + ms_per,
+                      t_od, runs[1].t, true, want_s, want, runs[1].equal ? "yes" : "no");
+    }
+    if ((scan || tum) && r == "0.05") {
+        const MethodRun *best = nullptr; // the fastest method whose map equals OctoMap's
+        for (const MethodRun &mr : runs)
+            if (mr.equal && (best == nullptr || median(mr.t) < median(best->t))) best = &mr;
+        if (best != nullptr) {
+            const bool disc = vs_discrete(best->meth);
+            const std::string name = tum ? "10 TUM frames" : "scan.dat";
+            add_bench_row(base + "best",
+                          name + " 0.05 m, best exact method: " + method_name(best->meth) +
+                              " vs insertPointCloud" + (disc ? " discretize" : "") + ms_per,
+                          disc ? t_od : t_os, best->t, true, tum ? "ratio >= 10" : "ratio >= 45",
+                          tum ? 10.0 : 45.0, "yes");
+        }
+    }
+    if (tum && (r == "0.10" || r == "0.20"))
+        add_bench_row(base + "superray_vs_simple",
+                      "10 TUM frames " + r + " m, SUPER_RAYS vs SIMPLE" + ms_per, runs[0].t,
+                      runs[3].t, false, "ratio >= 1.5 vs SIMPLE", 1.5, runs[3].equal ? "yes" : "no");
+}
+
+// One dataset at one resolution: `reps` interleaved rounds (OctoMap, OctoMap discretize, then
+// each occmap method, each into a fresh map), medians of CPU ms per scan; the maps of the last
+// round are compared.
+static void bench_dataset(const Dataset &d, float res, int reps)
 {
     const float tol = 0.002f * (float)d.scans.size() + 0.001f;
     OcTree *octo_simple = nullptr, *octo_disc = nullptr;
-    const double t_os = run_octo(d, res, false, octo_reps, octo_simple);
-    const double t_od = run_octo(d, res, true, octo_reps, octo_disc);
-    const size_t mem_os = octo_simple->memoryUsage(), mem_od = octo_disc->memoryUsage();
-    char resbuf[32];
-    std::snprintf(resbuf, sizeof resbuf, "%.2f", (double)res);
-    rows.push_back(Row{d.name, "octomap", (double)res, t_os, 1.0, mem_os, mem_os, "-", 0, 0});
-    rows.push_back(
-        Row{d.name, "octomap-discrete", (double)res, t_od, 1.0, mem_od, mem_od, "-", 0, 0});
     unsigned dfast = 0;
     while (res * (float)(1u << (dfast + 1)) <= 0.2f + 1e-6f) dfast++;
     const occ_insert_method_t methods[] = {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE,
                                            OCC_INSERT_FAST_DISCRETE, OCC_INSERT_SUPER_RAYS};
+    std::vector<MethodRun> runs;
     for (occ_insert_method_t meth : methods) {
-        occ_insert_params_t p = occ_insert_params_default();
-        p.method = meth;
-        p.fast_n = 0;
-        p.fast_d = (uint8_t)dfast;
-        occ_map_t m;
-        occ_insert_result_t out = {};
-        const double t = run_occ(d, res, p, reps, m, out);
-        const bool vs_disc = meth == OCC_INSERT_DISCRETE || meth == OCC_INSERT_FAST_DISCRETE;
-        const OcTree &ref = vs_disc ? *octo_disc : *octo_simple;
-        const double ref_t = vs_disc ? t_od : t_os;
-        const size_t ref_mem = vs_disc ? mem_od : mem_os;
-        occ_map_stats_t st;
-        occ_map_pool_stats(&m, &st);
-        std::string eq;
-        const Diff df = compare(m, ref, tol);
-        char buf[160];
-        if (meth == OCC_INSERT_FAST_DISCRETE && dfast > 0) {
-            std::snprintf(buf, sizeof buf, "d=%u: +%zu free, %zu occ missed (voxels)", dfast,
-                          df.extra_free, df.missed_occ);
-            eq = buf;
-        } else {
-            std::snprintf(buf, sizeof buf, "%s (%zu of %zu leaves differ)",
-                          df.bad == 0 ? "yes" : "NO", df.bad, df.checked);
-            eq = buf;
+        MethodRun mr;
+        mr.meth = meth;
+        mr.p = occ_insert_params_default();
+        mr.p.method = meth;
+        mr.p.fast_n = 0;
+        mr.p.fast_d = (uint8_t)dfast;
+        runs.push_back(mr);
+    }
+    std::vector<double> t_os, t_od;
+    for (int r = 0; r < reps; r++) {
+        t_os.push_back(run_octo_once(d, res, false, octo_simple));
+        t_od.push_back(run_octo_once(d, res, true, octo_disc));
+        for (MethodRun &mr : runs) {
+            occ_map_t m;
+            mr.t.push_back(run_occ_once(d, res, mr.p, m, mr.out));
+            if (r == reps - 1)
+                check_run(mr, m, vs_discrete(mr.meth) ? *octo_disc : *octo_simple, tol, dfast);
         }
-        if (meth == OCC_INSERT_SUPER_RAYS && out.rays_cast > 0) {
-            // The super-ray target is a ratio to SIMPLE in the same run; points per traversal
+    }
+    const double m_os = median(t_os), m_od = median(t_od);
+    const size_t mem_os = octo_simple->memoryUsage(), mem_od = octo_disc->memoryUsage();
+    rows.push_back(Row{d.name, "octomap", (double)res, m_os, 1.0, mem_os, mem_os, "-", 0, 0});
+    rows.push_back(Row{d.name, "octomap-discrete", (double)res, m_od, 1.0, mem_od, mem_od, "-", 0, 0});
+    for (MethodRun &mr : runs) {
+        const double t = median(mr.t);
+        const bool vd = vs_discrete(mr.meth);
+        std::string eq = mr.eq;
+        char buf[160];
+        if (mr.meth == OCC_INSERT_SUPER_RAYS && mr.out.rays_cast > 0) {
+            // The super-ray target is a ratio to SIMPLE in the same rounds; points per traversal
             // (last scan) says how much the grouping found.
+            std::vector<double> q;
+            for (size_t i = 0; i < mr.t.size(); i++) q.push_back(runs[0].t[i] / mr.t[i]);
             std::snprintf(buf, sizeof buf,
                           "; %.2fx SIMPLE (median of %d interleaved pairs), %.1f points per traversal",
-                          superrays_vs_simple(d, res, reps),  reps,
-                          (double)out.points_integrated / (double)out.rays_cast);
+                          median(q), reps,
+                          (double)mr.out.points_integrated / (double)mr.out.rays_cast);
             eq += buf;
         }
-        std::string name = method_name(meth);
-        if (meth == OCC_INSERT_FAST_DISCRETE) name += "(n=0,d=" + std::to_string(dfast) + ")";
-        rows.push_back(Row{d.name, name, (double)res, t, ref_t / t, st.bytes_used, ref_mem, eq,
-                           out.voxels_updated, out.voxel_visits});
+        std::string name = method_name(mr.meth);
+        if (mr.meth == OCC_INSERT_FAST_DISCRETE) name += "(n=0,d=" + std::to_string(dfast) + ")";
+        rows.push_back(Row{d.name, name, (double)res, t, (vd ? m_od : m_os) / t, mr.st.bytes_used,
+                           vd ? mem_od : mem_os, eq, mr.out.voxels_updated, mr.out.voxel_visits});
         const Row &r = rows.back();
         std::printf("%-22s %5.2f %-18s %10.2f ms %8.1fx  mem %10zu B (%5.1f%% of OctoMap)  visits "
                     "%zu  equal: %s\n",
                     r.data.c_str(), r.res, r.method.c_str(), r.ms, r.ratio, r.bytes,
                     100.0 * (double)r.bytes / (double)r.octo_bytes, r.visits, r.equal.c_str());
-        std::fflush(stdout);
     }
     std::printf("%-22s %5.2f %-18s %10.2f ms   (OctoMap, %zu B)\n", d.name.c_str(), (double)res,
-                "octomap", t_os, mem_os);
+                "octomap", m_os, mem_os);
     std::printf("%-22s %5.2f %-18s %10.2f ms   (OctoMap, %zu B)\n", d.name.c_str(), (double)res,
-                "octomap-discrete", t_od, mem_od);
+                "octomap-discrete", m_od, mem_od);
+    std::fflush(stdout);
+    char resbuf[32];
+    std::snprintf(resbuf, sizeof resbuf, "%.2f", (double)res);
+    table_rows(d, resbuf, runs, t_os, t_od);
     delete octo_simple;
     delete octo_disc;
 }
@@ -337,6 +414,7 @@ int main(int argc, char **argv)
     int reps = 5;
     bool quick = false;
     std::string json = "build/bench/insert.json";
+    std::string rows_json = "build/bench/rows/insert.json";
     std::string only;
     float res_only = 0.0f;
     size_t max_frames = 0;
@@ -344,6 +422,7 @@ int main(int argc, char **argv)
         if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--quick")) quick = true;
         else if (!std::strcmp(argv[i], "--json") && i + 1 < argc) json = argv[++i];
+        else if (!std::strcmp(argv[i], "--rows") && i + 1 < argc) rows_json = argv[++i];
         else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
         else if (!std::strcmp(argv[i], "--res") && i + 1 < argc) res_only = (float)std::atof(argv[++i]);
         else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) max_frames = (size_t)std::atoi(argv[++i]);
@@ -399,7 +478,7 @@ int main(int argc, char **argv)
         for (float res : resolutions) {
             if (quick && res < 0.1f && d.name != "scan.dat") continue;
             if (res_only > 0.0f && std::fabs(res - res_only) > 1e-4f) continue;
-            bench_dataset(d, res, reps, reps);
+            bench_dataset(d, res, reps);
         }
     }
     FILE *f = std::fopen(json.c_str(), "w");
@@ -419,5 +498,10 @@ int main(int argc, char **argv)
         std::fprintf(f, "]}\n");
         std::fclose(f);
     }
+    if (!bench_rows_write(rows_json, bench_rows_out)) {
+        std::fprintf(stderr, "bench: cannot write %s\n", rows_json.c_str());
+        return 1;
+    }
+    std::printf("wrote %zu table rows to %s\n", bench_rows_out.size(), rows_json.c_str());
     return 0;
 }
