@@ -5,7 +5,9 @@
 // loaded through OctoMap and through occ_file_load (or, if that fails, copied leaf by leaf).
 // Prints a table of medians (ns per operation over 9 batches, occmap and OctoMap batches
 // alternating) and the median of the per-batch ratios as the speedup, and writes
-// build/bench/query.json.   usage: query [--quick] [--json PATH] [MAP...]
+// build/bench/query.json; the rows of issue 22's table (bench_rows.hpp: lookups on geb079.bt and
+// fr_079, sphere and ray cast on geb079.bt) go to build/bench/rows/query.json.
+// usage: query [--quick] [--json PATH] [--rows PATH] [MAP...]
 #include <octomap/OcTree.h>
 #include <octomap/AbstractOcTree.h>
 
@@ -25,6 +27,8 @@ extern "C" {
 #include "occmap/occmap.h"
 #include "occmap/host/occ_file.h"
 }
+
+#include "bench_rows.hpp"
 
 using octomap::OcTree;
 using octomap::OcTreeKey;
@@ -50,6 +54,7 @@ static double now_ns()
 // per-batch time ratios (b / a), which is the speedup reported.
 struct Paired {
     double a_ns, b_ns, ratio;
+    std::vector<double> va, vb; // per-batch ns per operation, in batch order (a: occmap)
 };
 // A template, not std::function: an indirect call per operation would add a few ns to both sides,
 // a fifth of a path-cached lookup.
@@ -70,13 +75,44 @@ static Paired paired(size_t na, const FA &fa, size_t nb, const FB &fb, int batch
         tb.push_back(bb);
         r.push_back(bb / a);
     }
+    const std::vector<double> va = ta, vb = tb;
     std::sort(ta.begin(), ta.end());
     std::sort(tb.begin(), tb.end());
     std::sort(r.begin(), r.end());
-    return Paired{ta[ta.size() / 2], tb[tb.size() / 2], r[r.size() / 2]};
+    return Paired{ta[ta.size() / 2], tb[tb.size() / 2], r[r.size() / 2], va, vb};
 }
 
 static volatile size_t sink;
+
+// The rows of issue 22's table (bench_rows.hpp), written to build/bench/rows/query.json.
+static std::vector<BenchRow> table_rows;
+
+// The table's short name of a map this bench measures for it ("" for the others).
+static std::string table_map(const std::string &file)
+{
+    if (file == "geb079.bt") return "geb079";
+    if (file.compare(0, 6, "fr_079") == 0) return "fr_079";
+    return "";
+}
+
+// One table row from a paired measurement (ns per operation, occmap against OctoMap's batches).
+// max_ns / min_ratio < 0: that part of the target is not set.
+static void table_row(const std::string &id, const std::string &work, const Paired &p,
+                      const std::string &target, double max_ns, double min_ratio, bool equal)
+{
+    BenchRow r;
+    r.id = id;
+    r.work = work;
+    r.unit = "ns";
+    r.octomap = bench_median(p.vb);
+    r.occmap = bench_median(p.va);
+    bench_row_ratios(r, p.vb, p.va);
+    r.target = target;
+    r.met = (max_ns >= 0 || min_ratio >= 0) && (max_ns < 0 || r.occmap <= max_ns) &&
+            (min_ratio < 0 || r.ratio >= min_ratio);
+    r.equal = equal ? "yes" : "no";
+    table_rows.push_back(r);
+}
 
 struct Row {
     std::string map, op;
@@ -184,6 +220,7 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
         return;
     }
     const std::string name = path.substr(path.find_last_of('/') + 1);
+    const std::string tmap = table_map(name);
     double x0, y0, z0, x1, y1, z1;
     t->getMetricMin(x0, y0, z0);
     t->getMetricMax(x1, y1, z1);
@@ -226,6 +263,10 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
             });
         rows.push_back({name, "point lookup random (occ_map_state_at vs search)", pl.a_ns, pl.b_ns, pl.ratio,
                         std::to_string(same) + "/" + std::to_string(pts.size()) + " same state"});
+        if (!tmap.empty())
+            table_row("query/lookup_random/" + tmap + "/root",
+                      "random point lookup, " + name + ": occ_map_state_at vs search()", pl,
+                      "occmap <= 50 ns, ratio >= 4", 50.0, 4.0, same == pts.size());
         // Along trajectories (5 cm steps from free starts), as a vehicle queries: path cache.
         std::vector<point3d> traj(N * 10);
         for (size_t i = 0; i < traj.size(); i++) {
@@ -241,8 +282,14 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
         }
         occ_lookup_t lk;
         occ_lookup_init(&lk, &map);
-        size_t same_t = 0;
-        for (auto &p : traj) same_t += occ_lookup_state(&lk, v3(p)) == occ_map_state_at(&map, v3(p));
+        size_t same_t = 0, same_octo = 0;
+        for (auto &p : traj) {
+            const occ_state_t s = occ_lookup_state(&lk, v3(p));
+            const octomap::OcTreeNode *n = t->search(p);
+            same_t += s == occ_map_state_at(&map, v3(p));
+            same_octo += (n == nullptr ? s == OCC_STATE_UNKNOWN
+                                       : (t->isNodeOccupied(n) ? s == OCC_STATE_OCCUPIED : s == OCC_STATE_FREE));
+        }
         const auto octo_traj = [&](size_t i) {
             const octomap::OcTreeNode *n = t->search(traj[i]);
             sink += n == nullptr ? 0u : (t->isNodeOccupied(n) ? 2u : 1u);
@@ -255,6 +302,10 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
             octo_traj);
         rows.push_back({name, "point lookup trajectory 5 cm (occ_lookup_state vs search)", pt.a_ns, pt.b_ns, pt.ratio,
                         std::to_string(same_t) + "/" + std::to_string(traj.size()) + " same as occ_map_state_at"});
+        if (tmap == "geb079")
+            table_row("query/lookup_trajectory",
+                      "trajectory lookup (5 cm steps), geb079.bt: occ_lookup_state cursor vs search()", pt,
+                      "occmap < 20 ns", 20.0, -1.0, same_t == traj.size() && same_octo == traj.size());
         rows.push_back({name, "point lookup trajectory 5 cm (occ_map_state_at vs search)", pt2.a_ns, pt2.b_ns,
                         pt2.ratio, ""});
     }
@@ -291,6 +342,11 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
                         std::to_string(unsafe) + "/" + std::to_string(N) + " unsafe"});
         rows.push_back({name, "sphere r=0.25 unknown-unsafe vs octomap search/voxel", ss.a_ns, ss.b_ns, ss.ratio,
                         std::to_string(agree) + "/" + std::to_string(N) + " same answer"});
+        if (tmap == "geb079")
+            table_row("query/sphere_0.25",
+                      "sphere r=0.25 m, unknown unsafe, geb079.bt: occ_collide_sphere vs search() per voxel "
+                      "(the same answer)",
+                      ss, "none set", -1.0, -1.0, agree == N);
         rows.push_back({name, "sphere r=0.25 occupied-only vs octomap leaf_bbx", so.a_ns, so.b_ns, so.ratio, ""});
         // The same 200 poses over and over (checks around a hovering vehicle): each side's map
         // stays in cache, so this is the compute alone; the rows above include the misses after
@@ -336,6 +392,9 @@ static void bench_map(const std::string &path, bool quick, std::vector<Row> &row
         const Paired ri = cast_pair(true);
         rows.push_back({name, "castRay 10 m ignoreUnknown", ri.a_ns, ri.b_ns, ri.ratio,
                         std::to_string(same) + "/" + std::to_string(N) + " identical, " + std::to_string(hits) + " hits"});
+        if (tmap == "geb079")
+            table_row("query/raycast_10m", "10 m ray cast, ignore unknown, geb079.bt: occ_cast_ray vs castRay()",
+                      ri, "none set", -1.0, -1.0, same == N);
         const Paired ru = cast_pair(false);
         rows.push_back({name, "castRay 10 m stop at unknown", ru.a_ns, ru.b_ns, ru.ratio, ""});
     }
@@ -510,10 +569,12 @@ int main(int argc, char **argv)
 {
     bool quick = false;
     std::string json = "build/bench/query.json";
+    std::string rows_json = "build/bench/rows/query.json";
     std::vector<std::string> maps;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) quick = true;
         else if (!strcmp(argv[i], "--json") && i + 1 < argc) json = argv[++i];
+        else if (!strcmp(argv[i], "--rows") && i + 1 < argc) rows_json = argv[++i];
         else maps.push_back(argv[i]);
     }
     if (maps.empty()) maps.push_back("/usr/share/doc/liboctomap-dev/examples/data/geb079.bt");
@@ -547,5 +608,10 @@ int main(int argc, char **argv)
     fprintf(f, "]}\n");
     fclose(f);
     printf("wrote %s\n", json.c_str());
+    if (!bench_rows_write(rows_json, table_rows)) {
+        perror(rows_json.c_str());
+        return 1;
+    }
+    printf("wrote %zu table rows to %s\n", table_rows.size(), rows_json.c_str());
     return 0;
 }

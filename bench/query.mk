@@ -2,7 +2,7 @@
 # query.mk - `make bench` step: collision checks, ray casts, line of sight and information gain
 # against OctoMap in the same run (bench/query.cpp) on geb079.bt, ../shared/data/maps/* and maps
 # built from the real scans by `occmap build` (5 cm, written as .bt so that OctoMap reads the same
-# tree). Writes build/bench/query.json.
+# tree). Writes build/bench/query.json and the issue-22 rows build/bench/rows/query.json.
 TUM_DIR := ../shared/data/depth/tum_fr2_pioneer_slam2
 BENCH_QUERY_BUILT := $(BUILD)/bench/maps/scan_dat_5cm.bt $(BUILD)/bench/maps/spherical_scan_5cm.bt \
   $(if $(wildcard $(TUM_DIR)/my_association.txt),$(BUILD)/bench/maps/tum_fr2_pioneer_5cm.bt)
@@ -21,6 +21,7 @@ $(BUILD)/bench/query: bench/query.cpp $(BUILD)/relhost/port/posix/file_io.o $(BU
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $^ -loctomap -loctomath -lm
 bench-query: $(BUILD)/bench/query $(BENCH_QUERY_BUILT)
-	./$(BUILD)/bench/query --json $(BUILD)/bench/query.json $(BENCH_QUERY_MAPS)
+	@mkdir -p $(BUILD)/bench/rows
+	./$(BUILD)/bench/query --json $(BUILD)/bench/query.json --rows $(BUILD)/bench/rows/query.json $(BENCH_QUERY_MAPS)
 BENCH_STEPS += bench-query
 .PHONY: bench-query
