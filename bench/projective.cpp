@@ -5,8 +5,9 @@
 // spread of CPU ms per frame. Then the maps' agreement with OctoMap's (voxels equal, free vs
 // occupied, known vs unknown on a voxel grid) and collision answers (spheres along the camera
 // path), the 500-frame tum_fr1_rpy sequence per frame (median, p99), and the scratch per pixel.
-// usage: projective [--reps N] [--proj-only] (--proj-only: just the projective inserts, for
-// callgrind).
+// The rows of issue 22's table (bench_rows.hpp) go to build/bench/rows/projective.json.
+// usage: projective [--reps N] [--proj-only] [--rows PATH] (--proj-only: just the projective
+// inserts, for callgrind).
 #include <octomap/OcTree.h>
 #include <octomap/octomap.h>
 
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "../tests/support/oracle_res.hpp"
+#include "bench_rows.hpp"
 
 extern "C" {
 #include "occmap/occmap.h"
@@ -57,6 +59,21 @@ struct Frame {
 };
 
 static std::vector<uint8_t> arena, arena_sr, scratch; // arena_sr: SUPER_RAYS' map
+static std::vector<BenchRow> table_rows; // the rows of issue 22's table (bench_rows.hpp)
+
+// A row without an OctoMap side and without a target (per-frame times, scratch).
+static void table_row_alone(const std::string &id, const std::string &work, const std::string &unit,
+                            double value, int reps)
+{
+    BenchRow r;
+    r.id = id;
+    r.work = work;
+    r.unit = unit;
+    r.occmap = value;
+    r.reps = reps;
+    r.target = "none set";
+    table_rows.push_back(r);
+}
 
 static occ_map_config_t octomap_config(float res)
 {
@@ -189,7 +206,7 @@ static occ_state_t octo_state(const OcTree &t, const point3d &p)
 
 // Every second voxel per axis of the box OctoMap's map spans: equal, free-vs-occupied, known in
 // one map only.
-static void agreement(const occ_map_t &m, const OcTree &t, float res)
+static double agreement(const occ_map_t &m, const OcTree &t, float res)
 {
     double x0, y0, z0, x1, y1, z1;
     t.getMetricMin(x0, y0, z0);
@@ -217,6 +234,7 @@ static void agreement(const occ_map_t &m, const OcTree &t, float res)
                 n, 100.0 * (double)eq / (double)n, both_known, fo,
                 100.0 * (double)fo / (double)std::max<size_t>(both_known, 1), ours_only,
                 100.0 * (double)ours_only / (double)n, octo_only, 100.0 * (double)octo_only / (double)n);
+    return 100.0 * (double)eq / (double)n;
 }
 
 // Spheres of radius r along the camera path (each camera position and 0.5..3 m ahead on its
@@ -302,6 +320,14 @@ static void rpy_sequence(float res, float max_m)
                 "bytes (%.2f per pixel)\n",
                 ms.size(), (double)res, (double)max_m, pct(ms, 0.5), pct(ms, 0.99), pct(ms, 1.0),
                 used, (double)used / (double)std::max<size_t>(px, 1));
+    char work[160];
+    std::snprintf(work, sizeof work, "tum_fr1_rpy, %zu frames at %.2f m, max range %.0f m, every "
+                  "pixel, accumulated: per-frame CPU ms, ", ms.size(), (double)res, (double)max_m);
+    const std::string w50 = std::string(work) + "median", w99 = std::string(work) + "p99";
+    if (!ms.empty()) {
+        table_row_alone("projective/fr1_rpy/frame_p50", w50, "ms", pct(ms, 0.5), (int)ms.size());
+        table_row_alone("projective/fr1_rpy/frame_p99", w99, "ms", pct(ms, 0.99), (int)ms.size());
+    }
     free(en);
     free(gt);
 }
@@ -310,9 +336,11 @@ int main(int argc, char **argv)
 {
     int reps = 3;
     bool proj_only = false;
+    std::string rows_json = "build/bench/rows/projective.json";
     for (int i = 1; i < argc; i++) {
         if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--proj-only")) proj_only = true;
+        else if (!std::strcmp(argv[i], "--rows") && i + 1 < argc) rows_json = argv[++i];
     }
     std::vector<Frame> fr;
     if (!load_pioneer(fr)) return 0;
@@ -359,13 +387,47 @@ int main(int argc, char **argv)
                 (size_t)OCC_PROJ_SCRATCH_BYTES(640, 480, OCC_PROJ_OUT_DEFAULT(640, 480)),
                 (double)OCC_PROJ_SCRATCH_BYTES(640, 480, OCC_PROJ_OUT_DEFAULT(640, 480)) / (double)px);
     print_counters();
-    agreement(mp, *octo, res);
+    const double agree = agreement(mp, *octo, res);
     collisions(mp, *octo, fr, res);
+    {
+        // The 10 frames in total (the printed table is per frame); ratio from the rounds' pairs.
+        BenchRow r;
+        r.id = "projective/tum/0.05";
+        char work[200];
+        std::snprintf(work, sizeof work, "%zu TUM pioneer frames 0.05 m, PROJECTIVE vs insertPointCloud "
+                      "(CPU ms for all frames; %.2f%% of voxels agree with OctoMap's map)",
+                      fr.size(), agree);
+        r.work = work;
+        r.unit = "ms";
+        std::vector<double> a, b;
+        for (int i = 0; i < reps; i++) {
+            a.push_back(to[(size_t)i] * (double)fr.size());
+            b.push_back(tp[(size_t)i] * (double)fr.size());
+        }
+        r.octomap = bench_median(a);
+        r.occmap = bench_median(b);
+        bench_row_ratios(r, a, b);
+        r.target = "ratio >= 10";
+        r.met = r.ratio >= 10.0;
+        r.equal = agree >= 100.0 ? "yes" : "no"; // a different method: agreement, not equality
+        table_rows.push_back(r);
+        table_row_alone("projective/scratch_per_pixel",
+                        "scratch of occ_map_insert_depth per pixel, 640x480 TUM frames (most used; "
+                        "OCC_PROJ_SCRATCH_BYTES gives " +
+                            std::to_string((size_t)OCC_PROJ_SCRATCH_BYTES(640, 480, OCC_PROJ_OUT_DEFAULT(640, 480))) +
+                            " bytes)",
+                        "bytes", (double)used / (double)px, reps);
+    }
     std::printf("  (SUPER_RAYS' map against OctoMap, for scale:)\n");
     agreement(ms, *octo, res);
     collisions(ms, *octo, fr, res);
     delete octo;
     for (Frame &f : fr) free(f.pix);
     rpy_sequence(0.05f, 4.0f);
+    if (!bench_rows_write(rows_json, table_rows)) {
+        std::printf("FAIL: cannot write %s\n", rows_json.c_str());
+        return 1;
+    }
+    std::printf("wrote %zu table rows to %s\n", table_rows.size(), rows_json.c_str());
     return 0;
 }
