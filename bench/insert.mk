@@ -6,7 +6,7 @@ $(BUILD)/bench/insert: bench/insert.cpp $(BENCH_INSERT_PORT:%.c=$(BUILD)/relhost
 	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -I/usr/include/eigen3 -o $@ $^ \
 	  -loctomap -loctomath -lpng -lm
 bench-insert: $(BUILD)/bench/insert $(BUILD)/data/scan.dat
-	@mkdir -p $(BUILD)/bench/rows
-	./$(BUILD)/bench/insert --rows $(BUILD)/bench/rows/insert.json
+	@mkdir -p $(BENCH_ROWS_DIR)
+	./$(BUILD)/bench/insert --rows $(BENCH_ROWS_DIR)/insert.json
 BENCH_STEPS += bench-insert
 .PHONY: bench-insert

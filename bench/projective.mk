@@ -8,7 +8,7 @@ $(BUILD)/bench/projective: bench/projective.cpp $(BENCH_PROJ_PORT:%.c=$(BUILD)/r
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $^ -loctomap -loctomath -lpng -lm
 bench-projective: $(BUILD)/bench/projective
-	@mkdir -p $(BUILD)/bench/rows
-	./$(BUILD)/bench/projective --rows $(BUILD)/bench/rows/projective.json
+	@mkdir -p $(BENCH_ROWS_DIR)
+	./$(BUILD)/bench/projective --rows $(BENCH_ROWS_DIR)/projective.json
 BENCH_STEPS += bench-projective
 .PHONY: bench-projective

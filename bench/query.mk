@@ -21,7 +21,7 @@ $(BUILD)/bench/query: bench/query.cpp $(BUILD)/relhost/port/posix/file_io.o $(BU
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $^ -loctomap -loctomath -lm
 bench-query: $(BUILD)/bench/query $(BENCH_QUERY_BUILT)
-	@mkdir -p $(BUILD)/bench/rows
-	./$(BUILD)/bench/query --json $(BUILD)/bench/query.json --rows $(BUILD)/bench/rows/query.json $(BENCH_QUERY_MAPS)
+	@mkdir -p $(BENCH_ROWS_DIR)
+	./$(BUILD)/bench/query --json $(BUILD)/bench/query.json --rows $(BENCH_ROWS_DIR)/query.json $(BENCH_QUERY_MAPS)
 BENCH_STEPS += bench-query
 .PHONY: bench-query

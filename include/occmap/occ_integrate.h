@@ -97,9 +97,19 @@ typedef enum {
      * paper's mapping lines) share one traversal. Same map as SIMPLE, voxel for voxel: rays
      * within 1e-9 (relative) of a decision or ending within 1e-4 voxel of a face are cast
      * singly, and so are end voxels with fewer than super_k points and bundles split into more
-     * than a third as many super rays as rays. Pays off when a voxel holds many points of a
-     * dense sensor (depth cameras at coarse resolution); needs the dense per-scan set (the
-     * scan's box fits the scratch), else it runs as SIMPLE. */
+     * than a third as many super rays as rays. Needs the dense per-scan set (the scan's box
+     * fits the scratch), else it runs as SIMPLE; memory and scratch as SIMPLE.
+     * When to use it: SIMPLE's exact map from a dense depth camera at coarse voxels, where
+     * several points end in one voxel. Measured (`make bench-insert`, bench/insert.cpp: 10 TUM
+     * fr2 pioneer frames 640x480, 5 interleaved rounds, CPU ms per frame, medians; ratio = median
+     * of the per-round SIMPLE / SUPER_RAYS): 0.2 m 34.9 -> 22.2 ms, 1.57x [1.54, 1.58], 2.9
+     * points per traversal; 0.1 m 63.9 -> 57.8 ms, 1.13x [1.08, 1.15], 1.7 points; 0.05 m
+     * 121.1 -> 118.9 ms, 1.02x, 1.2 points.
+     * When not: at 0.05 m or finer, and for laser scans (scan.dat 1.09x / 1.01x / 1.00x at
+     * 0.2 / 0.1 / 0.05 m, spherical_scan.graph 0.96x to 1.03x: about one point per traversal),
+     * it buys nothing over SIMPLE. If OctoMap's discretize = true map will do, DISCRETE is
+     * faster still (TUM: 6.6 / 9.2 / 20.5 ms per frame at 0.2 / 0.1 / 0.05 m), and for depth
+     * images PROJECTIVE (approximate) is faster than both. */
     OCC_INSERT_SUPER_RAYS = 3,
     /* Depth images only (occ_map_insert_depth, occ_map_insert_projective below): free space by
      * projecting octree nodes into the image, no rays. occ_map_insert_cloud refuses it. */
