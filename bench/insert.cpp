@@ -306,6 +306,7 @@ static void table_rows(const Dataset &d, const char *res_s, const std::vector<Me
     const std::string r = res_s, base = "insert/" + (tum ? std::string("tum") : d.name) + "/" + r + "/";
     const char *want_s = r == "0.05" ? "ratio >= 45" : "ratio >= 35";
     const double want = r == "0.05" ? 45.0 : 35.0;
+    const std::string frames = std::to_string(d.scans.size()) + " TUM frames";
     const std::string ms_per = " (CPU ms per scan, " + std::to_string(d.scans.size()) + " scan" +
                                (d.scans.size() == 1 ? "" : "s") + ")";
     if (scan && (r == "0.10" || r == "0.05")) {
@@ -321,7 +322,7 @@ static void table_rows(const Dataset &d, const char *res_s, const std::vector<Me
             if (mr.equal && (best == nullptr || median(mr.t) < median(best->t))) best = &mr;
         if (best != nullptr) {
             const bool disc = vs_discrete(best->meth);
-            const std::string name = tum ? "10 TUM frames" : "scan.dat";
+            const std::string name = tum ? frames : "scan.dat";
             add_bench_row(base + "best",
                           name + " 0.05 m, best exact method: " + method_name(best->meth) +
                               " vs insertPointCloud" + (disc ? " discretize" : "") + ms_per,
@@ -331,7 +332,7 @@ static void table_rows(const Dataset &d, const char *res_s, const std::vector<Me
     }
     if (tum && (r == "0.10" || r == "0.20"))
         add_bench_row(base + "superray_vs_simple",
-                      "10 TUM frames " + r + " m, SUPER_RAYS vs SIMPLE" + ms_per, runs[0].t,
+                      frames + " " + r + " m, SUPER_RAYS vs SIMPLE" + ms_per, runs[0].t,
                       runs[3].t, false, "ratio >= 1.5 vs SIMPLE", 1.5, runs[3].equal ? "yes" : "no");
 }
 
