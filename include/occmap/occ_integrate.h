@@ -104,9 +104,10 @@ typedef enum {
      * fr2 pioneer frames 640x480, 5 interleaved rounds, CPU ms per frame, medians; ratio = median
      * of the per-round SIMPLE / SUPER_RAYS): 0.2 m 34.9 -> 22.2 ms, 1.57x [1.54, 1.58], 2.9
      * points per traversal; 0.1 m 63.9 -> 57.8 ms, 1.13x [1.08, 1.15], 1.7 points; 0.05 m
-     * 121.1 -> 118.9 ms, 1.02x, 1.2 points.
-     * When not: at 0.05 m or finer, and for laser scans (scan.dat 1.09x / 1.01x / 1.00x at
-     * 0.2 / 0.1 / 0.05 m, spherical_scan.graph 0.96x to 1.03x: about one point per traversal),
+     * 121.1 -> 118.9 ms, 1.02x, 1.2 points (two more runs: 1.56x / 1.12x / 1.02x and 1.56x /
+     * 1.14x / 1.04x).
+     * When not: at 0.05 m or finer, and for laser scans (scan.dat, spherical_scan.graph at
+     * 0.2 / 0.1 / 0.05 m: 0.95x to 1.11x over three runs, 1.0 to 1.8 points per traversal),
      * it buys nothing over SIMPLE. If OctoMap's discretize = true map will do, DISCRETE is
      * faster still (TUM: 6.6 / 9.2 / 20.5 ms per frame at 0.2 / 0.1 / 0.05 m), and for depth
      * images PROJECTIVE (approximate) is faster than both. */
