@@ -86,3 +86,12 @@ $(eval $(call FOUNDATION_VARIANT,rayf,-DOCC_RAY_DOUBLE=0,test_tree_octomap))
 TEST_STEPS += test-morton-bmi2
 TEST_BUILD_EXTRA += $(MORTON_BMI2_BIN)
 .PHONY: test-morton-bmi2
+
+# ---- make cross: the core for Cortex-M4F once more with the 8-bit values (issue 22) -----------
+# Objects only (no size table or stack budget of their own: the 16-bit build is the reference);
+# proves the compact mode builds warning-free for the flight controller.
+CROSS_V8_DIR := $(BUILD)/cross-v8/m4
+$(CROSS_V8_DIR)/%.o: %.c | $(FW_HEADERS)
+	@mkdir -p $(dir $@)
+	$(CROSS_CC) $(CROSS_COMMON) $(CROSS_M4) -DOCC_VALUE_BITS=8 -MMD -MP -c $< -o $@
+CROSS_EXTRA += $(OCC_CORE_SRC:%.c=$(CROSS_V8_DIR)/%.o)
