@@ -3,8 +3,8 @@
  * test_value.c - the fixed-point value arithmetic of this build (issue 22), against values
  * computed by hand from OctoMap's float model: the quantized sensor model, hit/miss sequences,
  * clamps, the occupancy threshold, saturation at both ends of the value range, the reserved
- * unobserved value, the block sizes, and (8-bit) that .occ snapshots of another value kind are
- * refused. Built in the default 16-bit build and in the 8-bit variant (test-variant-v8);
+ * unobserved value, the block sizes, .ot values rounded and saturated on load (a hand-built
+ * one-node file), and that .occ snapshots of the other value family are refused. Built in the default 16-bit build and in the 8-bit variant (test-variant-v8);
  * the expectations follow OCC_VALUE_BITS. The float build has its own oracle tests.
  */
 #include <stdarg.h>
@@ -309,6 +309,49 @@ static void test_snapshot_kind(void **state)
     assert_int_equal(occ_io_probe(file, n, NULL, &info), OCC_ERR_FORMAT);
 }
 
+/* .ot load converts float log-odds with rounding and saturation: a one-node tree (the root, no
+ * children) with value f, built by hand in OctoMap's .ot layout. */
+static size_t ot_one_node(uint8_t *const out, const float f)
+{
+    static const char hdr[] = "# Octomap OcTree file\nid OcTree\nsize 1\nres 0.1\ndata\n";
+    const size_t n = sizeof hdr - 1u;
+    memcpy(out, hdr, n);
+    memcpy(out + n, &f, 4u); /* little-endian hosts only, as the tests run */
+    out[n + 4u] = 0u;        /* no children */
+    return n + 5u;
+}
+
+static void ot_case(const float f, const int want_raw, const uint32_t want_warn)
+{
+    const size_t n = ot_one_node(file, f);
+    occ_map_t m;
+    occ_io_info_t info;
+    assert_int_equal(occ_io_load(&m, NULL, arena2, sizeof arena2, file, n, &info), OCC_OK);
+    occ_node_info_t ni;
+    assert_int_equal(occ_map_read_key(&m, mk(32768u, 32768u, 32768u), 0u, &ni), OCC_OK);
+    assert_true(ni.observed);
+    assert_true(feq(ni.logodds, (float)want_raw / (float)SCALE));
+    assert_int_equal(info.warnings & (OCC_IO_WARN_QUANTIZED | OCC_IO_WARN_CLAMPED), want_warn);
+}
+
+static void test_ot_conversion(void **state)
+{
+    (void)state;
+    ot_case(0.0f, 0, 0u);
+    ot_case(0.8472979f, Q_HIT, OCC_IO_WARN_QUANTIZED);
+    ot_case(-2.0f, -2 * SCALE, 0u);
+#if OCC_VALUE_BITS == 8
+    ot_case(3.5f, 126, 0u);
+    ot_case(10.0f, 127, OCC_IO_WARN_CLAMPED);  /* saturated to the 8-bit range */
+    ot_case(-10.0f, -127, OCC_IO_WARN_CLAMPED);
+    ot_case(-1.0e30f, -127, OCC_IO_WARN_CLAMPED);
+#else
+    ot_case(10.0f, 10 * SCALE, 0u);
+    ot_case(40.0f, 32767, OCC_IO_WARN_CLAMPED);
+    ot_case(-40.0f, -32767, OCC_IO_WARN_CLAMPED);
+#endif
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -319,6 +362,7 @@ int main(void)
         cmocka_unit_test_setup(test_saturation, setup),
         cmocka_unit_test_setup(test_threshold, setup),
         cmocka_unit_test_setup(test_snapshot_kind, setup),
+        cmocka_unit_test_setup(test_ot_conversion, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
