@@ -244,11 +244,12 @@ static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_
  * value steps, saturated to +-32767); the other modes use the value type itself. */
 #if !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 8
 typedef int16_t occ_delta_t;
-occ_delta_t occi_delta_from_logodds(float logodds);
 #else
 typedef occ_value_t occ_delta_t;
-#define occi_delta_from_logodds occ_value_from_logodds
 #endif
+/* A log-odds delta in value steps, rounded to nearest and saturated (NaN: the bottom). In the
+ * 8-bit mode to +-INT16_MAX steps, otherwise occ_value_from_logodds(). O(1). */
+occ_delta_t occi_delta_from_logodds(float logodds);
 
 /* OctoMap's update of one voxel value: an unobserved voxel starts at 0; a value at a clamp
  * bound is kept when the delta pushes outward; the result is clamped to [clamp_min, clamp_max]. */

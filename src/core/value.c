@@ -50,6 +50,11 @@ occ_delta_t occi_delta_from_logodds(const float logodds)
     const float r = scaled >= 0.0f ? scaled + 0.5f : scaled - 0.5f;
     return (occ_delta_t)(int32_t)r;
 }
+#else
+occ_delta_t occi_delta_from_logodds(const float logodds)
+{
+    return occ_value_from_logodds(logodds);
+}
 #endif
 
 bool occ_value_observed(const occ_value_t v)
