@@ -8,7 +8,11 @@
 // leaf's level), so both hold the same tree; this is the "407,411 nodes at 0.1 m" case.
 // For each resolution (0.1 m, 0.05 m): nodes, leaves, bytes, bytes per node and per leaf, and
 // the ratio occmap / OctoMap memoryUsage(). Endpoint insertion time: median of 5 runs each.
-// Usage: memory SCAN.dat OUT.json
+// The table row (bench_rows.hpp, issue 22) is the scan+free tree at 0.05 m: id
+// memory/scan.dat/0.05/16bit, or .../8bit when built against a library with OCC_VALUE_BITS 8
+// (build/bench/memory8, `make bench-memory` runs both). The byte counts are the pool blocks in
+// use (occ_map_stats bytes_used) vs OctoMap's memoryUsage(); no repetitions (sizes are exact).
+// Usage: memory SCAN.dat OUT.json [ROWS.json]
 #include <octomap/OcTree.h>
 
 #include <algorithm>
@@ -19,6 +23,7 @@
 #include <vector>
 
 #include "../tests/support/oracle_res.hpp"
+#include "bench_rows.hpp"
 #include "occmap/occmap.h"
 #include "occmap/host/occ_scan.h"
 
@@ -89,12 +94,43 @@ void fill_row(Row &r, const occ_map_t *m, const octomap::OcTree &t)
     r.om_bytes = t.memoryUsage();
 }
 
+// The table's row: the scan+free tree at 0.05 m, occmap's pool bytes vs OctoMap's memoryUsage().
+bool write_rows(const char *path, const std::vector<Row> &rows)
+{
+    const bool compact = OCC_VALUE_BITS == 8;
+    const double goal = compact ? 0.10 : 0.174;
+    std::vector<BenchRow> out;
+    for (const Row &r : rows) {
+        if (r.content != "scan+free" || r.res > 0.075) {
+            continue;
+        }
+        BenchRow b;
+        b.id = std::string("memory/scan.dat/0.05/") + (compact ? "8bit" : "16bit");
+        b.work = std::string("map memory, scan.dat 0.05 m with free space (OctoMap's tree copied), ") +
+                 (compact ? "8-bit" : "16-bit") + " values, leaf block " +
+                 std::to_string(OCC_LEAF_BLOCK_BYTES) + " B, inner block " +
+                 std::to_string(OCC_INNER_BLOCK_BYTES) + " B";
+        b.unit = "MB";
+        b.octomap = static_cast<double>(r.om_bytes) / 1e6;
+        b.occmap = static_cast<double>(r.occ_bytes) / 1e6;
+        b.ratio = b.ratio_min = b.ratio_max = b.octomap / b.occmap;
+        b.reps = 1;
+        b.target = compact ? "occmap <= 10% of OctoMap" : "occmap <= 17.4% of OctoMap";
+        b.met = static_cast<double>(r.occ_bytes) <= goal * static_cast<double>(r.om_bytes);
+        // Same tree: the 16-bit copy keeps every OctoMap leaf; the 8-bit one may prune siblings
+        // whose values round to the same step, so it is compared by leaf count only.
+        b.equal = r.occ_leaves == r.om_leaves ? "yes" : "no";
+        out.push_back(b);
+    }
+    return !out.empty() && bench_rows_write(path, out);
+}
+
 }  // namespace
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        std::fprintf(stderr, "usage: %s SCAN.dat OUT.json\n", argv[0]);
+    if (argc != 3 && argc != 4) {
+        std::fprintf(stderr, "usage: %s SCAN.dat OUT.json [ROWS.json]\n", argv[0]);
         return 2;
     }
     occ_vec3_t *raw = nullptr;
@@ -181,10 +217,10 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < rows.size(); i++) {
         const Row &r = rows[i];
         const double ratio = static_cast<double>(r.occ_bytes) / static_cast<double>(r.om_bytes);
-        // The least any layout with 16-bit values in blocks of 8 siblings addressed by uint32
-        // indices can use for this tree: one leaf block and one index per split level-1 node.
+        // The least any layout with this build's values in blocks of 8 siblings addressed by
+        // uint32 indices can use for this tree: one leaf block and one index per split level-1 node.
         const double floor_ratio =
-            static_cast<double>(r.occ_leaf_blocks * (8u * 2u + 4u)) / static_cast<double>(r.om_bytes);
+            static_cast<double>(r.occ_leaf_blocks * (OCC_LEAF_BLOCK_BYTES + 4u)) / static_cast<double>(r.om_bytes);
         std::printf("%-10s %5.2f | %9llu %9llu %10llu %7.2f %7.2f | %9llu %9llu %10llu %7.2f %7.2f "
                     "| %5.1f%% %5.1f%% | %9s %9s\n",
                     r.content.c_str(), r.res, (unsigned long long)r.occ_nodes,
@@ -220,9 +256,15 @@ int main(int argc, char **argv)
     }
     json += "]}\n";
     std::printf("ratio = occmap bytes_used / OctoMap memoryUsage() for the same tree; target <= 10%%.\n"
-                "floor = split level-1 nodes x (16 B leaf block + 4 B index) / memoryUsage(): no layout "
-                "with 16-bit values in 8-sibling blocks and uint32 indices goes below it.\n"
+                "floor = split level-1 nodes x (leaf block + 4 B index) / memoryUsage(): no layout "
+                "with these values in 8-sibling blocks and uint32 indices goes below it.\n"
                 "Insert times: median of %d runs, endpoints only.\n", kReps);
+    std::printf("value mode: %d-bit, leaf block %u B, inner block %u B\n", OCC_VALUE_BITS,
+                static_cast<unsigned>(OCC_LEAF_BLOCK_BYTES), static_cast<unsigned>(OCC_INNER_BLOCK_BYTES));
+    if (argc == 4 && !write_rows(argv[3], rows)) {
+        std::fprintf(stderr, "memory: cannot write %s\n", argv[3]);
+        return 1;
+    }
     FILE *f = std::fopen(argv[2], "w");
     if (f == nullptr || std::fputs(json.c_str(), f) < 0 || std::fclose(f) != 0) {
         std::fprintf(stderr, "memory: cannot write %s\n", argv[2]);

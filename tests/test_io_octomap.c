@@ -27,7 +27,7 @@
 #define TOL 0.0f  /* the float build stores OctoMap's values bit for bit */
 #else
 /* Fixed point: values round to 1/1024, so a float log-odds moves by at most half a step. */
-#define TOL (0.5f / 1024.0f + 1e-6f)
+#define TOL (0.5f / (float)OCC_FIXED_ONE + 1e-6f)
 #endif
 
 static uint32_t rng_state;
@@ -233,8 +233,14 @@ static void random_updates(oracle_io_t *o, occ_map_t *m, unsigned n, bool repres
     for (unsigned i = 0; i < n; i++) {
         const uint32_t k[3] = {base + rng() % 80u, base + rng() % 80u, base + rng() % 24u};
         /* Multiples of 1/1024 stay exact in float: both sides then hold the same values. */
+#if OCC_VALUE_BITS == 8
+        /* The 8-bit grid's hit / miss (k / 36: float keeps their sums within 1e-6). */
+        const float d = representable ? ((rng() % 3u) ? -15.0f : 31.0f) / 36.0f
+                                      : ((rng() % 3u) ? -0.405465f : 0.847298f);
+#else
         const float d = representable ? ((rng() % 3u) ? -415.0f : 868.0f) / 1024.0f
                                       : ((rng() % 3u) ? -0.405465f : 0.847298f);
+#endif
         if (o != NULL) {
             oracle_io_update(o, k[0], k[1], k[2], d);
         }

@@ -54,6 +54,21 @@ extern "C" {
  *                      Range +-31.99 log-odds. Leaf block 16 B, inner block 56 B.
  *                   1: float values (leaf block 32 B, inner block 72 B). Changes block sizes,
  *                      not the public structs' field names.
+ * OCC_VALUE_BITS   16: (with OCC_VALUE_FLOAT 0) the fixed-point width above (default).
+ *                   8: compact int8 log-odds, step 1/OCC_FIXED_ONE = 1/36 (0.0278). Leaf block
+ *                      8 B, inner block 48 B. Raw range [-127, +127] = [-3.53, +3.53] log-odds,
+ *                      -128 is reserved for "unobserved". OctoMap's defaults land exactly or
+ *                      nearly on the grid: clamp_min -2.0 -> -72 (exact), clamp_max 3.511 ->
+ *                      126 (3.500, -0.011), occupancy threshold 0 -> 0 (exact, so the occupied /
+ *                      free split of any value is the float build's), hit 0.847 -> 31 (0.861,
+ *                      +0.014 per hit), miss -0.405 -> -15 (-0.417, -0.011 per miss). After k
+ *                      unclamped updates a value differs from float by <= k * 0.014; updates
+ *                      saturate at the clamps (deltas are added in int32, never wrap); a
+ *                      config whose values fall outside +-3.53 is saturated to it. A .occ file
+ *                      records its value kind; the 8-bit build refuses 16-bit / float
+ *                      snapshots (and they refuse its) with OCC_ERR_UNSUPPORTED; .bt/.ot load
+ *                      converts float log-odds with rounding and saturation.
+ *                   Any other value is rejected with #error.
  * OCC_RAY_DOUBLE    1: key and ray arithmetic in double, bit-for-bit the arithmetic OctoMap
  *                      uses (host default). 0: float only (firmware default, no soft-double);
  *                      keys can then differ from OctoMap's for points within ~1e-7 relative
@@ -78,6 +93,15 @@ extern "C" {
 #ifndef OCC_VALUE_FLOAT
 #define OCC_VALUE_FLOAT 0
 #endif
+#ifndef OCC_VALUE_BITS
+#define OCC_VALUE_BITS 16
+#endif
+#if OCC_VALUE_BITS != 16 && OCC_VALUE_BITS != 8
+#error "OCC_VALUE_BITS must be 16 or 8"
+#endif
+#if OCC_VALUE_FLOAT && OCC_VALUE_BITS != 16
+#error "OCC_VALUE_BITS 8 needs OCC_VALUE_FLOAT 0"
+#endif
 #ifndef OCC_RAY_DOUBLE
 #if defined(__arm__) || defined(__thumb__)
 #define OCC_RAY_DOUBLE 0
@@ -93,10 +117,16 @@ extern "C" {
 #endif
 
 #define OCC_MAX_DEPTH 21u         /* 3 x 21 bits of key fit a 63-bit Morton code. */
+#if OCC_VALUE_BITS == 8
+#define OCC_FIXED_ONE 36          /* fixed-point log-odds: value = round(logodds * 36). */
+#else
 #define OCC_FIXED_ONE 1024        /* fixed-point log-odds: value = round(logodds * 1024). */
+#endif
 
 #if OCC_VALUE_FLOAT
 typedef float occ_value_t;
+#elif OCC_VALUE_BITS == 8
+typedef int8_t occ_value_t;
 #else
 typedef int16_t occ_value_t;
 #endif

@@ -30,7 +30,10 @@
  * multiples of 1/1024 (everything occmap writes) round-trip byte-identically; other float
  * log-odds are quantized (error <= 1/2048, OCC_IO_WARN_QUANTIZED) and siblings that become
  * equal are pruned, so the tree OctoMap reads back equals the original leaf for leaf within
- * 1/2048. With OCC_VALUE_FLOAT=1 every .ot value round-trips bit-exactly. Output is canonical
+ * 1/2048. With OCC_VALUE_FLOAT=1 every .ot value round-trips bit-exactly. With OCC_VALUE_BITS=8
+ * the step is 1/36 (error <= 1/72, values saturate to +-127/36 with OCC_IO_WARN_CLAMPED), and
+ * .occ files of the 16-bit/float kinds and of the 8-bit kind are refused by the other family
+ * with OCC_ERR_UNSUPPORTED (occ_core.h). Output is canonical
  * (fully pruned, inner value = max of children); where OctoMap's own file is not (unpruned .ot),
  * the rewrite describes the same voxels with fewer nodes.
  *

@@ -279,8 +279,8 @@ static void refresh_up_to(occ_map_t *const m, path_t *const p, const unsigned to
 
 typedef enum { DELTA_TAGGED, DELTA_FIXED } delta_mode_t;
 
-static occ_value_t delta_of(const occ_map_t *const m, const occ_code_t code, const delta_mode_t mode,
-                            const occ_value_t fixed)
+static occ_delta_t delta_of(const occ_map_t *const m, const occ_code_t code, const delta_mode_t mode,
+                            const occ_delta_t fixed)
 {
     if (mode == DELTA_FIXED) {
         return fixed;
@@ -319,7 +319,7 @@ static bool codes_valid(const occ_map_t *const m, const occ_code_t *const codes,
 
 /* Read-only pass: blocks the batch will allocate if nothing is freed on the way. */
 static void count_blocks(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
-                         const delta_mode_t mode, const occ_value_t fixed, uint64_t *const n_inner,
+                         const delta_mode_t mode, const occ_delta_t fixed, uint64_t *const n_inner,
                          uint64_t *const n_leaf)
 {
     path_t p;
@@ -380,7 +380,7 @@ static bool can_supply64(const occ_map_t *const m, const uint64_t n_inner, const
 /* `bound_fits`: the caller showed that an upper bound of the blocks needed fits, so the exact
  * read-only count can be skipped. */
 static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, const size_t n,
-                             const delta_mode_t mode, const occ_value_t fixed,
+                             const delta_mode_t mode, const occ_delta_t fixed,
                              const bool bound_fits, size_t *const n_changed)
 {
     if (n_changed != NULL) {
@@ -493,7 +493,7 @@ occ_err_t occ_map_update_key(occ_map_t *const map, const occ_key_t key, const fl
         return OCC_ERR_RANGE;
     }
     const occ_code_t code = occ_morton_encode(key);
-    return apply_batch(map, &code, 1u, DELTA_FIXED, occ_value_from_logodds(delta_logodds), false,
+    return apply_batch(map, &code, 1u, DELTA_FIXED, occi_delta_from_logodds(delta_logodds), false,
                        NULL);
 }
 

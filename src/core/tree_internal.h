@@ -37,10 +37,19 @@ typedef char occ_leaf_block_bytes_match[sizeof(occ_leaf_block_t) == OCC_LEAF_BLO
 #define OCC_VALUE_UNOBSERVED (-3.0e38f)
 #define OCC_VALUE_MIN (-1.0e30f)
 #define OCC_VALUE_MAX (1.0e30f)
+#elif OCC_VALUE_BITS == 8
+#define OCC_VALUE_UNOBSERVED INT8_MIN
+#define OCC_VALUE_MIN (INT8_MIN + 1)
+#define OCC_VALUE_MAX INT8_MAX
 #else
 #define OCC_VALUE_UNOBSERVED INT16_MIN
 #define OCC_VALUE_MIN (INT16_MIN + 1)
 #define OCC_VALUE_MAX INT16_MAX
+#endif
+#if !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 8
+/* The compact mode's blocks really shrink: 8 x (child 4 + value 1 + flags 1), 8 x value 1. */
+typedef char occ_inner_block_is_48[sizeof(occ_inner_block_t) == 48u ? 1 : -1];
+typedef char occ_leaf_block_is_8[sizeof(occ_leaf_block_t) == 8u ? 1 : -1];
 #endif
 
 /* Pointers to one node's fields, wherever it lives. */
@@ -230,10 +239,22 @@ static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_
     return (uint8_t)(v < m->priv.q_free_max ? OCC_NODE_HAS_FREE : OCC_NODE_HAS_UNKNOWN);
 }
 
+/* An update's delta. The 8-bit mode's values span +-127 steps while a delta may need to cross
+ * the whole clamp range and more (-72 .. +126 is 198 steps), so its deltas are int16 (in
+ * value steps, saturated to +-32767); the other modes use the value type itself. */
+#if !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 8
+typedef int16_t occ_delta_t;
+#else
+typedef occ_value_t occ_delta_t;
+#endif
+/* A log-odds delta in value steps, rounded to nearest and saturated (NaN: the bottom). In the
+ * 8-bit mode to +-INT16_MAX steps, otherwise occ_value_from_logodds(). O(1). */
+occ_delta_t occi_delta_from_logodds(float logodds);
+
 /* OctoMap's update of one voxel value: an unobserved voxel starts at 0; a value at a clamp
  * bound is kept when the delta pushes outward; the result is clamped to [clamp_min, clamp_max]. */
 static inline occ_value_t occ_value_apply_delta(const occ_map_t *const m, const occ_value_t v,
-                                                const occ_value_t delta)
+                                                const occ_delta_t delta)
 {
     const bool observed = occ_is_observed(v);
     /* OctoMap's updateNode returns early when the voxel sits at a clamp bound already. */

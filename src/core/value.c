@@ -36,6 +36,27 @@ occ_value_t occ_value_from_logodds(const float logodds)
 }
 #endif
 
+#if !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 8
+/* A delta in value steps, rounded to nearest, saturated to +-INT16_MAX (NaN: the bottom). */
+occ_delta_t occi_delta_from_logodds(const float logodds)
+{
+    const float scaled = logodds * (float)OCC_FIXED_ONE;
+    if (!(scaled > (float)-INT16_MAX)) {
+        return (occ_delta_t)-INT16_MAX;
+    }
+    if (scaled >= (float)INT16_MAX) {
+        return (occ_delta_t)INT16_MAX;
+    }
+    const float r = scaled >= 0.0f ? scaled + 0.5f : scaled - 0.5f;
+    return (occ_delta_t)(int32_t)r;
+}
+#else
+occ_delta_t occi_delta_from_logodds(const float logodds)
+{
+    return occ_value_from_logodds(logodds);
+}
+#endif
+
 bool occ_value_observed(const occ_value_t v)
 {
     return occ_is_observed(v);

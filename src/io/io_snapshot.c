@@ -2,7 +2,7 @@
 /*
  * io_snapshot.c - occmap's native snapshot (.occ). Layout (little endian):
  *   0 "OCCMAPSN"   8 u16 version (1)   10 u16 header bytes (64)   12 u8 value kind (0: int16
- *   fixed point, step 1/1024; 1: float32 log-odds)   13 u8 depth_levels   14 u16 flags (0)
+ *   fixed point, step 1/1024; 1: float32 log-odds; 2: int8 fixed point, step 1/36)   13 u8 depth_levels   14 u16 flags (0)
  *   16 f32 resolution_m, hit, miss, clamp_min, clamp_max, free_max, occupied_min
  *   44 u32 inner blocks   48 u32 leaf blocks   52 u64 payload bytes   60 u32 reserved (0)
  *   64 payload: root tag (0 unobserved, 1 uniform + value, 2 has children); then per node with
@@ -10,6 +10,9 @@
  *      the values of its observed childless children in slot order, then those children.
  *   64 + payload: u32 CRC-32 of bytes [0, 64 + payload).
  * Values are stored raw, so a snapshot reloads bit-exactly in the build that wrote it.
+ * Kinds 0 and 1 load in the 16-bit and float builds (converted, QUANTIZED when not exact);
+ * kind 2 loads only in the 8-bit build (OCC_VALUE_BITS 8), which loads only kind 2: the
+ * others give OCC_ERR_UNSUPPORTED (their grids do not map onto each other exactly).
  */
 #include <string.h>
 
@@ -19,9 +22,12 @@ static const char magic[8] = {'O', 'C', 'C', 'M', 'A', 'P', 'S', 'N'};
 
 #if OCC_VALUE_FLOAT
 #define OWN_KIND 1u
+#elif OCC_VALUE_BITS == 8
+#define OWN_KIND 2u
 #else
 #define OWN_KIND 0u
 #endif
+#define KIND_INT8 2u
 
 occ_err_t occi_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const h)
 {
@@ -52,8 +58,13 @@ occ_err_t occi_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const
         return occ_cursor_fail(c, end, "CRC mismatch");
     }
     h->value_kind = p[12];
-    if (h->value_kind > 1u) {
+    if (h->value_kind > 2u) {
         return occ_cursor_fail(c, 12u, "unknown value encoding");
+    }
+    if ((h->value_kind == KIND_INT8) != (OWN_KIND == KIND_INT8)) {
+        c->error = "snapshot value kind (8-bit vs 16-bit/float) not loadable by this build";
+        c->error_offset = 12u;
+        return OCC_ERR_UNSUPPORTED;
     }
     occ_map_config_t *const cfg = &h->cfg;
     cfg->depth_levels = p[13];
@@ -79,10 +90,18 @@ occ_err_t occi_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const
 
 static occ_err_t read_value(occ_cursor_t *const c, const uint8_t kind, occ_value_t *const v)
 {
-    const size_t n = kind == 0u ? 2u : 4u;
+    const size_t n = kind == 0u ? 2u : kind == KIND_INT8 ? 1u : 4u;
     if (c->len - c->pos < n) {
         return occ_cursor_fail(c, c->pos, "truncated snapshot payload");
     }
+#if OWN_KIND == KIND_INT8
+    /* The header parser let only kind 2 through. */
+    const int8_t raw8 = (int8_t)c->buf[c->pos];
+    if (raw8 == INT8_MIN) {
+        return occ_cursor_fail(c, c->pos, "unobserved value stored as observed");
+    }
+    *v = raw8;
+#else
     if (kind == 0u) {
         const int16_t raw = (int16_t)occi_rd_u16(c->buf + c->pos);
         if (raw == INT16_MIN) {
@@ -104,6 +123,7 @@ static occ_err_t read_value(occ_cursor_t *const c, const uint8_t kind, occ_value
             c->warnings |= OCC_IO_WARN_QUANTIZED;
         }
     }
+#endif
     c->pos += n;
     return OCC_OK;
 }
@@ -202,6 +222,8 @@ static void put_value(occ_sink_t *const s, const occ_value_t v)
 {
 #if OCC_VALUE_FLOAT
     occi_sink_f32(s, v);
+#elif OCC_VALUE_BITS == 8
+    occi_sink_u8(s, (uint8_t)v);
 #else
     occi_sink_u16(s, (uint16_t)v);
 #endif

@@ -130,7 +130,7 @@ occ_value_t shadow_get(const shadow_grid_t *s, occ_key_t key)
     return s->vox[vidx(s, key)];
 }
 
-occ_value_t shadow_apply_delta(const shadow_grid_t *s, occ_value_t v, occ_value_t d)
+occ_value_t shadow_apply_delta(const shadow_grid_t *s, occ_value_t v, shadow_delta_t d)
 {
     acc_t acc;
     if (v > OCC_VALUE_UNOBSERVED) {
@@ -152,7 +152,7 @@ occ_value_t shadow_apply_delta(const shadow_grid_t *s, occ_value_t v, occ_value_
     return (occ_value_t)acc;
 }
 
-bool shadow_update(shadow_grid_t *s, occ_key_t key, occ_value_t q_delta)
+bool shadow_update(shadow_grid_t *s, occ_key_t key, shadow_delta_t q_delta)
 {
     occ_value_t *const p = &s->vox[vidx(s, key)];
     const occ_value_t nv = shadow_apply_delta(s, *p, q_delta);

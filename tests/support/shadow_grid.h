@@ -39,12 +39,18 @@ void shadow_clear(shadow_grid_t *s);
 void shadow_copy(shadow_grid_t *dst, const shadow_grid_t *src);
 
 /* The reference update rule on raw values (OctoMap's updateNode on quantized numbers). */
-occ_value_t shadow_apply_delta(const shadow_grid_t *s, occ_value_t v, occ_value_t d);
+/* A delta in value steps: wider than an 8-bit value (OCC_VALUE_BITS 8 takes int16 deltas). */
+#if OCC_VALUE_FLOAT
+typedef float shadow_delta_t;
+#else
+typedef int32_t shadow_delta_t;
+#endif
+occ_value_t shadow_apply_delta(const shadow_grid_t *s, occ_value_t v, shadow_delta_t d);
 occ_state_t shadow_state(const shadow_grid_t *s, occ_value_t v);
 
 /* Operations; keys are absolute voxel keys inside the volume, levels <= vol_log2. Return true
  * when some voxel value changed. */
-bool shadow_update(shadow_grid_t *s, occ_key_t key, occ_value_t q_delta);
+bool shadow_update(shadow_grid_t *s, occ_key_t key, shadow_delta_t q_delta);
 bool shadow_set(shadow_grid_t *s, occ_key_t key, unsigned level, occ_value_t v);
 bool shadow_forget(shadow_grid_t *s, occ_key_t key, unsigned level);
 occ_value_t shadow_get(const shadow_grid_t *s, occ_key_t key);
