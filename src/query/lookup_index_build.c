@@ -7,7 +7,7 @@
 #include "lookup_internal.h"
 #include "../core/sat_internal.h"
 
-void occ_idx_walk_begin(occ_idx_walk_t *const w, const occ_map_t *const m, const unsigned stop)
+void occi_idx_walk_begin(occ_idx_walk_t *const w, const occ_map_t *const m, const unsigned stop)
 {
     w->top = (unsigned)m->cfg.depth_levels + 1u;
     w->stop = stop;
@@ -37,7 +37,7 @@ static bool walk_root(occ_idx_walk_t *const w, const occ_map_t *const m, occ_idx
     return true;
 }
 
-bool occ_idx_walk_next(occ_idx_walk_t *const w, const occ_map_t *const m, occ_idx_node_t *const out)
+bool occi_idx_walk_next(occ_idx_walk_t *const w, const occ_map_t *const m, occ_idx_node_t *const out)
 {
     const unsigned depth = m->cfg.depth_levels;
     if (w->root_pending && walk_root(w, m, out)) {
@@ -77,14 +77,14 @@ bool occ_idx_walk_next(occ_idx_walk_t *const w, const occ_map_t *const m, occ_id
     return false;
 }
 
-void occ_idx_box(const occ_map_t *const m, const unsigned level, uint32_t lo[3], uint32_t n[3])
+void occi_idx_box(const occ_map_t *const m, const unsigned level, uint32_t lo[3], uint32_t n[3])
 {
     uint32_t mn[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX}, mx[3] = {0u, 0u, 0u};
     bool any = false;
     occ_idx_walk_t w;
     occ_idx_node_t nd;
-    occ_idx_walk_begin(&w, m, level);
-    while (occ_idx_walk_next(&w, m, &nd)) {
+    occi_idx_walk_begin(&w, m, level);
+    while (occi_idx_walk_next(&w, m, &nd)) {
         any = true;
         for (unsigned a = 0; a < 3u; a++) {
             const uint32_t last = nd.key.k[a] + ((1u << nd.level) - 1u);
@@ -98,7 +98,7 @@ void occ_idx_box(const occ_map_t *const m, const unsigned level, uint32_t lo[3],
     }
 }
 
-size_t occ_idx_bytes(const unsigned level, const uint32_t n[3])
+size_t occi_idx_bytes(const unsigned level, const uint32_t n[3])
 {
     const size_t cells = occ_sat_mul(occ_sat_mul((size_t)n[0], (size_t)n[1]), (size_t)n[2]);
     if (level == 0u) {
@@ -114,8 +114,8 @@ occ_err_t occ_lookup_index_need(const occ_map_t *const map, const unsigned level
         return OCC_ERR_ARG;
     }
     uint32_t lo[3], n[3];
-    occ_idx_box(map, level, lo, n);
-    *bytes = occ_idx_bytes(level, n);
+    occi_idx_box(map, level, lo, n);
+    *bytes = occi_idx_bytes(level, n);
     return OCC_OK;
 }
 
@@ -177,8 +177,8 @@ static void fill_table(const occ_lookup_index_t *const ix, const occ_map_t *cons
     }
     occ_idx_walk_t w;
     occ_idx_node_t nd;
-    occ_idx_walk_begin(&w, m, ix->level);
-    while (occ_idx_walk_next(&w, m, &nd)) {
+    occi_idx_walk_begin(&w, m, ix->level);
+    while (occi_idx_walk_next(&w, m, &nd)) {
         if (nd.child != OCC_NONE) {
             OCC_ASSERT(nd.level == ix->level && nd.child < OCC_IDX_TAG);
             cells[cell_at(ix, nd.key.k)] = nd.child;
@@ -204,9 +204,9 @@ occ_err_t occ_lookup_index_build(occ_lookup_index_t *const idx, const occ_map_t 
     if (map->inner.hwm >= OCC_IDX_TAG || map->leaf.hwm >= OCC_IDX_TAG) {
         return OCC_ERR_UNSUPPORTED;
     }
-    occ_idx_box(map, level, idx->lo, idx->n);
+    occi_idx_box(map, level, idx->lo, idx->n);
     idx->level = (uint8_t)level;
-    idx->bytes = occ_idx_bytes(level, idx->n);
+    idx->bytes = occi_idx_bytes(level, idx->n);
     if (idx->bytes != 0u && mem == NULL) {
         return OCC_ERR_ARG;
     }

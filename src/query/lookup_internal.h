@@ -35,13 +35,13 @@ typedef struct {
     bool root_pending;
 } occ_idx_walk_t;
 
-void occ_idx_walk_begin(occ_idx_walk_t *w, const occ_map_t *m, unsigned stop);
-bool occ_idx_walk_next(occ_idx_walk_t *w, const occ_map_t *m, occ_idx_node_t *out);
+void occi_idx_walk_begin(occ_idx_walk_t *w, const occ_map_t *m, unsigned stop);
+bool occi_idx_walk_next(occ_idx_walk_t *w, const occ_map_t *m, occ_idx_node_t *out);
 
 /* Cells per axis and first keys of the table at `level` over the observed space (n = 0 when
  * nothing is observed). */
-void occ_idx_box(const occ_map_t *m, unsigned level, uint32_t lo[3], uint32_t n[3]);
+void occi_idx_box(const occ_map_t *m, unsigned level, uint32_t lo[3], uint32_t n[3]);
 /* Table bytes for n cells per axis at `level` (SIZE_MAX when it does not fit). */
-size_t occ_idx_bytes(unsigned level, const uint32_t n[3]);
+size_t occi_idx_bytes(unsigned level, const uint32_t n[3]);
 
 #endif
