@@ -418,10 +418,14 @@ occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned 
  *   occ_query_next: stack <= 768 / 832 B; work: amortized O(depth) per node touched
  *   occ_info_gain: stack <= 1,152 / 1,280 B; work: the cells reported (x the ray length in voxels
  *       with OCC_GAIN_OCCLUSION)
- *   occ_lookup_index_state, occ_lookup_index_read, occ_lookup_index_states: stack <= 256 / 256 B;
- *       work: one table load + <= level block reads per point
- *   occ_lookup_index_need, occ_lookup_index_pick: stack <= 256 / 256 B; work: every node once
- *   occ_lookup_index_build: stack <= 256 / 256 B; work: every node once + every table cell once
+ *   occ_lookup_index_state, occ_lookup_index_read: stack <= 256 / 256 B; work: one table load +
+ *       <= level block reads
+ *   occ_lookup_index_states: stack <= 320 / 384 B; work: per point one table load + <= level
+ *       block reads
+ *   occ_lookup_index_need: stack <= 384 / 384 B; work: every node down to the level once
+ *   occ_lookup_index_pick: stack <= 384 / 384 B; work: every node once per level tried
+ *   occ_lookup_index_build: stack <= 512 / 576 B; work: every node down to the level twice +
+ *       every table cell once
  *   occ_lookup_index_status: stack <= 256 / 256 B; work: O(1)
  *   occ_lookup_read, occ_lookup_state: stack <= 256 / 256 B; work: the levels below the highest key
  *       bit that differs from the last lookup
