@@ -3,7 +3,8 @@
  * occ_query.h - reading the map through volumes: iteration with state predicates, voxel counts,
  * nearest-first search, collision checks, ray casts, line of sight, information gain.
  * Included by occmap.h. Implemented in src/map/volume.c (volumes), query.c (iterator, counts),
- * lookup.c, nearest.c, collide.c, castray.c, infogain.c (core: no heap, no recursion, float
+ * lookup.c, lookup_index.c + lookup_index_build.c (the lookup index), nearest.c, collide.c,
+ * castray.c, infogain.c (core: no heap, no recursion, float
  * math). Convex shapes through libccd
  * are in occ_collide_ccd.h (host builds only).
  *
