@@ -3,7 +3,8 @@
  * occ_query.h - reading the map through volumes: iteration with state predicates, voxel counts,
  * nearest-first search, collision checks, ray casts, line of sight, information gain.
  * Included by occmap.h. Implemented in src/map/volume.c (volumes), query.c (iterator, counts),
- * lookup.c, nearest.c, collide.c, castray.c, infogain.c (core: no heap, no recursion, float
+ * lookup.c, lookup_index.c + lookup_index_build.c (the lookup index), nearest.c, collide.c,
+ * castray.c, infogain.c (core: no heap, no recursion, float
  * math). Convex shapes through libccd
  * are in occ_collide_ccd.h (host builds only).
  *
@@ -191,6 +192,74 @@ occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state);
  * occ_lookup_init(), OCC_ERR_ARG for NULL. O(1). */
 occ_err_t occ_lookup_status(const occ_lookup_t *lk);
 
+/* ---- Exact lookup index for random points (issue 22) ---------------------------------------------
+ * A dense table over the key bounding box of the map's observed space, built by the caller into
+ * caller-given memory (no heap), that answers occ_map_state_at exactly with one table load
+ * (level 0) or a table load plus `level` block loads (level >= 1) instead of a descent from the
+ * root (depth_levels dependent loads).
+ *  - level 0: 2 bits per voxel (its state): bytes ~ voxels of the box / 4.
+ *  - level L >= 1: 4 bytes per level-L cell of the box (the cell's child block, or its state when
+ *    the cell lies in a node without children): bytes ~ voxels / 8^L * 4; the lookup then walks
+ *    the last L levels of the tree (<= L block reads).
+ * Points outside the box hold no observed voxel: they answer UNKNOWN, as occ_map_state_at
+ * (which also says UNKNOWN off the map and for NaN / Inf). The key of a point is occ_map_key's
+ * (the map's one conversion), so the answer equals occ_map_state_at for every point, voxel
+ * borders included.
+ * Staleness: the index records the map's write_gen, arena and root block; after any write (or
+ * clear, or a re-load into the struct) it answers UNKNOWN with OCC_ERR_STATE without reading
+ * the table or the tree (fail closed: a stale index never says FREE). Rebuild it then.
+ * The caller's memory and the map must outlive the index; the index is not thread-safe against
+ * writers (as the map); concurrent readers of an unchanged map are fine (lookups only read). */
+typedef struct {
+    const occ_map_t *map; /* the map it was built on (NULL: not built) */
+    uint8_t level;        /* table level: 0 = 2-bit voxel states, >= 1 = cell references */
+    uint32_t lo[3];       /* first voxel key of the box per axis (low `level` bits clear) */
+    uint32_t n[3];        /* cells per axis (0 when nothing is observed) */
+    size_t bytes;         /* table bytes used of the caller's memory */
+    struct {              /* internal: do not touch, layout may change */
+        const uint32_t *cells;   /* the table (in the caller's memory) */
+        size_t stride_y, stride_x; /* cells per y step / per x step: n[2], n[1] * n[2] */
+        uint32_t gen;            /* map->write_gen at build */
+        uint32_t root;           /* the map's root block at build */
+        const void *arena;       /* the map's arena at build */
+    } priv;
+} occ_lookup_index_t;
+
+/* Table bytes for an index at `level` (0..depth_levels) over `map`'s observed space:
+ * *bytes = 0 when nothing is observed, SIZE_MAX when the size does not fit a size_t.
+ * OCC_ERR_ARG for NULL or level > depth_levels. O(nodes) (a walk for the bounding box),
+ * read only. */
+occ_err_t occ_lookup_index_need(const occ_map_t *map, unsigned level, size_t *bytes);
+/* The finest level whose table fits in `budget_bytes` (level 0 is the smallest table below
+ * level 2: its 2 bits per voxel are less than level 1's 4 bytes per 8 voxels). OCC_ERR_ARG for
+ * NULL, OCC_ERR_NOMEM when not even the coarsest level fits (*level unchanged). O(nodes). */
+occ_err_t occ_lookup_index_pick(const occ_map_t *map, size_t budget_bytes, unsigned *level);
+/* Build the index at `level` on `mem` (any alignment: the table starts at the next 4-byte
+ * boundary, so give occ_lookup_index_need()'s bytes + 3 unless mem is 4-aligned). Writes only
+ * [mem, mem + mem_bytes). OCC_ERR_ARG for NULL idx or map, level > depth_levels, or NULL mem
+ * with a non-empty table; OCC_ERR_NOMEM when mem_bytes is too small (nothing written to mem);
+ * OCC_ERR_UNSUPPORTED when a block index collides with the table's state tags (a pool of
+ * > 4 G - 4 blocks). On error the index is left unbuilt (lookups answer UNKNOWN + OCC_ERR_STATE).
+ * O(nodes + cells of the table). Stack: a fixed walk (<= depth_levels frames). */
+occ_err_t occ_lookup_index_build(occ_lookup_index_t *idx, const occ_map_t *map, unsigned level,
+                                 void *mem, size_t mem_bytes);
+/* OCC_OK while the index matches its map, OCC_ERR_STATE when it was never built (or its build
+ * failed) or the map was written, cleared or re-loaded since, OCC_ERR_ARG for NULL. O(1). */
+occ_err_t occ_lookup_index_status(const occ_lookup_index_t *idx);
+/* State of the voxel at `p`: exactly occ_map_state_at(map, p) while the index is valid; UNKNOWN
+ * (without reading table or tree) when it is stale, unbuilt or NULL. O(1 + level). */
+occ_state_t occ_lookup_index_state(const occ_lookup_index_t *idx, occ_vec3_t p);
+/* Same answer, with its error: OCC_OK, OCC_ERR_STATE (stale or unbuilt), OCC_ERR_ARG (NULL,
+ * NaN or Inf), OCC_ERR_RANGE (off the map); *state (when non-NULL) is UNKNOWN on every error. */
+occ_err_t occ_lookup_index_read(const occ_lookup_index_t *idx, occ_vec3_t p, occ_state_t *state);
+/* out[i] = occ_lookup_index_state(idx, pts[i]) for i < n, with the table loads of a few points
+ * started ahead (prefetch), so random points overlap their cache misses. OCC_ERR_STATE when
+ * stale or unbuilt (every out[i] UNKNOWN), OCC_ERR_ARG for NULL idx, or NULL pts / out with
+ * n > 0 (then nothing is written). Points that are NaN or off the map answer UNKNOWN (no error).
+ * O(n (1 + level)). */
+occ_err_t occ_lookup_index_states(const occ_lookup_index_t *idx, const occ_vec3_t *pts, size_t n,
+                                  occ_state_t *out);
+
 /* ---- Nearest-first iteration -------------------------------------------------------------------- */
 typedef struct {
     float dist2;       /* squared distance from the query point to the node cube */
@@ -350,6 +419,15 @@ occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned 
  *   occ_query_next: stack <= 768 / 832 B; work: amortized O(depth) per node touched
  *   occ_info_gain: stack <= 1,152 / 1,280 B; work: the cells reported (x the ray length in voxels
  *       with OCC_GAIN_OCCLUSION)
+ *   occ_lookup_index_state, occ_lookup_index_read: stack <= 256 / 256 B; work: one table load +
+ *       <= level block reads
+ *   occ_lookup_index_states: stack <= 320 / 384 B; work: per point one table load + <= level
+ *       block reads
+ *   occ_lookup_index_need: stack <= 384 / 384 B; work: every node down to the level once
+ *   occ_lookup_index_pick: stack <= 384 / 384 B; work: every node once per level tried
+ *   occ_lookup_index_build: stack <= 512 / 576 B; work: every node down to the level twice +
+ *       every table cell once
+ *   occ_lookup_index_status: stack <= 256 / 256 B; work: O(1)
  *   occ_lookup_read, occ_lookup_state: stack <= 256 / 256 B; work: the levels below the highest key
  *       bit that differs from the last lookup
  *   occ_query_begin: stack <= 256 / 320 B; work: <= 8 start cells, one key range each

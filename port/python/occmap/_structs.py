@@ -131,6 +131,12 @@ RayResult = _s("occ_ray_result_t", [("hit", C.c_bool), ("stop", enum_t), ("key",
 Lookup = _s("occ_lookup_t", [
     ("map", C.c_void_p), ("key", Key), ("lu", C.c_uint8), ("valid", C.c_bool), ("val", value_t),
     ("blk", C.c_uint32 * (MAX_DEPTH + 1)), ("gen", C.c_uint32)])
+LookupIndexPriv = _s("occ_lookup_index_priv", [
+    ("cells", C.c_void_p), ("stride_y", C.c_size_t), ("stride_x", C.c_size_t),
+    ("gen", C.c_uint32), ("root", C.c_uint32), ("arena", C.c_void_p)])
+LookupIndex = _s("occ_lookup_index_t", [
+    ("map", C.c_void_p), ("level", C.c_uint8), ("lo", C.c_uint32 * 3), ("n", C.c_uint32 * 3),
+    ("bytes", C.c_size_t), ("priv", LookupIndexPriv)])
 
 # ---- occ_io.h ----
 IoInfo = _s("occ_io_info_t", [
@@ -160,5 +166,5 @@ Sectors = _s("occ_sectors_t", [
 # are reached through their parents' dotted field paths).
 PUBLIC = [Vec3, Key, MapConfig, Pool, MapT, MapStats, Node, Quat, Pose, InsertParams,
           InsertResult, DepthImage, Pinhole, DepthParams, DepthResult, Volume, QueryCounts,
-          QueryNode, Collision, RayResult, Lookup, IoInfo, IoBuf, SectorsConfig, SectorsItem,
-          Sectors]
+          QueryNode, Collision, RayResult, Lookup, LookupIndex, IoInfo, IoBuf, SectorsConfig,
+          SectorsItem, Sectors]

@@ -1,0 +1,387 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/*
+ * test_lookup_index.c - the lookup index (occ_query.h, src/query/lookup_index*.c, issue 22):
+ *  - real maps (geb079.bt from Debian's liboctomap-dev, fr_079 from ../shared/data/maps; a
+ *    missing file is skipped and counted): at every level from 0 to the root, every probe
+ *    (random inside and around the map's box, on voxel borders and one float ulp either side,
+ *    outside the box, off the map, NaN and Inf) answers exactly occ_map_state_at, one by one
+ *    and in batches, and the batch equals the single lookups;
+ *  - a map built by hand: table bytes per level worked out by hand, the answers of an occupied
+ *    voxel, a free level-3 node and space outside the box;
+ *  - fail closed: after a write, a clear or a re-init, every answer is UNKNOWN with
+ *    OCC_ERR_STATE (a FREE voxel never reads FREE from a stale index);
+ *  - memory: too small -> OCC_ERR_NOMEM with nothing written; the table ends within the bytes
+ *    occ_lookup_index_need() gave (guard bytes after it untouched), unaligned memory works;
+ *  - bad input: NULL, level > depth, NaN / Inf, off-map points, an unbuilt index, pick budgets.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "occmap/occmap.h"
+#include "occmap/occ_io.h"
+#include "support/iotest.h"
+#include "support/leak_check.h"
+
+#define GEB079 "/usr/share/doc/liboctomap-dev/examples/data/geb079.bt"
+#define FR079 "../shared/data/maps/fr_079_t1_model.ot"
+
+static unsigned g_skipped;
+
+static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
+static double urand(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return (double)(rng_state >> 11) / 9007199254740992.0;
+}
+
+/* Every probe through the index equals occ_map_state_at; the batch equals them too. */
+static void check_probes(const occ_map_t *map, const occ_lookup_index_t *idx, const occ_vec3_t *pts,
+                         size_t n, const char *what)
+{
+    occ_state_t *const out = malloc(n * sizeof *out);
+    assert_non_null(out);
+    assert_int_equal(occ_lookup_index_states(idx, pts, n, out), OCC_OK);
+    size_t bad = 0;
+    for (size_t i = 0; i < n; i++) {
+        const occ_state_t want = occ_map_state_at(map, pts[i]);
+        occ_state_t got = OCC_STATE_OCCUPIED;
+        const occ_err_t e = occ_lookup_index_read(idx, pts[i], &got);
+        occ_key_t k;
+        const occ_err_t ke = occ_map_key(map, pts[i], &k);
+        if (occ_lookup_index_state(idx, pts[i]) != want || got != want || out[i] != want ||
+            e != ke) {
+            if (bad++ < 5u) {
+                printf("%s: point %zu (%.9g %.9g %.9g): want %d, state %d, read %d (%d), batch %d\n",
+                       what, i, (double)pts[i].x, (double)pts[i].y, (double)pts[i].z, (int)want,
+                       (int)occ_lookup_index_state(idx, pts[i]), (int)got, (int)e, (int)out[i]);
+            }
+        }
+    }
+    free(out);
+    assert_int_equal(bad, 0u);
+}
+
+/* Probes for a map whose observed box is [mn, mx] (metres): random in the box grown by 10 %
+ * (and every 64th far off the map), on voxel borders and one ulp either side, NaN and Inf. */
+static size_t make_probes(const occ_map_t *map, occ_vec3_t mn, occ_vec3_t mx, occ_vec3_t *pts,
+                          size_t n_random)
+{
+    const float lo[3] = {mn.x, mn.y, mn.z}, hi[3] = {mx.x, mx.y, mx.z};
+    const double res = (double)map->cfg.resolution_m;
+    size_t n = 0;
+    for (size_t i = 0; i < n_random; i++) {
+        float c[3];
+        for (unsigned a = 0; a < 3u; a++) {
+            const double ext = (double)(hi[a] - lo[a]);
+            c[a] = (float)((double)lo[a] - 0.1 * ext + 1.2 * ext * urand());
+        }
+        if (i % 64u == 63u) {
+            c[i % 3u] = (float)(1e6 * (urand() - 0.5));
+        }
+        pts[n++] = (occ_vec3_t){c[0], c[1], c[2]};
+    }
+    /* Voxel borders: a random face key k, the face (k - half) * res as the map computes it in
+     * double then rounded to float, and its float neighbours. */
+    occ_vec3_t base = pts[0];
+    for (size_t i = 0; i < n_random / 4u; i++) {
+        const unsigned a = (unsigned)(i % 3u);
+        const double t = (double)lo[a] + (double)(hi[a] - lo[a]) * urand();
+        const float face = (float)(floor(t / res) * res);
+        const float f[3] = {nextafterf(face, -INFINITY), face, nextafterf(face, INFINITY)};
+        base = pts[i];
+        for (unsigned j = 0; j < 3u; j++) {
+            occ_vec3_t q = base;
+            if (a == 0u) q.x = f[j];
+            if (a == 1u) q.y = f[j];
+            if (a == 2u) q.z = f[j];
+            pts[n++] = q;
+        }
+    }
+    const float bad[4] = {NAN, INFINITY, -INFINITY, -NAN};
+    for (unsigned j = 0; j < 4u; j++) {
+        pts[n++] = (occ_vec3_t){bad[j], 0.0f, 0.0f};
+        pts[n++] = (occ_vec3_t){mn.x, bad[j], mn.z};
+        pts[n++] = (occ_vec3_t){mn.x, mn.y, bad[j]};
+    }
+    return n;
+}
+
+static void check_every_level(const occ_map_t *map, const char *name, size_t n_random)
+{
+    occ_map_stats_t st;
+    occ_map_stats(map, &st);
+    assert_true(st.has_known);
+    const size_t cap = n_random + 3u * (n_random / 4u) + 12u;
+    occ_vec3_t *const pts = malloc(cap * sizeof *pts);
+    assert_non_null(pts);
+    const size_t n = make_probes(map, st.bbox_min, st.bbox_max, pts, n_random);
+    assert_true(n <= cap);
+    for (unsigned level = 0; level <= map->cfg.depth_levels; level++) {
+        size_t bytes = 0;
+        assert_int_equal(occ_lookup_index_need(map, level, &bytes), OCC_OK);
+        uint8_t *const mem = malloc(bytes + 3u + 1u);
+        assert_non_null(mem);
+        occ_lookup_index_t idx;
+        /* Unaligned on odd levels: the table starts at the next 4-byte boundary. */
+        uint8_t *const at = mem + (level % 2u);
+        assert_int_equal(occ_lookup_index_build(&idx, map, level, at, bytes + 3u), OCC_OK);
+        assert_int_equal(occ_lookup_index_status(&idx), OCC_OK);
+        assert_int_equal(idx.level, level);
+        assert_int_equal(idx.bytes, bytes);
+        char what[64];
+        snprintf(what, sizeof what, "%s level %u", name, level);
+        check_probes(map, &idx, pts, n, what);
+        free(mem);
+    }
+    printf("%s: %zu probes equal occ_map_state_at at every level 0..%u\n", name, n,
+           (unsigned)map->cfg.depth_levels);
+    free(pts);
+}
+
+static void real_map(const char *path, const char *name)
+{
+    size_t len = 0;
+    uint8_t *const file = iotest_read_file(path, &len);
+    if (file == NULL) {
+        g_skipped++;
+        printf("SKIP: %s absent (%u skipped)\n", path, g_skipped);
+        skip();
+    }
+    occ_map_t map;
+    occ_err_t e = OCC_OK;
+    void *const arena = iotest_load(&map, file, len, 0u, &e, NULL);
+    assert_int_equal(e, OCC_OK);
+    check_every_level(&map, name, 20000u);
+    free(arena);
+    free(file);
+}
+
+static void test_geb079(void **state)
+{
+    (void)state;
+    real_map(GEB079, "geb079");
+}
+
+static void test_fr079(void **state)
+{
+    (void)state;
+    real_map(FR079, "fr_079");
+}
+
+/* A hand-made map: voxel (0.05, 0.05, 0.05) occupied (key 32768 per axis at 0.1 m, depth 16),
+ * the level-3 node of (1.0, 1.0, 1.0) free (keys 32778 -> node 32776..32783). The box is keys
+ * 32768..32783 per axis: 16^3 voxels. */
+typedef struct {
+    occ_map_t map;
+    uint8_t arena[OCC_ARENA_BYTES(64, 64)];
+} small_t;
+
+static void small_init(small_t *s)
+{
+    const occ_map_config_t cfg = occ_map_config_default();
+    assert_int_equal(occ_map_init(&s->map, &cfg, s->arena, sizeof s->arena), OCC_OK);
+    assert_int_equal(occ_map_update(&s->map, (occ_vec3_t){0.05f, 0.05f, 0.05f}, 2.0f), OCC_OK);
+    const occ_key_t k = {{32778u, 32778u, 32778u}};
+    assert_int_equal(occ_map_set_key(&s->map, k, 3u, -1.0f), OCC_OK);
+}
+
+static void test_hand_map(void **state)
+{
+    (void)state;
+    static small_t s;
+    small_init(&s);
+    /* Bytes by hand: level 0: 16^3 cells / 16 per word x 4 = 1024; level 1: 8^3 x 4 = 2048;
+     * level 2: 4^3 x 4 = 256; level 3: 2^3 x 4 = 32; level 4 .. 16: one cell, 4 bytes. */
+    const size_t want[6] = {1024u, 2048u, 256u, 32u, 4u, 4u};
+    for (unsigned l = 0; l < 6u; l++) {
+        size_t b = 0;
+        assert_int_equal(occ_lookup_index_need(&s.map, l, &b), OCC_OK);
+        assert_int_equal(b, want[l]);
+    }
+    unsigned level = 99u;
+    assert_int_equal(occ_lookup_index_pick(&s.map, 1024u, &level), OCC_OK);
+    assert_int_equal(level, 0u);
+    assert_int_equal(occ_lookup_index_pick(&s.map, 1023u, &level), OCC_OK);
+    assert_int_equal(level, 2u);
+    assert_int_equal(occ_lookup_index_pick(&s.map, 31u, &level), OCC_OK);
+    assert_int_equal(level, 4u);
+    level = 99u;
+    assert_int_equal(occ_lookup_index_pick(&s.map, 3u, &level), OCC_ERR_NOMEM);
+    assert_int_equal(level, 99u);
+    static uint32_t mem[1024];
+    for (unsigned l = 0; l <= 16u; l++) {
+        occ_lookup_index_t idx;
+        assert_int_equal(occ_lookup_index_build(&idx, &s.map, l, mem, sizeof mem), OCC_OK);
+        assert_int_equal(idx.lo[0], l >= 16u ? 0u : (32768u >> l) << l);
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.05f, 0.05f, 0.05f}),
+                         OCC_STATE_OCCUPIED);
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.15f, 0.05f, 0.05f}),
+                         OCC_STATE_UNKNOWN);
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){1.0f, 1.0f, 1.0f}), OCC_STATE_FREE);
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.77f, 0.83f, 0.6f}),
+                         OCC_STATE_UNKNOWN); /* x key 32775: just below the free node */
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.79f, 0.83f, 0.6f}),
+                         occ_map_state_at(&s.map, (occ_vec3_t){0.79f, 0.83f, 0.6f}));
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){5.0f, 5.0f, 5.0f}),
+                         OCC_STATE_UNKNOWN);
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){-0.05f, 0.05f, 0.05f}),
+                         OCC_STATE_UNKNOWN);
+    }
+    assert_int_equal(leak_check(&s.map), 0);
+}
+
+static void test_stale(void **state)
+{
+    (void)state;
+    static small_t s;
+    small_init(&s);
+    static uint32_t mem[1024];
+    occ_lookup_index_t idx;
+    const occ_vec3_t freep = {1.0f, 1.0f, 1.0f};
+    assert_int_equal(occ_lookup_index_build(&idx, &s.map, 0u, mem, sizeof mem), OCC_OK);
+    assert_int_equal(occ_lookup_index_state(&idx, freep), OCC_STATE_FREE);
+    /* A write elsewhere (the free node's answer did not change) still makes it stale. */
+    assert_int_equal(occ_map_update(&s.map, (occ_vec3_t){0.35f, 0.05f, 0.05f}, -0.4f), OCC_OK);
+    occ_state_t st = OCC_STATE_FREE;
+    assert_int_equal(occ_lookup_index_status(&idx), OCC_ERR_STATE);
+    assert_int_equal(occ_lookup_index_state(&idx, freep), OCC_STATE_UNKNOWN);
+    assert_int_equal(occ_lookup_index_read(&idx, freep, &st), OCC_ERR_STATE);
+    assert_int_equal(st, OCC_STATE_UNKNOWN);
+    occ_vec3_t pts[3] = {freep, freep, {0.05f, 0.05f, 0.05f}};
+    occ_state_t out[3] = {OCC_STATE_FREE, OCC_STATE_FREE, OCC_STATE_FREE};
+    assert_int_equal(occ_lookup_index_states(&idx, pts, 3u, out), OCC_ERR_STATE);
+    for (unsigned i = 0; i < 3u; i++) {
+        assert_int_equal(out[i], OCC_STATE_UNKNOWN);
+    }
+    /* Rebuilt: valid again, and the new voxel reads FREE. */
+    for (unsigned l = 0; l <= 3u; l++) {
+        assert_int_equal(occ_lookup_index_build(&idx, &s.map, l, mem, sizeof mem), OCC_OK);
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.35f, 0.05f, 0.05f}),
+                         OCC_STATE_FREE);
+    }
+    occ_map_clear(&s.map);
+    assert_int_equal(occ_lookup_index_status(&idx), OCC_ERR_STATE);
+    assert_int_equal(occ_lookup_index_state(&idx, freep), OCC_STATE_UNKNOWN);
+    /* A re-init restarts write_gen: the root block (now none) tells it. */
+    small_init(&s);
+    assert_int_equal(occ_lookup_index_build(&idx, &s.map, 2u, mem, sizeof mem), OCC_OK);
+    const occ_map_config_t cfg = occ_map_config_default();
+    assert_int_equal(occ_map_init(&s.map, &cfg, s.arena, sizeof s.arena), OCC_OK);
+    assert_int_equal(occ_lookup_index_status(&idx), OCC_ERR_STATE);
+    assert_int_equal(occ_lookup_index_state(&idx, freep), OCC_STATE_UNKNOWN);
+}
+
+static void test_memory(void **state)
+{
+    (void)state;
+    static small_t s;
+    small_init(&s);
+    static uint32_t memw[(4096 + 16) / 4];
+    uint8_t *const mem = (uint8_t *)memw;
+    const size_t mem_size = sizeof memw;
+    for (unsigned l = 0; l <= 4u; l++) {
+        size_t need = 0;
+        assert_int_equal(occ_lookup_index_need(&s.map, l, &need), OCC_OK);
+        occ_lookup_index_t idx;
+        memset(mem, 0xA5, mem_size);
+        assert_int_equal(occ_lookup_index_build(&idx, &s.map, l, mem, need - 1u), OCC_ERR_NOMEM);
+        for (size_t i = 0; i < mem_size; i++) {
+            assert_int_equal(mem[i], 0xA5);
+        }
+        assert_int_equal(occ_lookup_index_status(&idx), OCC_ERR_STATE);
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.05f, 0.05f, 0.05f}),
+                         OCC_STATE_UNKNOWN);
+        /* Unaligned by one: needs 3 more bytes; with need + 2 it refuses. */
+        assert_int_equal(occ_lookup_index_build(&idx, &s.map, l, mem + 1, need + 2u), OCC_ERR_NOMEM);
+        assert_int_equal(occ_lookup_index_build(&idx, &s.map, l, mem + 1, need + 3u), OCC_OK);
+        for (size_t i = 0; i < 4u; i++) {
+            assert_int_equal(mem[i], 0xA5); /* the padding is not written */
+        }
+        for (size_t i = 4u + need; i < mem_size; i++) {
+            assert_int_equal(mem[i], 0xA5); /* nothing past the table */
+        }
+        assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.05f, 0.05f, 0.05f}),
+                         OCC_STATE_OCCUPIED);
+    }
+}
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    static small_t s;
+    small_init(&s);
+    static uint32_t mem[1024];
+    occ_lookup_index_t idx;
+    size_t b = 0;
+    unsigned l = 0;
+    assert_int_equal(occ_lookup_index_need(NULL, 0u, &b), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_need(&s.map, 0u, NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_need(&s.map, 17u, &b), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_pick(NULL, 100u, &l), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_pick(&s.map, 100u, NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_build(NULL, &s.map, 0u, mem, sizeof mem), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_build(&idx, NULL, 0u, mem, sizeof mem), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_build(&idx, &s.map, 17u, mem, sizeof mem), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_build(&idx, &s.map, 0u, NULL, sizeof mem), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_status(&idx), OCC_ERR_STATE);
+    assert_int_equal(occ_lookup_index_status(NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_state(NULL, (occ_vec3_t){0.05f, 0.05f, 0.05f}),
+                     OCC_STATE_UNKNOWN);
+    occ_state_t st = OCC_STATE_FREE;
+    assert_int_equal(occ_lookup_index_read(NULL, (occ_vec3_t){0, 0, 0}, &st), OCC_ERR_ARG);
+    assert_int_equal(st, OCC_STATE_UNKNOWN);
+    assert_int_equal(occ_lookup_index_states(NULL, NULL, 0u, NULL), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_build(&idx, &s.map, 0u, mem, sizeof mem), OCC_OK);
+    assert_int_equal(occ_lookup_index_states(&idx, NULL, 1u, &st), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_states(&idx, NULL, 0u, NULL), OCC_OK);
+    st = OCC_STATE_FREE;
+    assert_int_equal(occ_lookup_index_read(&idx, (occ_vec3_t){NAN, 0, 0}, &st), OCC_ERR_ARG);
+    assert_int_equal(st, OCC_STATE_UNKNOWN);
+    assert_int_equal(occ_lookup_index_read(&idx, (occ_vec3_t){0, -INFINITY, 0}, &st), OCC_ERR_ARG);
+    assert_int_equal(occ_lookup_index_read(&idx, (occ_vec3_t){0, 0, 1e5f}, &st), OCC_ERR_RANGE);
+    assert_int_equal(occ_lookup_index_read(&idx, (occ_vec3_t){0.05f, 0.05f, 0.05f}, &st), OCC_OK);
+    assert_int_equal(st, OCC_STATE_OCCUPIED);
+    assert_int_equal(occ_lookup_index_read(&idx, (occ_vec3_t){0.05f, 0.05f, 0.05f}, NULL), OCC_OK);
+    /* An empty map: no table, NULL memory is fine, everything UNKNOWN. */
+    occ_map_clear(&s.map);
+    assert_int_equal(occ_lookup_index_need(&s.map, 0u, &b), OCC_OK);
+    assert_int_equal(b, 0u);
+    assert_int_equal(occ_lookup_index_build(&idx, &s.map, 0u, NULL, 0u), OCC_OK);
+    assert_int_equal(occ_lookup_index_state(&idx, (occ_vec3_t){0.05f, 0.05f, 0.05f}),
+                     OCC_STATE_UNKNOWN);
+    /* A uniform observed root: the box is the whole map, one cell at the root level. */
+    assert_int_equal(occ_map_set_key(&s.map, (occ_key_t){{0u, 0u, 0u}}, 16u, -1.0f), OCC_OK);
+    assert_int_equal(occ_lookup_index_need(&s.map, 16u, &b), OCC_OK);
+    assert_int_equal(b, 4u);
+    assert_int_equal(occ_lookup_index_need(&s.map, 0u, &b), OCC_OK);
+#if SIZE_MAX > UINT32_MAX
+    assert_true(b == (size_t)1 << 46); /* 2^48 voxels x 2 bits */
+#else
+    assert_true(b == SIZE_MAX); /* does not fit a 32-bit size_t */
+#endif
+    assert_int_equal(occ_lookup_index_pick(&s.map, 1024u, &l), OCC_OK);
+    assert_int_equal(l, 14u); /* level 13: 8^3 cells x 4 = 2048 B, too big; 14: 4^3 x 4 = 256 */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hand_map),
+        cmocka_unit_test(test_stale),
+        cmocka_unit_test(test_memory),
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_geb079),
+        cmocka_unit_test(test_fr079),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
