@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "bench_rows.hpp"
+#include "octo_load.hpp"
 
 extern "C" {
 #include "occmap/host/occ_file.h"
@@ -39,21 +40,6 @@ static double thread_ns()
     return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
 }
 
-static OcTree *load_octo(const std::string &p)
-{
-    if (p.size() > 3 && p.compare(p.size() - 3, 3, ".bt") == 0) {
-        OcTree *t = new OcTree(0.1);
-        if (!t->readBinary(p)) {
-            delete t;
-            return nullptr;
-        }
-        return t;
-    }
-    octomap::AbstractOcTree *a = octomap::AbstractOcTree::read(p);
-    OcTree *t = dynamic_cast<OcTree *>(a);
-    if (t == nullptr) delete a;
-    return t;
-}
 
 static occ_vec3_t v3(const point3d &p) { return occ_vec3_t{p.x(), p.y(), p.z()}; }
 static volatile size_t sink;
@@ -140,7 +126,7 @@ static bool check(const OcTree &t, const occ_map_t &map, const occ_lookup_index_
 
 static void bench_map(const std::string &path, bool quick, size_t budget, std::vector<BenchRow> &rows)
 {
-    OcTree *t = load_octo(path);
+    OcTree *t = bench_load_octo(path);
     occ_map_t map;
     void *arena = nullptr;
     char msg[256] = "";

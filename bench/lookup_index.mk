@@ -5,7 +5,7 @@
 # Writes build/bench/rows/lookup_index.json.
 BENCH_LOOKUP_INDEX_MAPS := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt \
   $(wildcard ../shared/data/maps/fr_079*.bt ../shared/data/maps/fr_079*.ot)
-$(BUILD)/bench/lookup_index: bench/lookup_index.cpp bench/bench_rows.hpp $(BUILD)/relhost/port/posix/file_io.o $(BUILD)/libocc.a
+$(BUILD)/bench/lookup_index: bench/lookup_index.cpp bench/bench_rows.hpp bench/octo_load.hpp $(BUILD)/relhost/port/posix/file_io.o $(BUILD)/libocc.a
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $(filter-out %.hpp,$^) -loctomap -loctomath -lm
 bench-lookup-index: $(BUILD)/bench/lookup_index

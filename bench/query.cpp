@@ -29,6 +29,7 @@ extern "C" {
 }
 
 #include "bench_rows.hpp"
+#include "octo_load.hpp"
 
 using octomap::OcTree;
 using octomap::OcTreeKey;
@@ -120,21 +121,6 @@ struct Row {
     std::string note;
 };
 
-static OcTree *load_octo(const std::string &p)
-{
-    if (p.size() > 3 && p.compare(p.size() - 3, 3, ".bt") == 0) {
-        OcTree *t = new OcTree(0.1);
-        if (!t->readBinary(p)) {
-            delete t;
-            return nullptr;
-        }
-        return t;
-    }
-    octomap::AbstractOcTree *a = octomap::AbstractOcTree::read(p);
-    OcTree *t = dynamic_cast<OcTree *>(a);
-    if (t == nullptr) delete a;
-    return t;
-}
 
 static bool load_occ(const std::string &p, const OcTree &t, occ_map_t *map, void **arena, std::string *how)
 {
@@ -205,7 +191,7 @@ static occ_vec3_t v3(const point3d &p) { return occ_vec3_t{p.x(), p.y(), p.z()};
 
 static void bench_map(const std::string &path, bool quick, std::vector<Row> &rows, FILE *log)
 {
-    OcTree *t = load_octo(path);
+    OcTree *t = bench_load_octo(path);
     if (t == nullptr) {
         fprintf(log, "skip %s: OctoMap cannot read it\n", path.c_str());
         return;
