@@ -703,17 +703,42 @@ static bool chunkable(const occ_insert_params_t *const params)
     return params->method == OCC_INSERT_SIMPLE || params->method == OCC_INSERT_DISCRETE;
 }
 
+static int chunk_run(occ_ictx_t *x, const occ_insert_params_t *params, const occ_vec3_t *points,
+                     size_t n_points, const carve_t *c, occ_code_t lo);
+
 /* One more pass for the window starting at lo; -1 when the scratch ran out. */
 static int chunk_trace(occ_ictx_t *const x, const occ_insert_params_t *const params,
                        const occ_vec3_t *const points, const size_t n_points,
                        const carve_t *const c, const occ_code_t lo)
 {
-    memset(x->r, 0, sizeof *x->r);
+    /* The first pass (trace_scan) counted the scan in the caller's result; later passes count
+     * into a local that is dropped (here, not in run_chunks: off the tree update's stack). */
+    occ_insert_result_t *const keep = x->r;
+    occ_insert_result_t drop;
+    memset(&drop, 0, sizeof drop);
+    x->r = &drop;
+    const int rc = chunk_run(x, params, points, n_points, c, lo);
+    x->r = keep;
+    return rc;
+}
+
+static int chunk_run(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                     const occ_vec3_t *const points, const size_t n_points,
+                     const carve_t *const c, const occ_code_t lo)
+{
     memset(x->filt, 0xFF, FILTER_N * 8u);
     x->n = 0;
     x->win_lo = lo;
     x->win_hi = OCC_CODE_HIT_BIT;
-    return run_method(x, params, points, n_points, c->ends);
+    if (params->method == OCC_INSERT_SIMPLE) { /* not run_method: no super-ray stack here */
+        return occi_ictx_points(x, points, n_points, false);
+    }
+    if (x->cap < n_points) {
+        return -1;
+    }
+    const size_t u = discretize(x, points, n_points, c->ends);
+    const int rc = run_discrete(x, c->ends, u);
+    return rc < 0 || x->hit == NULL ? rc : occi_ictx_points(x, points, n_points, true);
 }
 
 /* The pass's sorted, collapsed codes. */
@@ -726,63 +751,73 @@ static occ_code_t *chunk_collapse(occ_ictx_t *const x, size_t *const m)
 }
 
 /* Pass 1 (the first window is already traced): the blocks every window can allocate, as if none
- * of its nodes existed (so pruning by one window cannot make the next one fail), summed, checked
- * against the pools (evicting for it first in automatic mode). Pass 2: trace and apply each
- * window. The map is written only after the check. */
-static occ_err_t run_chunks(occ_ictx_t *const x, const occ_insert_params_t *const params,
-                            const occ_vec3_t *const points, const size_t n_points,
-                            const carve_t *const c, const occ_vec3_t *const origin)
+ * of its nodes existed (so pruning by one window cannot make the next one fail), summed.
+ * False when the scratch ran out. */
+static bool chunk_need(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                       const occ_vec3_t *const points, const size_t n_points,
+                       const carve_t *const c, uint64_t *const ni, uint64_t *const nl)
 {
-    occ_map_t *const map = x->map;
-    const occ_insert_result_t first = *x->r;
-    uint64_t ni = 0, nl = 0;
+    *ni = 0;
+    *nl = 0;
     for (;;) {
         size_t m;
         const occ_code_t *const codes = chunk_collapse(x, &m);
         uint64_t wi, wl;
-        occi_coarse_need(codes, m, 0, map->cfg.depth_levels, &wi, &wl);
-        ni += wi;
-        nl += wl;
+        occi_coarse_need(codes, m, 0, x->map->cfg.depth_levels, &wi, &wl);
+        *ni += wi;
+        *nl += wl;
         if (x->win_hi == OCC_CODE_HIT_BIT) {
-            break;
+            return true;
         }
         if (chunk_trace(x, params, points, n_points, c, x->win_hi) < 0) {
-            *x->r = first;
-            return OCC_ERR_SCRATCH;
+            return false;
         }
     }
-    if (!coarse_fits(map, origin, params, ni, nl)) {
-        *x->r = first;
-        map->oom_count++;
-        return OCC_ERR_NOMEM;
-    }
-    size_t total = 0, hits = 0, changed = 0;
+}
+
+/* Pass 2: trace and apply each window, counting into the caller's result. */
+static occ_err_t chunk_apply(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                             const occ_vec3_t *const points, const size_t n_points,
+                             const carve_t *const c)
+{
+    occ_insert_result_t *const r = x->r;
     occ_code_t lo = 0;
-    occ_err_t e = OCC_OK;
     do {
-        size_t m, ch = 0;
         if (chunk_trace(x, params, points, n_points, c, lo) < 0) {
-            e = OCC_ERR_SCRATCH; /* cannot happen: pass 1 ran the same windows */
-            break;
+            return OCC_ERR_SCRATCH; /* cannot happen: pass 1 ran the same windows */
         }
+        size_t m, ch = 0;
         const occ_code_t *const codes = chunk_collapse(x, &m);
         for (size_t i = 0; i < m; i++) {
-            hits += (size_t)(codes[i] >> 63);
+            r->voxels_occupied += (size_t)(codes[i] >> 63);
         }
-        e = occ_map_observe_codes(map, codes, m, &ch);
+        const occ_err_t e = occ_map_observe_codes(x->map, codes, m, &ch);
         if (e != OCC_OK) {
-            break;
+            return e;
         }
-        total += m;
-        changed += ch;
+        r->voxels_updated += m;
+        r->voxels_changed += ch;
         lo = x->win_hi;
     } while (lo != OCC_CODE_HIT_BIT);
-    *x->r = first;
-    x->r->voxels_updated = total;
-    x->r->voxels_occupied = hits;
-    x->r->voxels_free = total - hits;
-    x->r->voxels_changed = changed;
-    return e;
+    r->voxels_free = r->voxels_updated - r->voxels_occupied;
+    return OCC_OK;
+}
+
+/* The scan in windows: pass 1, the pool check (evicting for it first in automatic mode), pass 2.
+ * The map is written only after the check. */
+static occ_err_t run_chunks(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                            const occ_vec3_t *const points, const size_t n_points,
+                            const carve_t *const c, const occ_vec3_t *const origin)
+{
+    uint64_t ni, nl;
+    if (!chunk_need(x, params, points, n_points, c, &ni, &nl)) {
+        return OCC_ERR_SCRATCH;
+    }
+    if (!coarse_fits(x->map, origin, params, ni, nl)) {
+        x->map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    return chunk_apply(x, params, points, n_points, c);
 }
 
 /* Trace the scan: in the dense set when the box fits the scratch, else as sorted codes (also
