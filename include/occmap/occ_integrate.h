@@ -16,6 +16,25 @@
  * OCC_ERR_SCRATCH; if the pools cannot hold the result, OCC_ERR_NOMEM; either way the map is
  * exactly as before (automatic eviction aside, see auto_evict).
  *
+ * Bounded scratch (SIMPLE and DISCRETE, issue 22): when the scan's sorted codes do not fit, the
+ * scan runs in Morton-range windows instead of failing. The first pass keeps the lowest codes
+ * that fit and narrows its window to them (codes above are dropped by every later ray); each
+ * further pass traces the whole scan again for the next window. Windows are disjoint key
+ * ranges, so each voxel is updated once and hits win exactly as in one batch: the map equals
+ * the one-shot result voxel for voxel. All or nothing still holds: a first round of passes adds
+ * up, per window, the blocks its update can allocate as if none of its nodes existed (so the
+ * pruning of one window cannot starve the next), checks the sum against the pools (evicting for
+ * it first with auto_evict; what was evicted then stays evicted) and returns OCC_ERR_NOMEM with
+ * the map unchanged when it does not fit - a conservative check: it may refuse where the
+ * one-shot call with enough scratch would succeed. Only then a second round traces and applies
+ * each window. Cost: 2 x windows traversals of the scan (windows ~ unique voxels / (scratch /
+ * 32)); scan.dat at 0.05 m in 8 MB: ~33x the time of the one-shot call (bench/scratch.cpp).
+ * Minimum scratch: the fixed term, plus (DISCRETE) 8 bytes per point, plus 16 bytes per code
+ * for c = max(longest ray's keys + 2, DISCRETE: n_points) codes, where a ray's keys are
+ * |dk|_1 + 4 (occ_insert_scratch_bytes_scan() of that one point is 8 + 16 (keys + 1)); below
+ * it OCC_ERR_SCRATCH, map unchanged. SUPER_RAYS and FAST_DISCRETE are not chunked: short
+ * scratch is OCC_ERR_SCRATCH as before.
+ *
  * Work: O(sum over rays of the voxels each ray crosses) for traversal, bounded per ray by
  * 3 * (max_range / resolution + 2) + 2 voxels (the whole map's edge with unlimited range), plus
  * O(unique voxels * depth) for the tree update. Firmware budgets rays x voxels per ray.
@@ -161,7 +180,8 @@ typedef struct {
                                * size that would suffice: use the bounds below for that. */
 } occ_insert_result_t;
 
-/* Scratch bytes that make occ_map_insert_cloud() never fail for lack of scratch, for up to
+/* Scratch bytes that make occ_map_insert_cloud() run in one pass (the fast path; less is chunked
+ * for SIMPLE and DISCRETE, see the top of this header), for up to
  * `n_points` points whose rays are at most `max_ray_m` long (pass max(max_range, farthest point
  * distance); <= 0 or non-finite means "the whole map": a huge number). Formula:
  *   OCC_INSERT_SCRATCH_BYTES(n_points, ceil(max_ray_m / res) + 2)
@@ -183,7 +203,8 @@ size_t occ_insert_scratch_bytes_scan(const occ_map_t *map, const occ_vec3_t *ori
 
 /* Integrate one scan taken from sensor position `origin` (map frame, metres). `points` are in
  * the map frame. `scratch` (any alignment, owned by the call only while it runs) holds the
- * per-scan sets; less than the bound above may still work: the sets are compacted when full.
+ * per-scan sets; less than the bound above may still work: the sets are compacted when full,
+ * and SIMPLE / DISCRETE then run in Morton-range windows (slower, same map; see the top).
  * `out` (may be NULL) gets the counters, also on error (then nothing was applied).
  * Scratch beyond 32 GiB is not used (the sort counts codes in 32 bits).
  * Errors: OCC_ERR_ARG (NULL map/origin/params, points NULL with n > 0, origin NaN/Inf, bad

@@ -116,7 +116,18 @@ bool occi_ictx_reserve(occ_ictx_t *const x, const size_t need)
     }
     occ_ictx_note(x, x->n, x->n);
     occ_code_t *const s = occi_keyset_sort(x->a, x->b, x->n, x->hist);
-    const size_t m = occi_keyset_unique(s, x->n);
+    size_t m = occi_keyset_unique(s, x->n);
+    if (x->chunked && x->cap - m < need && m > 0u) {
+        /* Bounded scratch: keep the lowest codes and narrow the window to them; the codes
+         * above are dropped now and by every later ray of this pass (a later pass takes them). */
+        const size_t room = x->cap > need ? x->cap - need : 0u;
+        const size_t keep = room < (m > 1u ? m / 2u : 1u) ? room : (m > 1u ? m / 2u : 1u);
+        if (keep > 0u) {
+            x->win_hi = keep < m ? (s[keep] & ~OCC_CODE_HIT_BIT)
+                                 : (s[m - 1u] & ~OCC_CODE_HIT_BIT) + 1u;
+            m = keep;
+        }
+    }
     if (s != x->a) {
         memcpy(x->a, s, m * sizeof *s);
     }
@@ -150,7 +161,7 @@ static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3]
     for (size_t i = 0; i < m; i++) {
         const occ_code_t c = base[i];
         const size_t s = filt_slot(c);
-        if (filt[s] != c) {
+        if (filt[s] != c && c >= x->win_lo && c < x->win_hi) {
             filt[s] = c;
             base[w++] = c;
         }
@@ -197,7 +208,9 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3], const bool hit)
     if (x->bs == NULL) {
         x->filt[filt_slot(c)] = c; /* later free visits of this voxel are moot: hit wins */
     }
-    occ_ictx_emit(x, c | OCC_CODE_HIT_BIT);
+    if (c >= x->win_lo && c < x->win_hi) {
+        occ_ictx_emit(x, c | OCC_CODE_HIT_BIT);
+    }
     return 0;
 }
 
@@ -592,6 +605,8 @@ static occ_err_t ictx_begin(occ_ictx_t *const x, occ_map_t *const map,
     }
     x->max_range = params->max_range_m > 0.0f ? params->max_range_m : -1.0f;
     x->max_range_r = (occ_rr_t)x->max_range;
+    x->win_lo = 0;
+    x->win_hi = OCC_CODE_HIT_BIT;
     return OCC_OK;
 }
 
@@ -677,6 +692,134 @@ static void layout_pass(occ_ictx_t *const x, const carve_t *const c, const bool 
     }
 }
 
+/* ---- bounded scratch: the scan in Morton-range windows ---------------------------------------
+ * SIMPLE and DISCRETE on the sorted path: when the codes do not fit, occi_ictx_reserve() narrows
+ * the window [win_lo, win_hi) to the codes it holds, and the pass ends with exactly the scan's
+ * codes in that window (every ray was traced, codes outside were dropped). Each further pass
+ * traces the scan again for the next window. Windows are disjoint, so "hit wins" and "once per
+ * voxel" hold per key as in one batch. */
+static bool chunkable(const occ_insert_params_t *const params)
+{
+    return params->method == OCC_INSERT_SIMPLE || params->method == OCC_INSERT_DISCRETE;
+}
+
+static int chunk_run(occ_ictx_t *x, const occ_insert_params_t *params, const occ_vec3_t *points,
+                     size_t n_points, const carve_t *c, occ_code_t lo);
+
+/* One more pass for the window starting at lo; -1 when the scratch ran out. */
+static int chunk_trace(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                       const occ_vec3_t *const points, const size_t n_points,
+                       const carve_t *const c, const occ_code_t lo)
+{
+    /* The first pass (trace_scan) counted the scan in the caller's result; later passes count
+     * into a local that is dropped (here, not in run_chunks: off the tree update's stack). */
+    occ_insert_result_t *const keep = x->r;
+    occ_insert_result_t drop;
+    memset(&drop, 0, sizeof drop);
+    x->r = &drop;
+    const int rc = chunk_run(x, params, points, n_points, c, lo);
+    x->r = keep;
+    return rc;
+}
+
+static int chunk_run(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                     const occ_vec3_t *const points, const size_t n_points,
+                     const carve_t *const c, const occ_code_t lo)
+{
+    memset(x->filt, 0xFF, FILTER_N * 8u);
+    x->n = 0;
+    x->win_lo = lo;
+    x->win_hi = OCC_CODE_HIT_BIT;
+    if (params->method == OCC_INSERT_SIMPLE) { /* not run_method: no super-ray stack here */
+        return occi_ictx_points(x, points, n_points, false);
+    }
+    if (x->cap < n_points) {
+        return -1;
+    }
+    const size_t u = discretize(x, points, n_points, c->ends);
+    const int rc = run_discrete(x, c->ends, u);
+    return rc < 0 || x->hit == NULL ? rc : occi_ictx_points(x, points, n_points, true);
+}
+
+/* The pass's sorted, collapsed codes. */
+static occ_code_t *chunk_collapse(occ_ictx_t *const x, size_t *const m)
+{
+    occ_ictx_note(x, x->n, x->n);
+    occ_code_t *const codes = occi_keyset_sort(x->a, x->b, x->n, x->hist);
+    *m = occi_keyset_unique(codes, x->n);
+    return codes;
+}
+
+/* Pass 1 (the first window is already traced): the blocks every window can allocate, as if none
+ * of its nodes existed (so pruning by one window cannot make the next one fail), summed.
+ * False when the scratch ran out. */
+static bool chunk_need(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                       const occ_vec3_t *const points, const size_t n_points,
+                       const carve_t *const c, uint64_t *const ni, uint64_t *const nl)
+{
+    *ni = 0;
+    *nl = 0;
+    for (;;) {
+        size_t m;
+        const occ_code_t *const codes = chunk_collapse(x, &m);
+        uint64_t wi, wl;
+        occi_coarse_need(codes, m, 0, x->map->cfg.depth_levels, &wi, &wl);
+        *ni += wi;
+        *nl += wl;
+        if (x->win_hi == OCC_CODE_HIT_BIT) {
+            return true;
+        }
+        if (chunk_trace(x, params, points, n_points, c, x->win_hi) < 0) {
+            return false;
+        }
+    }
+}
+
+/* Pass 2: trace and apply each window, counting into the caller's result. */
+static occ_err_t chunk_apply(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                             const occ_vec3_t *const points, const size_t n_points,
+                             const carve_t *const c)
+{
+    occ_insert_result_t *const r = x->r;
+    occ_code_t lo = 0;
+    do {
+        if (chunk_trace(x, params, points, n_points, c, lo) < 0) {
+            return OCC_ERR_SCRATCH; /* cannot happen: pass 1 ran the same windows */
+        }
+        size_t m, ch = 0;
+        const occ_code_t *const codes = chunk_collapse(x, &m);
+        for (size_t i = 0; i < m; i++) {
+            r->voxels_occupied += (size_t)(codes[i] >> 63);
+        }
+        const occ_err_t e = occ_map_observe_codes(x->map, codes, m, &ch);
+        if (e != OCC_OK) {
+            return e;
+        }
+        r->voxels_updated += m;
+        r->voxels_changed += ch;
+        lo = x->win_hi;
+    } while (lo != OCC_CODE_HIT_BIT);
+    r->voxels_free = r->voxels_updated - r->voxels_occupied;
+    return OCC_OK;
+}
+
+/* The scan in windows: pass 1, the pool check (evicting for it first in automatic mode), pass 2.
+ * The map is written only after the check. */
+static occ_err_t run_chunks(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                            const occ_vec3_t *const points, const size_t n_points,
+                            const carve_t *const c, const occ_vec3_t *const origin)
+{
+    uint64_t ni, nl;
+    if (!chunk_need(x, params, points, n_points, c, &ni, &nl)) {
+        return OCC_ERR_SCRATCH;
+    }
+    if (!coarse_fits(x->map, origin, params, ni, nl)) {
+        x->map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    return chunk_apply(x, params, points, n_points, c);
+}
+
 /* Trace the scan: in the dense set when the box fits the scratch, else as sorted codes (also
  * when a visit fell outside the box, which the padding should rule out). Returns run_method's
  * code; *dense says which path holds the result. */
@@ -699,6 +842,7 @@ static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const para
             x->cbs->overflow = false;
         }
         layout_pass(x, c, *dense, bs, bricks, hits_cap);
+        x->chunked = !*dense && chunkable(params);
         rc = run_method(x, params, points, n_points, c->ends);
         if (rc < 0 || !*dense || !bs->overflow) {
             break;
@@ -744,9 +888,13 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
     occ_ictx_note(&x, x.n, 0);
     /* A shared map publishes the scan's evictions, coarse and voxel updates as one version. */
     const bool shared = map->priv.shared != NULL && occ_map_write_begin(map) == OCC_OK;
-    e = rc < 0 || (x.cbs != NULL && cbs.overflow)
-            ? OCC_ERR_SCRATCH
-            : collapse_and_apply(&x, params, origin, dense, &bs, &cbs);
+    if (rc < 0 || (x.cbs != NULL && cbs.overflow)) {
+        e = OCC_ERR_SCRATCH;
+    } else if (x.win_hi != OCC_CODE_HIT_BIT) {
+        e = run_chunks(&x, params, points, n_points, &c, origin);
+    } else {
+        e = collapse_and_apply(&x, params, origin, dense, &bs, &cbs);
+    }
     if (shared) {
         (void)occ_map_write_end(map);
     }

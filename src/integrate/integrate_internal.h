@@ -162,6 +162,8 @@ typedef struct {
     size_t a_hwm, b_hwm;   /* codes ever written at a[] and at b[] (scratch_used) */
     size_t n_ends;         /* DISCRETE: end voxels written (scratch_used) */
     const bool *hit;       /* per point, false: no hit (occ_map_insert_rays); NULL: all hit */
+    occ_code_t win_lo, win_hi; /* sorted path: only codes in [win_lo, win_hi) are kept */
+    bool chunked;          /* reserve may shrink win_hi instead of failing (bounded scratch) */
     occ_insert_result_t *r;
 } occ_ictx_t;
 
