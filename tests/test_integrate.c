@@ -43,89 +43,7 @@ static void oracle_insert(void *t, const it_cloud_t *c, double max_range, int di
     oracle_ins_cloud(t, (const float *)(const void *)c->p, c->n, o, max_range, discretize);
 }
 
-/* ---- comparisons ----------------------------------------------------------------------------- */
-/* Differences between our map and OctoMap's: every OctoMap leaf read from ours at its level,
- * every leaf of ours searched in OctoMap. Values within tol, states equal. */
-/* The 8-bit mode (OCC_VALUE_BITS 8, test-variant-v8i) rounds each hit / miss by up to 0.014
- * (occ_core.h), so values are compared within that per update (0.25: ~18 unclamped updates of
- * one voxel) and a state may differ only where OctoMap's value is that close to the threshold. */
-#if OCC_VALUE_BITS == 8
-#define V8_TOL 0.25f
-#endif
-static bool differs(const float ours, const float ref, const float tol)
-{
-    const bool state_differs = (ours >= 0.0f) != (ref >= 0.0f);
-#if OCC_VALUE_BITS == 8
-    (void)tol;
-    return fabsf(ours - ref) > V8_TOL || (state_differs && fabsf(ref) > V8_TOL);
-#else
-    return fabsf(ours - ref) > tol || state_differs;
-#endif
-}
-
-static size_t diff_oracle(const occ_map_t *m, void *t, float tol)
-{
-    const size_t n = oracle_ins_leaves(t, NULL, NULL, NULL, 0);
-    uint32_t *keys = malloc(n * 3u * sizeof *keys + 1u);
-    uint8_t *lv = malloc(n + 1u);
-    float *lo = malloc(n * sizeof *lo + 1u);
-    assert_non_null(keys);
-    assert_int_equal(oracle_ins_leaves(t, keys, lv, lo, n), n);
-    size_t bad = 0;
-    for (size_t i = 0; i < n; i++) {
-        const occ_key_t k = {{keys[3 * i], keys[3 * i + 1], keys[3 * i + 2]}};
-        occ_node_info_t info;
-        if (occ_map_read_key(m, k, lv[i], &info) != OCC_OK || !info.observed) {
-            if (bad++ < 5u) {
-                printf("octomap leaf %u %u %u L%u %.4f: unobserved here\n", k.k[0], k.k[1],
-                       k.k[2], lv[i], (double)lo[i]);
-            }
-            continue;
-        }
-        if (info.level < lv[i]) {
-            continue; /* finer here: checked from our side */
-        }
-        if (differs(info.logodds, lo[i], tol)) {
-            if (bad++ < 5u) {
-                printf("octomap leaf %u %u %u L%u %.4f: here %.4f\n", k.k[0], k.k[1], k.k[2],
-                       lv[i], (double)lo[i], (double)info.logodds);
-            }
-        }
-    }
-    free(keys);
-    free(lv);
-    free(lo);
-    occ_walk_t w;
-    occ_walk_node_t nd;
-    occ_walk_begin(&w, m);
-    while (occ_walk_next(&w, &nd)) {
-        if (nd.has_children || !nd.observed) {
-            continue;
-        }
-        float ref;
-        unsigned level;
-        const uint32_t k[3] = {nd.key.k[0], nd.key.k[1], nd.key.k[2]};
-        const float ours = occ_value_to_logodds(nd.value);
-        if (!oracle_ins_search(t, k, &ref, &level)) {
-            if (bad++ < 5u) {
-                printf("our leaf %u %u %u L%u %.4f: unknown to OctoMap\n", k[0], k[1], k[2],
-                       nd.level, (double)ours);
-            }
-            continue;
-        }
-        if (level < nd.level) {
-            continue;
-        }
-        if (differs(ours, ref, tol)) {
-            if (bad++ < 5u) {
-                printf("our leaf %u %u %u L%u %.4f: OctoMap %.4f\n", k[0], k[1], k[2], nd.level,
-                       (double)ours, (double)ref);
-            }
-        }
-    }
-    return bad;
-}
-
+/* ---- comparisons: it_it_diff_oracle() (support/integrate_fixture.c) -------------------------- */
 /* Insert with our map and OctoMap, compare. Returns the differences. */
 static size_t run_pair(const it_cloud_t *c, float res, occ_insert_method_t meth, float max_range,
                        int discretize)
@@ -142,7 +60,7 @@ static size_t run_pair(const it_cloud_t *c, float res, occ_insert_method_t meth,
     assert_int_equal(occ_map_check(&m), OCC_OK);
     void *t = oracle_ins_new((double)res);
     oracle_insert(t, c, max_range > 0.0f ? (double)max_range : -1.0, discretize);
-    const size_t bad = diff_oracle(&m, t, 0.002f);
+    const size_t bad = it_diff_oracle(&m, t, 0.002f);
     printf("  res %.2f method %d range %.1f: %zu points, %zu visits, %zu voxels, %zu differ\n",
            (double)res, (int)meth, (double)max_range, out.points_integrated, out.voxel_visits,
            out.voxels_updated, bad);
@@ -226,7 +144,7 @@ static void test_superrays_dense(void **state)
             assert_true(rb.rays_cast * 3u < c.n);
             void *t = oracle_ins_new((double)resolutions[i]);
             oracle_insert(t, &c, -1.0, 0);
-            assert_int_equal(diff_oracle(&b, t, 0.002f), 0);
+            assert_int_equal(it_diff_oracle(&b, t, 0.002f), 0);
             oracle_ins_delete(t);
         }
     }
@@ -276,7 +194,7 @@ static void test_accumulate(void **state)
         oracle_insert(t, &c, -1.0, 0);
     }
     assert_int_equal(occ_map_check(&m), OCC_OK);
-    assert_int_equal(diff_oracle(&m, t, 0.004f), 0);
+    assert_int_equal(it_diff_oracle(&m, t, 0.004f), 0);
     oracle_ins_delete(t);
     free(c.p);
 }
@@ -376,7 +294,7 @@ static void test_sorted_path(void **state)
             assert_int_equal(e, OCC_OK);
         }
         if (e == OCC_OK) {
-            assert_int_equal(diff_oracle(&m, t, 0.002f), 0);
+            assert_int_equal(it_diff_oracle(&m, t, 0.002f), 0);
         } else {
             assert_int_equal(e, OCC_ERR_SCRATCH);
             size_t nodes;

@@ -47,30 +47,6 @@ static size_t min_scratch(const occ_map_t *m, const it_cloud_t *c, const occ_ins
     return OCC_INSERT_SCRATCH_FIXED_BYTES + 16u * codes;
 }
 
-static size_t oracle_diff(const occ_map_t *m, void *t)
-{
-    const size_t n = oracle_ins_leaves(t, NULL, NULL, NULL, 0);
-    uint32_t *keys = malloc(n * 3u * sizeof *keys + 1u);
-    uint8_t *lv = malloc(n + 1u);
-    float *lo = malloc(n * sizeof *lo + 1u);
-    assert_non_null(keys);
-    assert_int_equal(oracle_ins_leaves(t, keys, lv, lo, n), n);
-    size_t bad = 0;
-    for (size_t i = 0; i < n; i++) {
-        const occ_key_t k = {{keys[3 * i], keys[3 * i + 1], keys[3 * i + 2]}};
-        occ_node_info_t info;
-        if (occ_map_read_key(m, k, lv[i], &info) != OCC_OK || !info.observed) {
-            bad++;
-        } else if (info.level >= lv[i] && fabsf(info.logodds - lo[i]) > 0.002f) {
-            bad++;
-        }
-    }
-    free(keys);
-    free(lv);
-    free(lo);
-    return bad;
-}
-
 static void check_method(const occ_insert_method_t method, const float res, const size_t every,
                          const bool at_min)
 {
@@ -91,7 +67,7 @@ static void check_method(const occ_insert_method_t method, const float res, cons
     const float o[3] = {c.origin.x, c.origin.y, c.origin.z};
     oracle_ins_cloud(t, (const float *)(const void *)c.p, c.n, o, -1.0,
                      method == OCC_INSERT_DISCRETE);
-    assert_int_equal(oracle_diff(&ref, t), 0);
+    assert_int_equal(it_diff_oracle(&ref, t, 0.002f), 0);
     const size_t lo = min_scratch(&m, &c, &p);
     const size_t sizes[] = {lo, lo + 4096u, r0.scratch_used / 8u, r0.scratch_used / 3u};
     for (size_t i = at_min ? 0u : 2u; i < (at_min ? 2u : 4u); i++) {
@@ -109,7 +85,7 @@ static void check_method(const occ_insert_method_t method, const float res, cons
         assert_int_equal(r.points_integrated, r0.points_integrated);
         assert_int_equal(it_diff_maps(&ref, &m), 0);
         assert_int_equal(it_diff_maps(&m, &ref), 0);
-        assert_int_equal(oracle_diff(&m, t), 0);
+        assert_int_equal(it_diff_oracle(&m, t, 0.002f), 0);
         assert_true(occ_map_check(&m) == OCC_OK);
     }
     /* Below the minimum: OCC_ERR_SCRATCH, map unchanged (it holds the last scan: insert again). */

@@ -29,6 +29,10 @@ bool it_load_tum(it_cloud_t *c, size_t frame, unsigned stride);
 size_t it_diff_into(const occ_map_t *x, const occ_map_t *y);
 /* Differences between two of our maps (exact values). */
 size_t it_diff_maps(const occ_map_t *a, const occ_map_t *b);
+/* Differences between our map and OctoMap's tree t (oracle_rays.h), both ways: every OctoMap
+ * leaf read from ours at its level, every leaf of ours searched in t; values within tol (the
+ * 8-bit mode: its documented rounding), states equal. Prints the first five. */
+size_t it_diff_oracle(const occ_map_t *m, void *t, float tol);
 /* Checksum of everything a walk reports; *nodes = nodes walked. */
 uint64_t it_map_digest(const occ_map_t *m, size_t *nodes);
 /* CMocka setup/teardown that print each test's CPU time. */
