@@ -137,6 +137,34 @@ static occ_mav_frame_t att_frame(uint8_t sysid, uint8_t compid, uint32_t ms, flo
     return parse(buf, len);
 }
 
+/* ATTITUDE_QUATERNION of the autopilot: q = w, x, y, z (body FRD -> local NED). */
+static occ_mav_frame_t attq_frame(uint32_t ms, const float q[4], uint8_t *buf)
+{
+    mavlink_attitude_quaternion_t a;
+    memset(&a, 0, sizeof a);
+    a.time_boot_ms = ms;
+    a.q1 = q[0], a.q2 = q[1], a.q3 = q[2], a.q4 = q[3];
+    const size_t len = occ_mav_finalize(&ap, MAVLINK_MSG_ID_ATTITUDE_QUATERNION,
+                                        (const uint8_t *)&a, MAVLINK_MSG_ID_ATTITUDE_QUATERNION_LEN,
+                                        buf, OCC_MAV_FRAME_MAX);
+    return parse(buf, len);
+}
+
+/* ODOMETRY of the autopilot in MAV_FRAME_LOCAL_NED (1): position NED, q body FRD -> NED. */
+static occ_mav_frame_t odom_frame(uint64_t usec, float n, float e, float d, const float q[4],
+                                  uint8_t *buf)
+{
+    mavlink_odometry_t o;
+    memset(&o, 0, sizeof o);
+    o.time_usec = usec;
+    o.frame_id = 1;
+    o.x = n, o.y = e, o.z = d;
+    memcpy(o.q, q, sizeof o.q);
+    const size_t len = occ_mav_finalize(&ap, MAVLINK_MSG_ID_ODOMETRY, (const uint8_t *)&o,
+                                        MAVLINK_MSG_ID_ODOMETRY_LEN, buf, OCC_MAV_FRAME_MAX);
+    return parse(buf, len);
+}
+
 static void test_pose_filter(void **state)
 {
     (void)state;
@@ -188,12 +216,14 @@ static void test_pose_filter(void **state)
     assert_true(occ_mav_pose_rx_take(&rx, &f, &s));
     assert_true(s.t_us == 1030000u);
     assert_float_equal(s.pose.p.x, 2.0f, 1e-6f);
-    /* the same stamp again: not newer; an attitude 100 ms from the position: unpaired */
+    /* the same stamp again: not newer; an attitude 100 ms from the position: no pose. Replaced
+     * without ever making a pose (unpaired): the 1020 attitude (by 1030's) and the repeated
+     * 1030 one (by 1130's); 1130's itself counts only once something replaces it */
     f = att_frame(1, 1, 1030, 0.0f, buf);
     assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
     f = att_frame(1, 1, 1130, 0.0f, buf);
     assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
-    assert_int_equal(rx.counters.unpaired, 1u);
+    assert_int_equal(rx.counters.unpaired, 2u);
     /* a NaN position is refused and does not become the position */
     f = pos_frame(1, 1, 1130, NAN, 0.0f, 0.0f, buf);
     assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
@@ -203,12 +233,63 @@ static void test_pose_filter(void **state)
     assert_int_equal(rx.counters.attitudes, 6u);
 }
 
+/* Take one frame of the autopilot; true when it completed a pose (its stamp in *t_us). */
+static bool take(occ_mav_pose_rx_t *rx, occ_mav_frame_t f, uint64_t *t_us)
+{
+    occ_pose_sample_t s;
+    const bool got = occ_mav_pose_rx_take(rx, &f, &s);
+    *t_us = got ? s.t_us : 0u;
+    return got;
+}
+
+/* unpaired counts a position or attitude replaced by a newer one without ever having made a
+ * pose: a 33 ms stream (beyond the 25 ms tolerance from the previous partner) whose position
+ * comes before its attitude, or the other way round, pairs a moment later and is not counted. */
+static void test_pose_unpaired(void **state)
+{
+    (void)state;
+    occ_mav_pose_rx_t rx;
+    const occ_mav_pose_rx_config_t cfg = occ_mav_pose_rx_config_default();
+    assert_int_equal(occ_mav_pose_rx_init(&rx, &cfg), OCC_OK);
+    uint8_t buf[OCC_MAV_FRAME_MAX];
+    uint64_t t = 0;
+    const float level[4] = {1.0f, 0.0f, 0.0f, 0.0f};
+    /* position first, then attitude, every 33 ms: three poses, nothing unpaired */
+    for (uint32_t ms = 1000; ms <= 1066; ms += 33) {
+        assert_false(take(&rx, pos_frame(1, 1, ms, 0.0f, 0.0f, 0.0f, buf), &t));
+        assert_true(take(&rx, att_frame(1, 1, ms, 0.0f, buf), &t));
+        assert_true(t == (uint64_t)ms * 1000u);
+    }
+    /* attitude first (34 ms after the last position), then its position: a pose */
+    assert_false(take(&rx, att_frame(1, 1, 1100, 0.0f, buf), &t));
+    assert_true(take(&rx, pos_frame(1, 1, 1100, 0.0f, 0.0f, 0.0f, buf), &t));
+    assert_int_equal(rx.counters.unpaired, 0u);
+    /* a position that never pairs (replaced 33 ms later): one */
+    assert_false(take(&rx, pos_frame(1, 1, 1200, 0.0f, 0.0f, 0.0f, buf), &t));
+    assert_false(take(&rx, pos_frame(1, 1, 1233, 0.0f, 0.0f, 0.0f, buf), &t));
+    assert_int_equal(rx.counters.unpaired, 1u);
+    assert_true(take(&rx, attq_frame(1233, level, buf), &t));
+    /* an attitude that never pairs (replaced by the next): two */
+    assert_false(take(&rx, attq_frame(1300, level, buf), &t));
+    assert_false(take(&rx, attq_frame(1400, level, buf), &t));
+    assert_true(take(&rx, pos_frame(1, 1, 1400, 0.0f, 0.0f, 0.0f, buf), &t));
+    assert_int_equal(rx.counters.unpaired, 2u);
+    /* ODOMETRY replaces both parts: the lone position before it counts, the paired attitude
+     * does not; ODOMETRY itself is a pose */
+    assert_false(take(&rx, pos_frame(1, 1, 1500, 0.0f, 0.0f, 0.0f, buf), &t));
+    assert_true(take(&rx, odom_frame(1600000u, 0.0f, 0.0f, 0.0f, level, buf), &t));
+    assert_true(t == 1600000u);
+    assert_int_equal(rx.counters.unpaired, 3u);
+    assert_int_equal(rx.counters.poses, 7u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_timesync_offset),
         cmocka_unit_test(test_codecs),
         cmocka_unit_test(test_pose_filter),
+        cmocka_unit_test(test_pose_unpaired),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

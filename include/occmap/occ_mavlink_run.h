@@ -121,7 +121,9 @@ typedef struct {
     uint32_t poses;                /* poses handed out */
     uint32_t foreign;              /* pose messages from another system or component */
     uint32_t bad;                  /* pose messages that did not decode or were not finite */
-    uint32_t unpaired;             /* position/attitude whose partner was too far in time */
+    uint32_t unpaired;             /* positions / attitudes replaced by a newer one without
+                                    * ever having made a pose (no partner within pair_tol_us);
+                                    * one that pairs with a later partner is not counted */
 } occ_mav_pose_rx_counters_t;
 
 typedef struct {
@@ -129,6 +131,7 @@ typedef struct {
     occ_mav_pose_rx_counters_t counters;
     struct {                       /* internal: do not touch, layout may change */
         bool have_pos, have_att, have_out;
+        bool pos_paired, att_paired; /* the stored part is in a pose handed out */
         uint64_t pos_us, att_us, out_us;
         occ_vec3_t ned;
         occ_quat_t q;

@@ -42,6 +42,7 @@ static bool emit(occ_mav_pose_rx_t *rx, uint64_t t_us, occ_pose_sample_t *out)
         return false;
     }
     s.t_us = t_us;
+    rx->priv.pos_paired = rx->priv.att_paired = true;
     rx->priv.have_out = true;
     rx->priv.out_us = t_us;
     rx->counters.poses++;
@@ -58,13 +59,20 @@ static bool pair(occ_mav_pose_rx_t *rx, bool have_other, uint64_t other_us, uint
     }
     const uint64_t d = t_us > other_us ? t_us - other_us : other_us - t_us;
     if (d > rx->cfg.pair_tol_us) {
-        rx->counters.unpaired++;
-        return false;
+        return false; /* its own partner may still come: counted only if it never does */
     }
     if (rx->priv.have_out && other_us <= rx->priv.out_us) {
         return false; /* the partner is in the last pose already: wait for its own partner */
     }
     return emit(rx, t_us > other_us ? t_us : other_us, out);
+}
+
+/* A part about to be replaced: unpaired if it never made a pose. */
+static void replace_part(occ_mav_pose_rx_t *rx, bool have, bool paired)
+{
+    if (have && !paired) {
+        rx->counters.unpaired++;
+    }
 }
 
 static bool take_position(occ_mav_pose_rx_t *rx, const occ_mav_frame_t *f, occ_pose_sample_t *out)
@@ -76,11 +84,13 @@ static bool take_position(occ_mav_pose_rx_t *rx, const occ_mav_frame_t *f, occ_p
         return false;
     }
     rx->counters.positions++;
+    replace_part(rx, rx->priv.have_pos, rx->priv.pos_paired);
     rx->priv.ned.x = m.x;
     rx->priv.ned.y = m.y;
     rx->priv.ned.z = m.z;
     rx->priv.pos_us = (uint64_t)m.time_boot_ms * 1000u;
     rx->priv.have_pos = true;
+    rx->priv.pos_paired = false;
     return pair(rx, rx->priv.have_att, rx->priv.att_us, rx->priv.pos_us, out);
 }
 
@@ -93,9 +103,11 @@ static bool take_attitude(occ_mav_pose_rx_t *rx, occ_quat_t q, uint32_t time_boo
         return false;
     }
     rx->counters.attitudes++;
+    replace_part(rx, rx->priv.have_att, rx->priv.att_paired);
     rx->priv.q = u;
     rx->priv.att_us = (uint64_t)time_boot_ms * 1000u;
     rx->priv.have_att = true;
+    rx->priv.att_paired = false;
     return pair(rx, rx->priv.have_pos, rx->priv.pos_us, rx->priv.att_us, out);
 }
 
@@ -114,6 +126,9 @@ static bool take_odometry(occ_mav_pose_rx_t *rx, const occ_mav_frame_t *f, occ_p
     }
     rx->counters.positions++;
     rx->counters.attitudes++;
+    replace_part(rx, rx->priv.have_pos, rx->priv.pos_paired);
+    replace_part(rx, rx->priv.have_att, rx->priv.att_paired);
+    rx->priv.pos_paired = rx->priv.att_paired = false;
     rx->priv.ned.x = m.x;
     rx->priv.ned.y = m.y;
     rx->priv.ned.z = m.z;
