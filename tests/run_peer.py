@@ -23,7 +23,9 @@ times faster so the tests take seconds). Tests (each prints PASS/FAIL):
             pymavlink, at the points another component reported (within a voxel).
   jitter    mapping busy (full-resolution frames) while the feed runs: its period jitter is
             reported (p50/p99/max, printed), its median below half an integration's (the feed
-            never waits for the writer), the feed saw new map versions while it ran.
+            never waits for the writer), the feed saw new map versions while it ran; the final
+            telemetry's clock source is TIMESYNC and its offset the stand-in's (within half
+            the round trip).
 Exit 0 when every test passed."""
 import argparse
 import json
@@ -314,6 +316,21 @@ def expected_drops(frames, sent_us):
     return out
 
 
+def clock_ok(c, fin, peer):
+    """The final telemetry's clock: TIMESYNC answered, and its offset (autopilot - occmap
+    clock, us) is the stand-in's: its boot time is (monotonic - t0) x speed, occmap's clock is
+    the same CLOCK_MONOTONIC, so at speed 1 the offset is -t0 within half the round trip."""
+    clk = fin.get("clock", {})
+    c.that(clk.get("source") == "timesync" and clk.get("timesync_replies", 0) > 0,
+           "clock %s (want source timesync)" % clk)
+    want = -peer.t0 * 1e6
+    err = abs(clk.get("offset_us", 0) - want)
+    c.that(peer.speed == 1.0 and err <= clk.get("rtt_us", 0) / 2 + 1000,
+           "clock offset %s us, the stand-in's %.0f us (off by %.0f, rtt %s us)" %
+           (clk.get("offset_us"), want, err, clk.get("rtt_us")))
+    return err
+
+
 def test_requests(o, frames, gt):
     c = Check("requests")
     port = free_port()
@@ -451,6 +468,7 @@ def test_jitter(o, frames, gt):
                                 "--stats", st, "--feed-log", fl], peer, 30)
     c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     fin = stats_lines(st)[-1].get("final", {}) if os.path.exists(st) else {}
+    clock_err = clock_ok(c, fin, peer)
     feed, im = fin.get("feed", {}), fin.get("integrate_ms", {})
     j = feed.get("jitter_ms", {})
     c.that(j.get("n", 0) == feed.get("sent", 0) - 1 and j.get("n", 0) > 0,
@@ -466,9 +484,9 @@ def test_jitter(o, frames, gt):
            "the writer" % (j.get("p50"), im.get("p50")))
     return c.done("mapping full frames (integrate p50 %s / p99 %s / max %s ms) while the feed "
                   "sent %s at %s ms: jitter p50 %s / p99 %s / max %s ms (lock-free map: p50 "
-                  "below half an integration)" %
+                  "below half an integration); TIMESYNC offset within %.0f us of the stand-in's" %
                   (im.get("p50"), im.get("p99"), im.get("max"), feed.get("sent"),
-                   feed.get("period_ms"), j.get("p50"), j.get("p99"), j.get("max")))
+                   feed.get("period_ms"), j.get("p50"), j.get("p99"), j.get("max"), clock_err))
 
 
 def test_ranges(o, frames, gt):

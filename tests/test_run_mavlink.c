@@ -283,6 +283,77 @@ static void test_pose_unpaired(void **state)
     assert_int_equal(rx.counters.poses, 7u);
 }
 
+/* A pose completed by the receiver, pushed into the history (as `occmap run` does). */
+static void take_push(occ_mav_pose_rx_t *rx, occ_pose_history_t *h, occ_mav_frame_t f,
+                      uint64_t want_t_us)
+{
+    occ_pose_sample_t s;
+    assert_true(occ_mav_pose_rx_take(rx, &f, &s));
+    assert_true(s.t_us == want_t_us);
+    assert_int_equal(occ_pose_history_push(h, s.t_us, &s.pose), OCC_OK);
+}
+
+/* The history's pose at t: position, and where the body's forward (FLU x) and left (y) axes
+ * point in the ENU map. */
+static void expect_at(occ_pose_history_t *h, uint64_t t_us, occ_vec3_t p, occ_vec3_t fwd,
+                      occ_vec3_t left)
+{
+    occ_pose_t pose;
+    assert_int_equal(occ_pose_history_at(h, t_us, &pose, NULL), OCC_OK);
+    const occ_vec3_t f = occ_pose_rotate(&pose, (occ_vec3_t){1.0f, 0.0f, 0.0f});
+    const occ_vec3_t l = occ_pose_rotate(&pose, (occ_vec3_t){0.0f, 1.0f, 0.0f});
+    const float got[9] = {pose.p.x, pose.p.y, pose.p.z, f.x, f.y, f.z, l.x, l.y, l.z};
+    const float want[9] = {p.x, p.y, p.z, fwd.x, fwd.y, fwd.z, left.x, left.y, left.z};
+    for (unsigned i = 0; i < 9u; i++) {
+        assert_float_equal(got[i], want[i], 1e-5f);
+    }
+}
+
+/* ATTITUDE_QUATERNION (+ LOCAL_POSITION_NED) and ODOMETRY through the receiver into a pose
+ * history, read back at and between the samples against hand-computed poses. NED heading h
+ * is ENU yaw 90 deg - h; NED (n, e, d) is ENU (e, n, -d). */
+static void test_pose_history_feed(void **state)
+{
+    (void)state;
+    occ_mav_pose_rx_t rx;
+    const occ_mav_pose_rx_config_t cfg = occ_mav_pose_rx_config_default();
+    assert_int_equal(occ_mav_pose_rx_init(&rx, &cfg), OCC_OK);
+    occ_pose_sample_t ring[8];
+    const occ_pose_history_cfg_t hc = {100000u, 0u};
+    occ_pose_history_t h;
+    assert_int_equal(occ_pose_history_init(&h, ring, 8, &hc), OCC_OK);
+    uint8_t buf[OCC_MAV_FRAME_MAX];
+    const float c15 = 0.96592583f, s15 = 0.25881905f, c45 = 0.70710678f;
+    const float c30 = 0.86602540f;
+    /* 1.000 s: NED (1, 2, -3), heading 30 deg (q = cos 15, 0, 0, sin 15) -> ENU (2, 1, 3),
+     * yaw 60 deg: forward (cos 60, sin 60, 0), left (-sin 60, cos 60, 0) */
+    occ_mav_frame_t f = pos_frame(1, 1, 1000, 1.0f, 2.0f, -3.0f, buf);
+    occ_pose_sample_t s;
+    assert_false(occ_mav_pose_rx_take(&rx, &f, &s));
+    const float qa[4] = {c15, 0.0f, 0.0f, s15};
+    take_push(&rx, &h, attq_frame(1000, qa, buf), 1000000u);
+    /* 1.080 s, ODOMETRY: NED (1, 4, -3), heading 90 deg (east) -> ENU (4, 1, 3), yaw 0 */
+    const float qb[4] = {c45, 0.0f, 0.0f, c45};
+    take_push(&rx, &h, odom_frame(1080000u, 1.0f, 4.0f, -3.0f, qb, buf), 1080000u);
+    /* 1.160 s, ODOMETRY: the same place and heading, rolled 30 deg right (right wing down):
+     * q = qz(90) qx(30); the left wing points north and up (0, cos 30, sin 30) */
+    const float qc[4] = {c45 * c15, c45 * s15, c45 * s15, c45 * c15};
+    take_push(&rx, &h, odom_frame(1160000u, 1.0f, 4.0f, -3.0f, qc, buf), 1160000u);
+    expect_at(&h, 1000000u, (occ_vec3_t){2.0f, 1.0f, 3.0f}, (occ_vec3_t){0.5f, c30, 0.0f},
+              (occ_vec3_t){-c30, 0.5f, 0.0f});
+    /* halfway to the first ODOMETRY: (3, 1, 3), yaw 30 deg */
+    expect_at(&h, 1040000u, (occ_vec3_t){3.0f, 1.0f, 3.0f}, (occ_vec3_t){c30, 0.5f, 0.0f},
+              (occ_vec3_t){-0.5f, c30, 0.0f});
+    expect_at(&h, 1080000u, (occ_vec3_t){4.0f, 1.0f, 3.0f}, (occ_vec3_t){1.0f, 0.0f, 0.0f},
+              (occ_vec3_t){0.0f, 1.0f, 0.0f});
+    /* a quarter of the way through the roll: 7.5 deg, left (0, cos 7.5, sin 7.5) */
+    expect_at(&h, 1100000u, (occ_vec3_t){4.0f, 1.0f, 3.0f}, (occ_vec3_t){1.0f, 0.0f, 0.0f},
+              (occ_vec3_t){0.0f, 0.99144486f, 0.13052619f});
+    expect_at(&h, 1160000u, (occ_vec3_t){4.0f, 1.0f, 3.0f}, (occ_vec3_t){1.0f, 0.0f, 0.0f},
+              (occ_vec3_t){0.0f, c30, 0.5f});
+    assert_int_equal(rx.counters.poses, 3u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -290,6 +361,7 @@ int main(void)
         cmocka_unit_test(test_codecs),
         cmocka_unit_test(test_pose_filter),
         cmocka_unit_test(test_pose_unpaired),
+        cmocka_unit_test(test_pose_history_feed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
