@@ -8,7 +8,8 @@ north), level, heading 30 deg. Run inside a network namespace with only loopback
 0.2..10 m; the duration; the rate), and one option on the command line overrides it.
 pydronecan node 10 sends uavcan.equipment.range_sensor.Measurement: sensor 3 reads 1.50 m
 (VALID), sensor 9 (no mount) 0.5 m. Checks (PASS/FAIL run-can):
- - before the reading is integrated the forward sector shows the wall (3/cos 30 = 3.46 m);
+ - before the first reading the configured sensor is stale (--sensor-timeout-ms applies to
+   each configured input): Proximity from node 100 says NO_DATA, never GOOD;
    after it, Proximity from node 100 (GOOD) of the sector centred on body yaw 0 reports
    1.35..1.50 m (1.5 - 0.1 sqrt 2: the nearest point of the hit voxel)
    (the hit voxel 1.5 m ahead, nearer than the wall), the wall sectors stay (2.9..3.5 m);
@@ -59,7 +60,7 @@ def main():
                           "--rate", "10", "--stats", st],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     t0 = time.monotonic()
-    t_read, nxt = t0 + 1.2, 0.0  # readings start once the wall has been reported for a while
+    t_read, nxt = t0 + 1.2, 0.0  # readings start after 1.2 s: sensor 3 is stale until then
     while p.poll() is None and time.monotonic() - t0 < 20:
         peer.step()
         node.spin(0)
@@ -76,10 +77,12 @@ def main():
         bad.append("exit %s: %s" % (p.returncode, err[-300:]))
     ours = [x for x in prox if x[1] == 100 and x[2] == 2]
     fwd = [x for x in ours if abs(x[3]) < 1.0]  # the sector centred on body yaw 0
-    before = [x[4] for x in fwd if x[0] < t_read]
+    good_before = [x for x in ours if x[0] < t_read]
+    nodata_before = [x for x in prox if x[1] == 100 and x[2] == 0 and x[0] < t_read]
     after = [x[4] for x in fwd if x[0] > t_read + 0.5]
-    if not before or not all(3.3 <= d <= 3.5 for d in before):
-        bad.append("forward before the reading %s (want the wall, 3.3..3.5 m)" % before[:5])
+    if good_before or not nodata_before:
+        bad.append("before the first reading (sensor 3 silent: stale) %d GOOD, %d NO_DATA "
+                   "(want none, some)" % (len(good_before), len(nodata_before)))
     if not after or not all(1.35 <= d <= 1.5 for d in after):
         bad.append("forward after the reading %s (want 1.35..1.50 m)" % after[:5])
     wall_after = [x for x in ours if x[0] > t_read + 0.5 and abs(x[3] + 30) <= 20]
@@ -103,9 +106,10 @@ def main():
     if bad:
         print("FAIL run-can: " + "; ".join(bad))
         return 1
-    print("PASS run-can: forward sector %.2f m (wall) -> %.2f m after %d DroneCAN readings "
-          "(sensor 3, 1.50 m); %d unknown-sensor readings refused; %d Proximity GOOD" %
-          (before[-1], after[-1], can["readings"], can["unknown_sensor"], len(ours)))
+    print("PASS run-can: %d NO_DATA while sensor 3 was silent, then forward sector %.2f m after "
+          "%d DroneCAN readings (sensor 3, 1.50 m), wall sectors kept; %d unknown-sensor readings "
+          "refused; %d Proximity GOOD" % (len(nodata_before), after[-1], can["readings"],
+                                          can["unknown_sensor"], len(ours)))
     return 0
 
 

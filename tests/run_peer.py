@@ -19,6 +19,8 @@ times faster so the tests take seconds). Tests (each prints PASS/FAIL):
             ends by itself (--exit-after-depth) with exit 0, eviction ran, occ_map_check holds.
   stale     sensors stale after the last frame (then pose stale with a prior --map): one
             STATUSTEXT each, no OBSTACLE_DISTANCE after it, HEARTBEAT ACTIVE before, CRITICAL after.
+  ranges_stale  --mavlink-ranges without a camera: the rangefinder stops while the poses go
+            on: one STATUSTEXT, no OBSTACLE_DISTANCE after it, HEARTBEAT CRITICAL.
   3d        --3d: OBSTACLE_DISTANCE_3D above / below after each OBSTACLE_DISTANCE, decoded by
             pymavlink, at the points another component reported (within a voxel).
   jitter    mapping busy (full-resolution frames) while the feed runs: its period jitter is
@@ -108,6 +110,7 @@ def read_tum(d):
 class Peer:
     def __init__(self, port, gt, speed=1.0, ignore=0, refuse=False, foreign=False,
                  withhold=None, stop_at_us=None, hold_last=False):
+        self.port = port
         self.conn = mavutil.mavlink_connection("udpin:127.0.0.1:%d" % port, source_system=1,
                                                source_component=1)
         self.other = mavutil.mavlink.MAVLink(None, srcSystem=2, srcComponent=1)
@@ -209,6 +212,28 @@ def run(occmap, args, peer, timeout):
     out, err = p.communicate()
     peer.conn.close()
     return p.returncode, out, err
+
+
+def run_sensor(occmap, args, peer, send, send_for=None, period=0.1):
+    """occmap run against the peer while another component (1/158) calls send(mav, boot_us)
+    every `period` s once the poses flow, for `send_for` s (None: to the end). Returns the exit
+    status, stderr and the local times of the first and last send."""
+    sensor = mavutil.mavlink.MAVLink(None, srcSystem=1, srcComponent=158)
+    p = subprocess.Popen([occmap, "run", "--udp", "127.0.0.1:%d" % peer.port] + args,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    nxt, first, last = 0.0, None, None
+    while p.poll() is None:
+        peer.step()
+        now = time.monotonic()
+        if peer.conn.clients and peer.sent_us and now > nxt:
+            first = now if first is None else first
+            if send_for is None or now - first < send_for:
+                nxt, last = now + period, now
+                for m in send(sensor, peer.boot_us()):
+                    peer.conn.write(m.pack(sensor))
+    _, err = p.communicate()
+    peer.conn.close()
+    return p.returncode, err, first, last
 
 
 def stats_lines(path):
@@ -489,6 +514,11 @@ def test_jitter(o, frames, gt):
                    feed.get("period_ms"), j.get("p50"), j.get("p99"), j.get("max"), clock_err))
 
 
+def down_150cm(mav, boot_us):
+    """DISTANCE_SENSOR: 1.50 m straight down (PITCH_270), 0.2..4 m, stamped now."""
+    return [mav.distance_sensor_encode(boot_us // 1000, 20, 400, 150, 0, 7, 25, 0)]
+
+
 def test_ranges(o, frames, gt):
     """DISTANCE_SENSOR from another component (1/158, down, 1.50 m) with --mavlink-ranges and no
     camera: the voxel 1.5 m under the vehicle is occupied, the column above it free (hand
@@ -497,22 +527,11 @@ def test_ranges(o, frames, gt):
     port = free_port()
     first = (gt[0][0], gt[0][1], gt[0][2], (0.0, 0.0, 0.3))  # level, heading 0.3 rad
     peer = Peer(port, [first], hold_last=True)
-    sensor = mavutil.mavlink.MAVLink(None, srcSystem=1, srcComponent=158)
     omap = os.path.join(o.out, "ranges.occ")
     st = os.path.join(o.out, "ranges_stats.json")
-    p = subprocess.Popen([o.occmap, "run", "--udp", "127.0.0.1:%d" % port, "--mavlink-ranges",
-                          "--duration", "2", "-o", omap, "--stats", st],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    nxt = 0.0
-    while p.poll() is None:
-        peer.step()
-        if peer.conn.clients and time.monotonic() > nxt and peer.sent_us:
-            nxt = time.monotonic() + 0.1
-            peer.conn.write(sensor.distance_sensor_encode(peer.boot_us() // 1000, 20, 400, 150, 0,
-                                                          7, 25, 0).pack(sensor))
-    _, err = p.communicate()
-    peer.conn.close()
-    c.that(p.returncode == 0, "exit %s: %s" % (p.returncode, err[-300:]))
+    rc, err, _, _ = run_sensor(o.occmap, ["--mavlink-ranges", "--duration", "2", "-o", omap,
+                                          "--stats", st], peer, down_150cm)
+    c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     fin = stats_lines(st)[-1]["final"] if os.path.exists(st) else {}
     r = fin.get("ranges", {})
     c.that(r.get("integrated", 0) > 0, "ranges %s" % r)
@@ -531,6 +550,31 @@ def test_ranges(o, frames, gt):
                   r.get("integrated"))
 
 
+def test_ranges_stale(o, frames, gt):
+    """--mavlink-ranges and no camera: another component's DISTANCE_SENSOR for 1 s, then none
+    while the poses go on: one STATUSTEXT (sensors stale) at least --sensor-timeout-ms after the
+    last reading, no OBSTACLE_DISTANCE after it, HEARTBEAT ACTIVE before and CRITICAL after."""
+    c = Check("ranges-stale")
+    first = (gt[0][0], gt[0][1], gt[0][2], (0.0, 0.0, 0.3))
+    peer = Peer(free_port(), [first], hold_last=True)
+    st = os.path.join(o.out, "ranges_stale_stats.json")
+    rc, err, _, last = run_sensor(o.occmap, ["--mavlink-ranges", "--sensor-timeout-ms", "400",
+                                             "--duration", "3.3", "--stats", st], peer,
+                                  down_150cm, send_for=1.0)
+    c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
+    silence(c, peer, "sensors stale")
+    warn = [s[0] for s in peer.statustexts if s[1] == 4]
+    c.that(warn and last is not None and warn[0] - last >= 0.35,
+           "STATUSTEXT %.3f s after the last reading (timeout 0.4 s)" %
+           ((warn[0] - last) if warn and last else -1))
+    fin = stats_lines(st)[-1].get("final", {}) if os.path.exists(st) else {}
+    c.that(fin.get("status") == "stale" and fin.get("stale_input") == "mavlink_ranges",
+           "final status %s, stale input %s" % (fin.get("status"), fin.get("stale_input")))
+    return c.done("rangefinder only: %d OBSTACLE_DISTANCE while it reported, then one STATUSTEXT "
+                  "%.2f s after its last reading and silence; HEARTBEAT 4 -> 5" %
+                  (len(peer.obstacles), (warn[0] - last) if warn and last else -1))
+
+
 def test_3d(o, frames, gt):
     """--3d: another component (1/158) reports two OBSTACLE_DISTANCE_3D points (BODY_FRD),
     forward-right 1.2 m above and behind-left 1.4 m below a level vehicle turned 0.3 rad
@@ -542,7 +586,6 @@ def test_3d(o, frames, gt):
     port = free_port()
     first = (gt[0][0], gt[0][1], gt[0][2], (0.0, 0.0, 0.3))
     peer = Peer(port, [first], hold_last=True)
-    sensor = mavutil.mavlink.MAVLink(None, srcSystem=1, srcComponent=158)
     pts = {0: (1.0, 0.5, -1.2), 1: (-0.8, -0.6, 1.4)}  # FRD m: above, below
     got = []  # (time, msg) of OBSTACLE_DISTANCE and OBSTACLE_DISTANCE_3D in arrival order
     handle = peer.handle
@@ -553,21 +596,13 @@ def test_3d(o, frames, gt):
         handle(m)
     peer.handle = grab
     fl = os.path.join(o.out, "3d_feed.json")
-    p = subprocess.Popen([o.occmap, "run", "--udp", "127.0.0.1:%d" % port, "--mavlink-ranges",
-                          "--3d", "--duration", "2.5", "--feed-log", fl,
-                          "--stats", os.path.join(o.out, "3d_stats.json")],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    nxt = 0.0
-    while p.poll() is None:
-        peer.step()
-        if peer.conn.clients and time.monotonic() > nxt and peer.sent_us:
-            nxt = time.monotonic() + 0.1
-            for x, y, z in pts.values():
-                peer.conn.write(sensor.obstacle_distance_3d_encode(
-                    peer.boot_us() // 1000, 0, 12, 65535, x, y, z, 0.2, 10.0).pack(sensor))
-    _, err = p.communicate()
-    peer.conn.close()
-    c.that(p.returncode == 0, "exit %s: %s" % (p.returncode, err[-300:]))
+    rc, err, _, _ = run_sensor(
+        o.occmap, ["--mavlink-ranges", "--3d", "--duration", "2.5", "--feed-log", fl,
+                   "--stats", os.path.join(o.out, "3d_stats.json")], peer,
+        lambda mav, boot_us: [mav.obstacle_distance_3d_encode(boot_us // 1000, 0, 12, 65535, x, y,
+                                                              z, 0.2, 10.0)
+                              for x, y, z in pts.values()])
+    c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
     diag = 0.1 * math.sqrt(3.0) + 1e-4
     batches, od = [], None
     for m in got:
@@ -602,7 +637,7 @@ def test_3d(o, frames, gt):
                      if full else None))
 
 
-TESTS = {"3d": test_3d, "ranges": test_ranges, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
+TESTS = {"3d": test_3d, "ranges": test_ranges, "ranges_stale": test_ranges_stale, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
 
 
 def main():

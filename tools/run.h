@@ -87,6 +87,14 @@ int run_depth_open(run_depth_t *d, const run_opts_t *o);
 void run_depth_close(run_depth_t *d);
 
 /* ---- shared state ---------------------------------------------------------------------------- */
+/* The sensor inputs, each with its own staleness (--sensor-timeout-ms). */
+enum { RUN_SRC_DEPTH, RUN_SRC_MAVLINK, RUN_SRC_CAN, RUN_SOURCES };
+
+/* Whether the options configure input `src` (--depth-dir; --mavlink-ranges; --can with a
+ * --can-range-mount), and its name in the telemetry. */
+bool run_source_on(const run_opts_t *o, int src);
+const char *run_source_name(int src);
+
 enum { RUN_DROP_EMPTY, RUN_DROP_TOO_OLD, RUN_DROP_TOO_NEW, RUN_DROP_GAP, RUN_DROP_NOMEM,
        RUN_DROP_ERROR, RUN_DROP_LATE, RUN_DROP_REASONS };
 
@@ -104,7 +112,6 @@ typedef struct {
     uint64_t points;                 /* back-projected points integrated */
     uint32_t *integrate_us;          /* every integration's time, in order */
     size_t n_integrate, cap_integrate;
-    uint64_t last_integrated_local_us; /* 0: none yet */
     uint64_t saves, save_errors;
     bool done;                       /* the mapping thread has finished the directory */
 } run_map_counters_t;
@@ -120,6 +127,7 @@ typedef struct {
     int64_t arrival_offset_us;       /* max(remote stamp - local arrival): offset without TIMESYNC */
     /* mapping thread -> link thread */
     run_map_counters_t mc;
+    uint64_t last_sample_local_us[RUN_SOURCES]; /* each input's newest integration; 0: none */
     run_list_t integrated, dropped;  /* since the last feed-log line */
     occ_evict_out_t evict;           /* written by the mapper under lock after each frame */
     occ_map_stats_t pool;            /* the pools after the last frame (occ_map_pool_stats) */

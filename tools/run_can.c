@@ -82,7 +82,7 @@ static void take_reading(run_link_t *l, run_can_t *c, const occ_dronecan_range_r
     b.n = 1;
     b.beam[0] = r->beam;
     c->readings++;
-    run_ranges_queue(l->st, l->st->ranges, &b, now);
+    run_ranges_queue(l->st, l->st->ranges, &b, now, RUN_SRC_CAN);
 }
 
 static occ_err_t bus_recv(run_can_t *c, occ_can_frame_t *f, bool *got)

@@ -100,17 +100,25 @@ static void poll_timesync(run_link_t *l, uint64_t now)
     send_frame(l, out, occ_mav_encode_timesync(&l->tx, &q, out, sizeof out));
 }
 
-static bool sensors_fresh(run_link_t *l, uint64_t now)
+/* Every configured input integrated a sample within --sensor-timeout-ms (none configured:
+ * fresh); else *stale names the first that did not. */
+static bool sensors_fresh(run_link_t *l, uint64_t now, const char **stale)
 {
-    if (l->depth == NULL) {
-        return true;
-    }
+    const uint64_t timeout = (uint64_t)l->opt->sensor_timeout_ms * 1000u;
+    uint64_t last[RUN_SOURCES];
     (void)pthread_mutex_lock(&l->st->lock);
-    const uint64_t last = l->st->mc.last_integrated_local_us;
+    memcpy(last, l->st->last_sample_local_us, sizeof last);
     (void)pthread_mutex_unlock(&l->st->lock);
-    /* last may be after `now` (the mapper integrated since the loop read the clock): fresh,
-     * not a huge unsigned age */
-    return last != 0u && (last >= now || now - last <= (uint64_t)l->opt->sensor_timeout_ms * 1000u);
+    for (int s = 0; s < RUN_SOURCES; s++) {
+        /* last may be after `now` (integrated since the loop read the clock): fresh, not a
+         * huge unsigned age */
+        const bool fresh = last[s] != 0u && (last[s] >= now || now - last[s] <= timeout);
+        if (run_source_on(l->opt, s) && !fresh) {
+            *stale = run_source_name(s);
+            return false;
+        }
+    }
+    return true;
 }
 
 static void statustext(run_link_t *l, uint8_t severity, const char *text)
@@ -126,10 +134,12 @@ static void statustext(run_link_t *l, uint8_t severity, const char *text)
 static bool update_status(run_link_t *l, uint64_t now)
 {
     const bool pose_ok = occ_mav_feed_pose(l->feed, now, NULL);
-    const bool sens_ok = sensors_fresh(l, now);
+    const char *input = NULL;
+    const bool sens_ok = sensors_fresh(l, now, &input);
     const bool stale = !pose_ok || !sens_ok;
     if (stale && !l->stale && l->ever_sent) {
-        l->stale_why = !pose_ok ? "pose" : "sensors";
+        l->stale_why = !pose_ok ? "pose" : input;
+        fprintf(stderr, "occmap run: stale input: %s\n", l->stale_why);
         statustext(l, OCC_MAV_SEVERITY_WARNING, !pose_ok ? "occmap: pose stale, obstacle data stopped"
                                                          : "occmap: sensors stale, obstacle data stopped");
     } else if (!stale && l->stale && l->ever_sent) {

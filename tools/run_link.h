@@ -32,7 +32,7 @@ typedef struct run_link_s {
     uint64_t t0, next_stats, next_timesync;
     uint32_t timesync_sent, refusals_logged, statustexts;
     bool ever_sent, stale, autopilot_logged;
-    const char *stale_why;
+    const char *stale_why;          /* what went stale last: "pose" or an input's name */
     uint64_t od_seq;
     run_feed_timing_t ft;
     bool done_seen;                 /* the mapper finished: */

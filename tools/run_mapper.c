@@ -235,7 +235,7 @@ static void record(run_mapper_t *m, const run_frame_t *f, int drop, bool partial
         c->integrated++;
         c->partial += partial ? 1u : 0u;
         c->points += points;
-        c->last_integrated_local_us = now;
+        st->last_sample_local_us[RUN_SRC_DEPTH] = now;
         /* inside the write section: the version write_end publishes holds this frame */
         (void)run_list_push(&st->integrated, f->index, run_write_next_version(m->guard),
                             map_from_cam);

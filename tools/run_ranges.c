@@ -20,16 +20,17 @@ bool run_ranges_take(run_state_t *st, run_ranges_t *r, occ_mav_ranges_t *tr,
     }
     static occ_mav_beams_t b; /* link thread only */
     if (occ_mav_ranges_decode(tr, f, &b) == OCC_OK) { /* else counted by the translator */
-        run_ranges_queue(st, r, &b, now);
+        run_ranges_queue(st, r, &b, now, RUN_SRC_MAVLINK);
     }
     return true;
 }
 
 void run_ranges_queue(run_state_t *st, run_ranges_t *r, const occ_mav_beams_t *beams,
-                      uint64_t now)
+                      uint64_t now, int source)
 {
     static run_range_msg_t m; /* link thread only */
     m.beams = *beams;
+    m.source = source;
     (void)pthread_mutex_lock(&st->lock);
     int64_t off = 0;
     const char *src = NULL;
@@ -99,7 +100,7 @@ static occ_err_t insert(run_mapper_t *m, const run_range_msg_t *msg, const occ_p
     (void)pthread_mutex_lock(&m->st->lock);
     m->st->evict = ev;
     if (e == OCC_OK) {
-        m->st->mc.last_integrated_local_us = occ_port_clock_us();
+        m->st->last_sample_local_us[msg->source] = occ_port_clock_us();
         m->st->ranges->integrated++;
         occ_map_pool_stats(map, &m->st->pool);
     }

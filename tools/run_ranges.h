@@ -15,6 +15,7 @@
 typedef struct {
     occ_mav_beams_t beams;
     uint64_t remote_us, local_us;    /* autopilot time of arrival; local arrival */
+    int source;                      /* RUN_SRC_MAVLINK or RUN_SRC_CAN (its staleness) */
 } run_range_msg_t;
 
 typedef struct run_ranges_s {
@@ -29,10 +30,11 @@ typedef struct run_ranges_s {
 bool run_ranges_take(run_state_t *st, run_ranges_t *r, occ_mav_ranges_t *tr,
                      const occ_mav_frame_t *f, uint64_t now);
 
-/* Link thread: queue beams (another front end's, e.g. DroneCAN) that arrived at local `now`,
- * stamped with the autopilot's time then. Takes st->lock. */
+/* Link thread: queue beams of input `source` (RUN_SRC_MAVLINK, or another front end's, e.g.
+ * RUN_SRC_CAN) that arrived at local `now`, stamped with the autopilot's time then. Takes
+ * st->lock. */
 void run_ranges_queue(run_state_t *st, run_ranges_t *r, const occ_mav_beams_t *beams,
-                      uint64_t now);
+                      uint64_t now, int source);
 
 /* Mapping thread: integrate every queued message whose pose is known (or give it up after
  * --pose-timeout-ms). */

@@ -4,6 +4,27 @@
 
 #include "run.h"
 
+static const char *const source_names[RUN_SOURCES] = {"depth", "mavlink_ranges", "can_ranges"};
+
+bool run_source_on(const run_opts_t *o, int src)
+{
+    switch (src) {
+    case RUN_SRC_DEPTH:
+        return o->depth_dir != NULL;
+    case RUN_SRC_MAVLINK:
+        return o->mavlink_ranges;
+    case RUN_SRC_CAN:
+        return o->can != NULL && o->n_can_mounts > 0u;
+    default:
+        return false;
+    }
+}
+
+const char *run_source_name(int src)
+{
+    return src >= 0 && src < RUN_SOURCES ? source_names[src] : "?";
+}
+
 bool run_state_offset(const run_state_t *st, int64_t *offset_us, const char **source)
 {
     if (st->ts.valid) {

@@ -132,6 +132,22 @@ static void print_mapping(FILE *f, const run_state_t *st)
             (unsigned long long)c->saves, (unsigned long long)c->save_errors);
 }
 
+/* The age of each configured input's newest integrated sample (ms; -1: none yet). */
+static void print_inputs(FILE *f, const run_link_t *l, uint64_t now)
+{
+    fprintf(f, ", \"sensor_age_ms\": {");
+    bool first = true;
+    for (int s = 0; s < RUN_SOURCES; s++) {
+        if (run_source_on(l->opt, s)) {
+            const uint64_t t = l->st->last_sample_local_us[s];
+            fprintf(f, "%s\"%s\": %.3f", first ? "" : ", ", run_source_name(s),
+                    t == 0u ? -1.0 : t >= now ? 0.0 : (double)(now - t) / 1000.0);
+            first = false;
+        }
+    }
+    fprintf(f, "}");
+}
+
 static void print_clock(FILE *f, run_link_t *l, uint64_t now)
 {
     const run_state_t *const st = l->st;
@@ -151,11 +167,14 @@ void run_stats_line(run_link_t *l, uint64_t now, const char *key, bool map_check
 {
     FILE *const f = l->stats;
     const char *const status = !l->ever_sent ? "boot" : l->stale ? "stale" : "active";
-    fprintf(f, "{%s%s%s\"t_s\": %.3f, \"status\": \"%s\", \"version\": %u, ",
-            key != NULL ? "\"" : "", key != NULL ? key : "", key != NULL ? "\": {" : "",
-            (double)(now - l->t0) / 1e6, status, run_read_version(l->guard));
+    fprintf(f, "{%s%s%s\"t_s\": %.3f, \"status\": \"%s\", \"stale_input\": %s%s%s, "
+            "\"version\": %u, ", key != NULL ? "\"" : "", key != NULL ? key : "",
+            key != NULL ? "\": {" : "", (double)(now - l->t0) / 1e6, status,
+            l->stale ? "\"" : "", l->stale ? l->stale_why : "null", l->stale ? "\"" : "",
+            run_read_version(l->guard));
     (void)pthread_mutex_lock(&l->st->lock);
     print_mapping(f, l->st);
+    print_inputs(f, l, now);
     print_clock(f, l, now);
     fprintf(f, ", ");
     run_ranges_print(f, l->st->ranges, &l->ranges_tr);
