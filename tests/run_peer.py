@@ -19,6 +19,8 @@ times faster so the tests take seconds). Tests (each prints PASS/FAIL):
             ends by itself (--exit-after-depth) with exit 0, eviction ran, occ_map_check holds.
   stale     sensors stale after the last frame (then pose stale with a prior --map): one
             STATUSTEXT each, no OBSTACLE_DISTANCE after it, HEARTBEAT ACTIVE before, CRITICAL after.
+  ranges_time   a range reading is integrated with the pose at its own time_boot_ms (TIMESYNC),
+            one stamped on another clock with the pose at its arrival.
   ranges_stale  --mavlink-ranges without a camera: the rangefinder stops while the poses go
             on: one STATUSTEXT, no OBSTACLE_DISTANCE after it, HEARTBEAT CRITICAL.
   3d        --3d: OBSTACLE_DISTANCE_3D above / below after each OBSTACLE_DISTANCE, decoded by
@@ -550,6 +552,53 @@ def test_ranges(o, frames, gt):
                   r.get("integrated"))
 
 
+def test_ranges_time(o, frames, gt):
+    """A reading is integrated with the pose at its own time_boot_ms (the autopilot's clock,
+    through the TIMESYNC offset), not its arrival's: the vehicle (level, heading 0.3 rad) stands
+    at A until boot 2.0 s, then moves 1 m east to B within 60 ms. Arriving at boot 2.2..2.45 s,
+    sensor 0 reads 1.50 m down stamped 0.5 s before its arrival: the hit lies under A, not B.
+    Sensor 1 reads 1.00 m down stamped boot 5 ms (not a time on the autopilot's clock: more
+    than --sensor-timeout-ms before its arrival): stamped at arrival, its hit lies under B."""
+    c = Check("ranges-time")
+    (bx, by, bz), rpy = gt[0][1], (0.0, 0.0, 0.3)
+    path = []
+    for k in range(301):  # every 20 ms, 0..6 s
+        t = k * 20000
+        x = bx + min(1.0, max(0.0, (t - 2000000) / 60000.0))
+        path.append((t, (x, by, bz), (by, x, -bz), rpy))
+    peer = Peer(free_port(), path)
+    omap = os.path.join(o.out, "ranges_time.occ")
+    st = os.path.join(o.out, "ranges_time_stats.json")
+
+    def send(mav, boot_us):
+        if not 2200000 <= boot_us <= 2450000:
+            return []
+        return [mav.distance_sensor_encode((boot_us - 500000) // 1000, 20, 400, 150, 0, 0, 25, 0),
+                mav.distance_sensor_encode(5, 20, 400, 100, 0, 1, 25, 0)]
+    rc, err, _, _ = run_sensor(o.occmap, ["--mavlink-ranges", "--duration", "3", "-o", omap,
+                                          "--stats", st], peer, send, period=0.05)
+    c.that(rc == 0, "exit %s: %s" % (rc, err[-300:]))
+    c.that(peer.sent_us and peer.sent_us[0] < 1500000, "poses started at %s us (want < 1.5 s)" %
+           (peer.sent_us[:1],))
+    fin = stats_lines(st)[-1].get("final", {}) if os.path.exists(st) else {}
+    clock_ok(c, fin, peer)
+    r = fin.get("ranges", {})
+    c.that(r.get("integrated", 0) >= 8 and r.get("stamped", {}).get("own", 0) >= 4 and
+           r.get("stamped", {}).get("arrival", 0) >= 4, "ranges %s" % r)
+
+    def occupied(x, y, z):
+        out = subprocess.run([o.occmap, "query", omap, "--sphere", "%f,%f,%f,0.08" % (x, y, z),
+                              "--json"], capture_output=True, text=True)
+        return (json.loads(out.stdout) if out.stdout.strip() else {}).get("occupied_voxels", 0)
+    c.that(occupied(bx, by, bz - 1.5) > 0, "nothing 1.5 m under A (the pose at the stamp)")
+    c.that(occupied(bx + 1.0, by, bz - 1.5) == 0, "a hit 1.5 m under B (the pose at arrival)")
+    c.that(occupied(bx + 1.0, by, bz - 1.0) > 0, "sensor 1 (stamp on another clock): nothing "
+           "1.0 m under B (the pose at arrival)")
+    return c.done("own stamps %s (0.5 s old) integrated under the vehicle's place then (A), "
+                  "stamps on another clock %s under its place at arrival (B)" %
+                  (r.get("stamped", {}).get("own"), r.get("stamped", {}).get("arrival")))
+
+
 def test_ranges_stale(o, frames, gt):
     """--mavlink-ranges and no camera: another component's DISTANCE_SENSOR for 1 s, then none
     while the poses go on: one STATUSTEXT (sensors stale) at least --sensor-timeout-ms after the
@@ -637,7 +686,7 @@ def test_3d(o, frames, gt):
                      if full else None))
 
 
-TESTS = {"3d": test_3d, "ranges": test_ranges, "ranges_stale": test_ranges_stale, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
+TESTS = {"3d": test_3d, "ranges": test_ranges, "ranges_stale": test_ranges_stale, "ranges_time": test_ranges_time, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
 
 
 def main():

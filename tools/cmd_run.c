@@ -181,6 +181,7 @@ static int run_all(run_opts_t *o, occ_map_t *map, run_depth_t *depth)
         return status != 0 ? status : 1;
     }
     memset(&ranges, 0, sizeof ranges);
+    ranges.own_window_us = (uint64_t)o->sensor_timeout_ms * 1000u;
     st.ranges = &ranges;
     occ_link_t link;
     static run_link_t l;

@@ -25,6 +25,20 @@ bool run_ranges_take(run_state_t *st, run_ranges_t *r, occ_mav_ranges_t *tr,
     return true;
 }
 
+/* A MAVLink reading's own stamp (autopilot us) is a time on the autopilot's clock: TIMESYNC
+ * answered, and mapped to our clock through its offset (as the poses) it lies at most `window`
+ * before the arrival `now` and not after it (beyond the offset's error, rtt / 2, and the
+ * millisecond of time_boot_ms). Caller holds st->lock. */
+static bool own_stamp_ok(const run_state_t *st, uint64_t own_us, uint64_t now, uint64_t window)
+{
+    if (!st->ts.valid || own_us == 0u || own_us > (uint64_t)INT64_MAX) {
+        return false;
+    }
+    const int64_t local = (int64_t)own_us - st->ts.offset_us;
+    const int64_t slack = (int64_t)st->ts.rtt_us / 2 + 2000;
+    return local <= (int64_t)now + slack && local >= (int64_t)now - (int64_t)window;
+}
+
 void run_ranges_queue(run_state_t *st, run_ranges_t *r, const occ_mav_beams_t *beams,
                       uint64_t now, int source)
 {
@@ -39,8 +53,12 @@ void run_ranges_queue(run_state_t *st, run_ranges_t *r, const occ_mav_beams_t *b
     } else if (r->n == RUN_RANGES_QUEUE) {
         r->queue_full++;
     } else {
+        const bool own = source == RUN_SRC_MAVLINK &&
+                         own_stamp_ok(st, beams->time_us, now, r->own_window_us);
         m.local_us = now;
-        m.remote_us = (uint64_t)((int64_t)now + off);
+        m.remote_us = own ? beams->time_us : (uint64_t)((int64_t)now + off);
+        r->stamped_own += own ? 1u : 0u;
+        r->stamped_arrival += own ? 0u : 1u;
         r->q[(r->head + r->n) % RUN_RANGES_QUEUE] = m;
         r->n++;
         r->queued++;
@@ -141,10 +159,12 @@ void run_ranges_service(run_mapper_t *m)
 void run_ranges_print(FILE *f, const run_ranges_t *r, const occ_mav_ranges_t *tr)
 {
     const occ_mav_ranges_counters_t *const c = &tr->counters;
-    fprintf(f, "\"ranges\": {\"translated\": %u, \"queued\": %llu, \"integrated\": %llu, "
+    fprintf(f, "\"ranges\": {\"translated\": %u, \"queued\": %llu, \"stamped\": {\"own\": %llu, "
+            "\"arrival\": %llu}, \"integrated\": %llu, "
             "\"dropped\": {\"no_pose\": %llu, \"no_clock\": %llu, \"queue_full\": %llu, "
             "\"nomem\": %llu, \"error\": %llu}, \"own_refused\": %u, \"malformed\": %u, "
             "\"unsupported\": %u}", c->translated, (unsigned long long)r->queued,
+            (unsigned long long)r->stamped_own, (unsigned long long)r->stamped_arrival,
             (unsigned long long)r->integrated, (unsigned long long)r->no_pose,
             (unsigned long long)r->no_clock, (unsigned long long)r->queue_full,
             (unsigned long long)r->nomem, (unsigned long long)r->errors, c->own_refused,
