@@ -25,6 +25,8 @@ times faster so the tests take seconds). Tests (each prints PASS/FAIL):
             on: one STATUSTEXT, no OBSTACLE_DISTANCE after it, HEARTBEAT CRITICAL.
   3d        --3d: OBSTACLE_DISTANCE_3D above / below after each OBSTACLE_DISTANCE, decoded by
             pymavlink, at the points another component reported (within a voxel).
+  save      -o with --save-every 0.5 ended by SIGTERM mid-run: exit 0, >= 2 saves counted, the
+            map written at the signal loads (occmap info), no temporary file left.
   jitter    mapping busy (full-resolution frames) while the feed runs: its period jitter is
             reported (p50/p99/max, printed), its median below half an integration's (the feed
             never waits for the writer), the feed saw new map versions while it ran; the final
@@ -35,6 +37,7 @@ import argparse
 import json
 import math
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -202,13 +205,18 @@ class Peer:
         time.sleep(0.002)
 
 
-def run(occmap, args, peer, timeout):
-    """occmap run against the peer until it exits (or timeout: killed, a failure)."""
+def run(occmap, args, peer, timeout, term_after=None):
+    """occmap run against the peer until it exits (or timeout: killed, a failure); SIGTERM
+    after `term_after` s if given (its wall-clock time in peer.term_time)."""
     p = subprocess.Popen([occmap, "run"] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          text=True)
-    end = time.monotonic() + timeout
+    start = time.monotonic()
+    end = start + timeout
     while p.poll() is None and time.monotonic() < end:
         peer.step()
+        if term_after is not None and time.monotonic() - start >= term_after:
+            term_after, peer.term_time = None, time.time()
+            p.send_signal(signal.SIGTERM)
     if p.poll() is None:
         p.kill()
     out, err = p.communicate()
@@ -485,6 +493,40 @@ def test_stale(o, frames, gt):
                   (n_sensor, len(peer.obstacles)))
 
 
+def test_save(o, frames, gt):
+    """-o with --save-every 0.5, ended by SIGTERM while frames are being mapped: exit 0, the
+    periodic saves counted (>= 2), the map saved at the signal (written after it) loads with
+    `occmap info` and holds occupied voxels, no temporary file left beside it."""
+    c = Check("save")
+    peer = Peer(free_port(), gt, speed=1.0)
+    sub = os.path.join(o.out, "save")
+    os.makedirs(sub, exist_ok=True)
+    for f in os.listdir(sub):
+        os.remove(os.path.join(sub, f))
+    omap, st = os.path.join(sub, "map.occ"), os.path.join(o.out, "save_stats.json")
+    rc, _, err = run(o.occmap, ["--udp", "127.0.0.1:%d" % peer.port, "--depth-dir", o.data,
+                                "--replay-speed", "0", "--depth-stride", "16", "-o", omap,
+                                "--save-every", "0.5", "--stats", st], peer, 20, term_after=2.5)
+    c.that(rc == 0, "exit %s after SIGTERM: %s" % (rc, err[-300:]))
+    fin = stats_lines(st)[-1].get("final", {}) if os.path.exists(st) else {}
+    fr = fin.get("frames", {})
+    c.that(fin.get("saves", 0) >= 2 and fin.get("save_errors") == 0,
+           "saves %s, errors %s (want >= 2 periodic, 0)" % (fin.get("saves"), fin.get("save_errors")))
+    c.that(0 < fr.get("done", 0) < len(frames), "SIGTERM not mid-run: %s of %d frames done" %
+           (fr.get("done"), len(frames)))
+    c.that(os.path.exists(omap) and os.path.getmtime(omap) >= peer.term_time - 0.01,
+           "-o not written at the signal")
+    info = subprocess.run([o.occmap, "info", omap, "--json"], capture_output=True, text=True)
+    occ = json.loads(info.stdout).get("occupied_voxels", 0) if info.returncode == 0 else 0
+    c.that(occ > 0, "occmap info %s: exit %d, %d occupied: %s" % (omap, info.returncode, occ,
+                                                                  info.stderr[-200:]))
+    left = sorted(f for f in os.listdir(sub) if f != "map.occ")
+    c.that(not left, "left beside the map: %s" % left)
+    return c.done("SIGTERM after 2.5 s (%s frames done): exit 0, %s periodic saves, the map "
+                  "written at the signal loads (%d occupied voxels), no temporary file" %
+                  (fr.get("done"), fin.get("saves"), occ))
+
+
 def test_jitter(o, frames, gt):
     c = Check("jitter")
     port = free_port()
@@ -686,7 +728,7 @@ def test_3d(o, frames, gt):
                      if full else None))
 
 
-TESTS = {"3d": test_3d, "ranges": test_ranges, "ranges_stale": test_ranges_stale, "ranges_time": test_ranges_time, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter}
+TESTS = {"3d": test_3d, "ranges": test_ranges, "ranges_stale": test_ranges_stale, "ranges_time": test_ranges_time, "requests": test_requests, "drop": test_drop, "stale": test_stale, "jitter": test_jitter, "save": test_save}
 
 
 def main():
