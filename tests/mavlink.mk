@@ -26,6 +26,7 @@ mavgen: $(MAVGEN_STAMP)
 # Every object of the feed (host, sanitizer, cross), the tools, ports and tests waits for them.
 MAV_USERS := $(OCC_FEED_SRC) $(TOOL_SRC) $(PORT_SRC) $(TEST_C) $(wildcard tests/mavlink/*.c)
 $(OCC_FEED_SRC:%.c=$(BUILD)/rel/%.o) $(OCC_FEED_SRC:%.c=$(BUILD)/asan/%.o): $(MAVGEN_STAMP)
+$(OCC_FEED_SRC:%.c=$(BUILD)/pic/%.o): $(MAVGEN_STAMP)
 $(OCC_FEED_SRC:%.c=$(BUILD)/cross/m4/%.o) $(OCC_FEED_SRC:%.c=$(BUILD)/cross/m0/%.o): $(MAVGEN_STAMP)
 $(MAV_USERS:%.c=$(BUILD)/relhost/%.o) $(MAV_USERS:%.c=$(BUILD)/asanhost/%.o): $(MAVGEN_STAMP)
 CROSS_EXTRA += $(BUILD)/cross/m4/port/baremetal/mavlink_hooks.o $(BUILD)/cross/m0/port/baremetal/mavlink_hooks.o

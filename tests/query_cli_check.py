@@ -3,7 +3,8 @@
 """query_cli_check.py - `occmap query` on geb079.bt: every answer is valid JSON with the documented
 keys; one query gives the same object alone and inside --batch; the unknown policy behaves as
 documented (far outside the scanned space: unknown voxels, so unsafe by default and safe with
---unknown safe); a ray along a direction hits at a voxel centre on the grid; bad input is an
+--unknown safe); a ray along a direction hits at a voxel centre on the grid; a point gives the
+state of its voxel (agreeing with a box of zero size there), in batches too; bad input is an
 error line and a non-zero exit.  usage: query_cli_check.py OCCMAP MAP"""
 import json
 import subprocess
@@ -89,5 +90,26 @@ with tempfile.NamedTemporaryFile("w", suffix=".txt", delete=False) as f:
     dbatch = f.name
 dl = [json.loads(x) for x in run(["--batch", dbatch, "--json"], rc=1).strip().splitlines()]
 assert dl == [near, undecided], dl
+# --point: the state of the voxel holding the point. The ray's hit voxel is occupied; a point in
+# the scanned corridor free, one beside it and one off the map unknown; each agrees with the voxel
+# count of a box of zero size at the point (another code path); batch lines equal single ones.
+hit = [s for q, s in zip(queries, single) if q.startswith("--ray 0,0,0.5,0,1,0")][0]["hit_point"]
+points = {",".join(map(str, hit)): "occupied", "1,0,1": "free", "1,7.3,1": "unknown",
+          "1e5,0,0": "unknown"}
+for p, want in points.items():
+    got = json.loads(run(["--point", p, "--json"]))
+    assert got == {"state": want}, (p, got)
+    assert run(["--point", p]).strip() == want
+    if want != "unknown" or p == "1,7.3,1":
+        box = json.loads(run(["--aabb", f"{p},{p}", "--json"]))
+        assert (box["occupied_voxels"], box["unknown_voxels"]) == \
+            {"occupied": (1, 0), "free": (0, 0), "unknown": (0, 1)}[want], (p, box)
+with tempfile.NamedTemporaryFile("w", suffix=".txt", delete=False) as f:
+    f.write("".join(f"--point {p}\n" for p in points))
+    pbatch = f.name
+pl = [json.loads(x) for x in run(["--batch", pbatch, "--json"]).strip().splitlines()]
+assert pl == [{"state": w} for w in points.values()], pl
+run(["--point", "1,nan,1"], rc=2)
+run(["--point", "1,0"], rc=2)
 print(f"PASS query cli: {len(queries)} queries, batch identical, policies and errors as documented, "
-      f"distance found/none/undecided")
+      f"distance found/none/undecided, point states")

@@ -26,23 +26,8 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "occmap/occ_io.h"
-#include "support/iotest.h"
+#include "support/lookup_probes.h"
 #include "support/leak_check.h"
-
-#define GEB079 "/usr/share/doc/liboctomap-dev/examples/data/geb079.bt"
-#define FR079 "../shared/data/maps/fr_079_t1_model.ot"
-
-static unsigned g_skipped;
-
-static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
-static double urand(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) / 9007199254740992.0;
-}
 
 /* Every probe through the index equals occ_map_state_at; the batch equals them too. */
 static void check_probes(const occ_map_t *map, const occ_lookup_index_t *idx, const occ_vec3_t *pts,
@@ -71,60 +56,15 @@ static void check_probes(const occ_map_t *map, const occ_lookup_index_t *idx, co
     assert_int_equal(bad, 0u);
 }
 
-/* Probes for a map whose observed box is [mn, mx] (metres): random in the box grown by 10 %
- * (and every 64th far off the map), on voxel borders and one ulp either side, NaN and Inf. */
-static size_t make_probes(const occ_map_t *map, occ_vec3_t mn, occ_vec3_t mx, occ_vec3_t *pts,
-                          size_t n_random)
-{
-    const float lo[3] = {mn.x, mn.y, mn.z}, hi[3] = {mx.x, mx.y, mx.z};
-    const double res = (double)map->cfg.resolution_m;
-    size_t n = 0;
-    for (size_t i = 0; i < n_random; i++) {
-        float c[3];
-        for (unsigned a = 0; a < 3u; a++) {
-            const double ext = (double)(hi[a] - lo[a]);
-            c[a] = (float)((double)lo[a] - 0.1 * ext + 1.2 * ext * urand());
-        }
-        if (i % 64u == 63u) {
-            c[i % 3u] = (float)(1e6 * (urand() - 0.5));
-        }
-        pts[n++] = (occ_vec3_t){c[0], c[1], c[2]};
-    }
-    /* Voxel borders: a random face key k, the face (k - half) * res as the map computes it in
-     * double then rounded to float, and its float neighbours. */
-    occ_vec3_t base = pts[0];
-    for (size_t i = 0; i < n_random / 4u; i++) {
-        const unsigned a = (unsigned)(i % 3u);
-        const double t = (double)lo[a] + (double)(hi[a] - lo[a]) * urand();
-        const float face = (float)(floor(t / res) * res);
-        const float f[3] = {nextafterf(face, -INFINITY), face, nextafterf(face, INFINITY)};
-        base = pts[i];
-        for (unsigned j = 0; j < 3u; j++) {
-            occ_vec3_t q = base;
-            if (a == 0u) q.x = f[j];
-            if (a == 1u) q.y = f[j];
-            if (a == 2u) q.z = f[j];
-            pts[n++] = q;
-        }
-    }
-    const float bad[4] = {NAN, INFINITY, -INFINITY, -NAN};
-    for (unsigned j = 0; j < 4u; j++) {
-        pts[n++] = (occ_vec3_t){bad[j], 0.0f, 0.0f};
-        pts[n++] = (occ_vec3_t){mn.x, bad[j], mn.z};
-        pts[n++] = (occ_vec3_t){mn.x, mn.y, bad[j]};
-    }
-    return n;
-}
-
 static void check_every_level(const occ_map_t *map, const char *name, size_t n_random)
 {
     occ_map_stats_t st;
     occ_map_stats(map, &st);
     assert_true(st.has_known);
-    const size_t cap = n_random + 3u * (n_random / 4u) + 12u;
+    const size_t cap = lp_probe_cap(n_random);
     occ_vec3_t *const pts = malloc(cap * sizeof *pts);
     assert_non_null(pts);
-    const size_t n = make_probes(map, st.bbox_min, st.bbox_max, pts, n_random);
+    const size_t n = lp_make_probes(map, st.bbox_min, st.bbox_max, pts, n_random);
     assert_true(n <= cap);
     for (unsigned level = 0; level <= map->cfg.depth_levels; level++) {
         size_t bytes = 0;
@@ -150,56 +90,34 @@ static void check_every_level(const occ_map_t *map, const char *name, size_t n_r
 
 static void real_map(const char *path, const char *name)
 {
-    size_t len = 0;
-    uint8_t *const file = iotest_read_file(path, &len);
-    if (file == NULL) {
-        g_skipped++;
-        printf("SKIP: %s absent (%u skipped)\n", path, g_skipped);
+    occ_map_t map;
+    void *const arena = lp_load_map(path, &map);
+    if (arena == NULL) {
         skip();
     }
-    occ_map_t map;
-    occ_err_t e = OCC_OK;
-    void *const arena = iotest_load(&map, file, len, 0u, &e, NULL);
-    assert_int_equal(e, OCC_OK);
     check_every_level(&map, name, 20000u);
     free(arena);
-    free(file);
 }
 
 static void test_geb079(void **state)
 {
     (void)state;
-    real_map(GEB079, "geb079");
+    real_map(LP_GEB079, "geb079");
 }
 
 static void test_fr079(void **state)
 {
     (void)state;
-    real_map(FR079, "fr_079");
+    real_map(LP_FR079, "fr_079");
 }
 
-/* A hand-made map: voxel (0.05, 0.05, 0.05) occupied (key 32768 per axis at 0.1 m, depth 16),
- * the level-3 node of (1.0, 1.0, 1.0) free (keys 32778 -> node 32776..32783). The box is keys
- * 32768..32783 per axis: 16^3 voxels. */
-typedef struct {
-    occ_map_t map;
-    uint8_t arena[OCC_ARENA_BYTES(64, 64)];
-} small_t;
-
-static void small_init(small_t *s)
-{
-    const occ_map_config_t cfg = occ_map_config_default();
-    assert_int_equal(occ_map_init(&s->map, &cfg, s->arena, sizeof s->arena), OCC_OK);
-    assert_int_equal(occ_map_update(&s->map, (occ_vec3_t){0.05f, 0.05f, 0.05f}, 2.0f), OCC_OK);
-    const occ_key_t k = {{32778u, 32778u, 32778u}};
-    assert_int_equal(occ_map_set_key(&s->map, k, 3u, -1.0f), OCC_OK);
-}
-
+/* The hand-made map of lookup_probes.h: its observed box is keys 32768..32783 per axis (16^3
+ * voxels). */
 static void test_hand_map(void **state)
 {
     (void)state;
-    static small_t s;
-    small_init(&s);
+    static lp_small_t s;
+    lp_small_init(&s);
     /* Bytes by hand: level 0: 16^3 cells / 16 per word x 4 = 1024; level 1: 8^3 x 4 = 2048;
      * level 2: 4^3 x 4 = 256; level 3: 2^3 x 4 = 32; level 4 .. 16: one cell, 4 bytes. */
     const size_t want[6] = {1024u, 2048u, 256u, 32u, 4u, 4u};
@@ -243,8 +161,8 @@ static void test_hand_map(void **state)
 static void test_stale(void **state)
 {
     (void)state;
-    static small_t s;
-    small_init(&s);
+    static lp_small_t s;
+    lp_small_init(&s);
     static uint32_t mem[1024];
     occ_lookup_index_t idx;
     const occ_vec3_t freep = {1.0f, 1.0f, 1.0f};
@@ -273,7 +191,7 @@ static void test_stale(void **state)
     assert_int_equal(occ_lookup_index_status(&idx), OCC_ERR_STATE);
     assert_int_equal(occ_lookup_index_state(&idx, freep), OCC_STATE_UNKNOWN);
     /* A re-init restarts write_gen: the root block (now none) tells it. */
-    small_init(&s);
+    lp_small_init(&s);
     assert_int_equal(occ_lookup_index_build(&idx, &s.map, 2u, mem, sizeof mem), OCC_OK);
     const occ_map_config_t cfg = occ_map_config_default();
     assert_int_equal(occ_map_init(&s.map, &cfg, s.arena, sizeof s.arena), OCC_OK);
@@ -284,8 +202,8 @@ static void test_stale(void **state)
 static void test_memory(void **state)
 {
     (void)state;
-    static small_t s;
-    small_init(&s);
+    static lp_small_t s;
+    lp_small_init(&s);
     static uint32_t memw[(4096 + 16) / 4];
     uint8_t *const mem = (uint8_t *)memw;
     const size_t mem_size = sizeof memw;
@@ -318,8 +236,8 @@ static void test_memory(void **state)
 static void test_bad_input(void **state)
 {
     (void)state;
-    static small_t s;
-    small_init(&s);
+    static lp_small_t s;
+    lp_small_init(&s);
     static uint32_t mem[1024];
     occ_lookup_index_t idx;
     size_t b = 0;

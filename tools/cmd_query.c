@@ -16,7 +16,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: occmap query MAP (--sphere x,y,z,r | --aabb x0,y0,z0,x1,y1,z1 |\n"
             "                         --capsule x0,y0,z0,x1,y1,z1,r | --ray x,y,z,dx,dy,dz,max_m |\n"
-            "                         --distance x,y,z,max_m [--heap N])\n"
+            "                         --distance x,y,z,max_m [--heap N] | --point x,y,z)\n"
             "                        [--unknown safe|unsafe] [--json]\n"
             "       occmap query MAP --batch FILE --json   (one query per line, same syntax)\n"
             "Answers whether the volume is free of occupied voxels (and of unknown ones with\n"
@@ -25,11 +25,13 @@ static void usage(FILE *f)
             "are over the segment from the origin to max_m along the direction.\n"
             "A distance is to the nearest blocking voxel within max_m: \"found\" with the distance,\n"
             "\"none\" (nothing within max_m), or \"undecided\" (the search's heap of N entries,\n"
-            "default %u, overflowed: exit 1, treat as an obstacle at 0).\n", DEFAULT_HEAP);
+            "default %u, overflowed: exit 1, treat as an obstacle at 0).\n"
+            "A point is the state of the voxel holding it (occ_map_state_at): \"unknown\",\n"
+            "\"free\" or \"occupied\"; unknown off the map.\n", DEFAULT_HEAP);
 }
 
 typedef struct {
-    enum { Q_NONE, Q_SPHERE, Q_AABB, Q_CAPSULE, Q_RAY, Q_DISTANCE } kind;
+    enum { Q_NONE, Q_SPHERE, Q_AABB, Q_CAPSULE, Q_RAY, Q_DISTANCE, Q_POINT } kind;
     float v[7];
     unsigned heap; /* --distance: nearest-search heap entries */
     occ_unknown_policy_t policy;
@@ -69,6 +71,9 @@ static const char *parse(int argc, char **argv, query_t *q)
         } else if (strcmp(a, "--distance") == 0) {
             kind = Q_DISTANCE;
             n = 4;
+        } else if (strcmp(a, "--point") == 0) {
+            kind = Q_POINT;
+            n = 3;
         } else if (strcmp(a, "--heap") == 0) {
             char *end = NULL;
             const unsigned long h = val != NULL ? strtoul(val, &end, 10) : 0ul;
@@ -81,12 +86,12 @@ static const char *parse(int argc, char **argv, query_t *q)
         } else {
             return "unknown option";
         }
-        if (q->kind != Q_NONE) return "give one of --sphere, --aabb, --capsule, --ray, --distance";
+        if (q->kind != Q_NONE) return "give one of --sphere, --aabb, --capsule, --ray, --distance, --point";
         if (val == NULL || !cli_parse_floats(val, q->v, n)) return "malformed numbers";
         q->kind = kind;
         i++;
     }
-    return q->kind == Q_NONE ? "give one of --sphere, --aabb, --capsule, --ray, --distance" : NULL;
+    return q->kind == Q_NONE ? "give one of --sphere, --aabb, --capsule, --ray, --distance, --point" : NULL;
 }
 
 static occ_vec3_t vec(const float *p)
@@ -152,6 +157,7 @@ static occ_err_t make_volume(const occ_map_t *map, const query_t *q, occ_volume_
         return e;
     }
     case Q_DISTANCE: /* run_distance */
+    case Q_POINT:    /* run */
     case Q_NONE:
     default:
         return OCC_ERR_ARG;
@@ -209,6 +215,13 @@ static int run(const occ_map_t *map, const query_t *q, FILE *out)
 {
     if (q->kind == Q_DISTANCE) {
         return run_distance(map, q, out);
+    }
+    if (q->kind == Q_POINT) {
+        static const char *const states[] = {"unknown", "free", "occupied"};
+        const char *const st = states[occ_map_state_at(map, vec(q->v))];
+        if (q->json) fprintf(out, "{\"state\": \"%s\"}\n", st);
+        else fprintf(out, "%s\n", st);
+        return 0;
     }
     answer_t r;
     memset(&r, 0, sizeof r);

@@ -309,7 +309,8 @@ occ_err_t occ_map_read_key(const occ_map_t *map, occ_key_t key, unsigned level,
                            occ_node_info_t *out);
 /* Same for a point in metres. OCC_ERR_ARG / OCC_ERR_RANGE as occ_map_key(). */
 occ_err_t occ_map_read(const occ_map_t *map, occ_vec3_t p, unsigned level, occ_node_info_t *out);
-/* State of the voxel at `p`; UNKNOWN for invalid or out-of-map points (never FREE by error). */
+/* State of the voxel at `p`; UNKNOWN for invalid or out-of-map points (never FREE by error).
+ * For many points in one call: occ_map_states_at() (occ_query.h). */
 occ_state_t occ_map_state_at(const occ_map_t *map, occ_vec3_t p);
 /* State of a log-odds value under this map's thresholds (observed values only). */
 occ_state_t occ_map_state_of(const occ_map_t *map, float logodds);

@@ -192,6 +192,20 @@ occ_err_t occ_lookup_read(occ_lookup_t *lk, occ_vec3_t p, occ_state_t *state);
  * occ_lookup_init(), OCC_ERR_ARG for NULL. O(1). */
 occ_err_t occ_lookup_status(const occ_lookup_t *lk);
 
+/* Many points in one call: states_out[i] = occ_map_state_at(map, pts[i]) for i < n (an
+ * occ_state_t value, UNKNOWN 0, FREE 1, OCCUPIED 2, stored in one byte: a fixed size whatever the
+ * compiler's enum size, for bindings (numpy uint8) and large batches). Points in metres, map
+ * frame; a NaN, Inf or off-map point answers UNKNOWN, as the single call does (no error). The
+ * points go through one lookup cursor started by this call, so a point next to the previous one
+ * (a grid slice row, a trajectory, a sensor footprint) re-descends only the levels below the
+ * highest key bit that changed; a random order costs one descent per point.
+ * Errors: OCC_ERR_ARG for a NULL map, or NULL pts / states_out with n > 0; then every
+ * states_out[i] is UNKNOWN when states_out is non-NULL (fail closed). n = 0 is OCC_OK.
+ * Reads only; as any reader, not safe against a concurrent writer of the same map (occ_shared.h).
+ * O(n x levels below the highest changed key bit), <= n x depth_levels blocks read. */
+occ_err_t occ_map_states_at(const occ_map_t *map, const occ_vec3_t *pts, size_t n,
+                            uint8_t *states_out);
+
 /* ---- Exact lookup index for random points (issue 22) ---------------------------------------------
  * A dense table over the key bounding box of the map's observed space, built by the caller into
  * caller-given memory (no heap), that answers occ_map_state_at exactly with one table load
@@ -430,6 +444,8 @@ occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned 
  *   occ_lookup_index_status: stack <= 256 / 256 B; work: O(1)
  *   occ_lookup_read, occ_lookup_state: stack <= 256 / 256 B; work: the levels below the highest key
  *       bit that differs from the last lookup
+ *   occ_map_states_at: stack <= 320 / 320 B; work: per point the levels below the highest key bit
+ *       that differs from the previous point's, <= n x depth_levels blocks read
  *   occ_query_begin: stack <= 256 / 320 B; work: <= 8 start cells, one key range each
  *   occ_query_status, occ_lookup_init, occ_lookup_status: stack <= 256 / 256 B; work: O(1)
  *   occ_volume_frustum: stack <= 704 / 832 B; work: O(1), no map access

@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
- * lookup.c - point lookups: occ_map_state_at (one descent from the root) and the cursor with a
+ * lookup.c - point lookups: occ_map_state_at (one descent from the root), the cursor with a
  * path cache for streams of nearby points (a trajectory, a sensor footprint), which walks again
- * only the levels below the highest key bit that changed.
+ * only the levels below the highest key bit that changed, and occ_map_states_at (many points
+ * through one cursor).
  */
 #include "query_internal.h"
 
@@ -110,6 +111,25 @@ occ_state_t occ_lookup_state(occ_lookup_t *lk, occ_vec3_t p)
         return OCC_STATE_UNKNOWN; /* stale cursor, NULL, NaN or off the map */
     }
     return cached_state(lk, k);
+}
+
+occ_err_t occ_map_states_at(const occ_map_t *const map, const occ_vec3_t *const pts, const size_t n,
+                            uint8_t *const states_out)
+{
+    if (map == NULL || (n > 0u && (pts == NULL || states_out == NULL))) {
+        for (size_t i = 0; states_out != NULL && i < n; i++) {
+            states_out[i] = (uint8_t)OCC_STATE_UNKNOWN; /* fail closed */
+        }
+        return OCC_ERR_ARG;
+    }
+    /* Through occ_lookup_state, so that the cursor's body keeps one (inlined) copy: its staleness
+     * check per point is two loads, and the map cannot change during this call. */
+    occ_lookup_t lk;
+    occ_lookup_init(&lk, map);
+    for (size_t i = 0; i < n; i++) {
+        states_out[i] = (uint8_t)occ_lookup_state(&lk, pts[i]);
+    }
+    return OCC_OK;
 }
 
 /* The key is computed twice here, so that occ_lookup_state, the hot path of trajectories, keeps

@@ -56,6 +56,7 @@ _PROTOS = {
     "occ_map_update": (C.c_int, [P(S.MapT), S.Vec3, C.c_float]),
     "occ_lookup_init": (None, [P(S.Lookup), P(S.MapT)]),
     "occ_lookup_state": (C.c_int, [P(S.Lookup), S.Vec3]),
+    "occ_map_states_at": (C.c_int, [P(S.MapT), C.c_void_p, C.c_size_t, C.c_void_p]),
     "occ_insert_params_default": (S.InsertParams, []),
     "occ_insert_scratch_bytes_scan": (C.c_size_t, [P(S.MapT), P(S.Vec3), C.c_void_p, C.c_size_t,
                                                    P(S.InsertParams)]),

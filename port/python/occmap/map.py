@@ -199,22 +199,19 @@ class Map:
     # ---- reading ----------------------------------------------------------------------------
     def state_at(self, points):
         """States (UNKNOWN 0, FREE 1, OCCUPIED 2: occ_state_t) of the voxels holding the points,
-        an array of shape points.shape[:-1] (uint8). UNKNOWN for NaN or off-map points, never
-        FREE by error. One C call per point through a lookup cursor (occ_lookup_state), which
-        re-descends only below the key bits that changed."""
+        an array of shape points.shape[:-1] (uint8). UNKNOWN for NaN, Inf or off-map points,
+        never FREE by error. One C call for all the points (occ_map_states_at: a lookup cursor
+        that re-descends only below the key bits that changed, so points in spatial sequence,
+        as a slice's rows, cost least). On geb079, 200k points: 20-30 ms in random order, 2-4
+        ms as slice rows (a Python loop of single C calls: 0.5-1 us per point)."""
         arr = np.ascontiguousarray(points, dtype=np.float32)
         if arr.ndim == 0 or arr.shape[-1] != 3:
             raise ValueError(f"points: expected an array of shape (..., 3), got {arr.shape}")
-        flat = arr.reshape(-1, 3)
-        n = flat.shape[0]
-        out = np.empty(n, dtype=np.uint8)
-        if n:
-            lk = S.Lookup()
-            lib.occ_lookup_init(C.byref(lk), self._ref)
-            fn, lkref = lib.occ_lookup_state, C.byref(lk)
-            vecs = (S.Vec3 * n).from_buffer(flat)
-            out[:] = [fn(lkref, v) for v in vecs]
-        return out.reshape(arr.shape[:-1])
+        n = arr.size // 3
+        out = np.empty(arr.shape[:-1], dtype=np.uint8)
+        check(lib.occ_map_states_at(self._ref, arr.ctypes.data, n, out.ctypes.data),
+              "occ_map_states_at")
+        return out
 
     def _count(self, make, *args):
         vol = S.Volume()

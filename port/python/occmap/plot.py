@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""Map.plot_slice: a horizontal slice of the map as a matplotlib image (states from the C
-lookups, one pixel per voxel column)."""
+"""Map.plot_slice: a horizontal slice of the map as a matplotlib image (one pixel per voxel
+column, the states of all pixels from one C call: Map.state_at, occ_map_states_at)."""
 import numpy as np
 
 COLOURS = np.array([[0.5, 0.5, 0.5], [1.0, 1.0, 1.0], [0.0, 0.0, 0.0]])  # unknown free occupied

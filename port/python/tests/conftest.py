@@ -56,3 +56,30 @@ def fr078():
 @pytest.fixture(scope="session")
 def fr079_ot():
     return _need(FR079_OT, "../shared/data/maps")
+
+
+class _Calls(list):
+    undo = None
+
+
+@pytest.fixture
+def batch_calls(monkeypatch):
+    """Records n of every occ_map_states_at call the binding makes, and makes the single-point
+    lookups (occ_map_state_at, occ_lookup_state) fail: a per-point loop over them shows.
+    .undo() gives the library's functions back (for a test's own single-point references)."""
+    from occmap._lib import lib
+    calls = _Calls()
+    calls.undo = monkeypatch.undo
+    batch = lib.occ_map_states_at
+
+    def counted(map_ref, pts, n, out):
+        calls.append(n)
+        return batch(map_ref, pts, n, out)
+
+    def forbidden(*_):
+        raise AssertionError("a single-point lookup was called: per-point loop")
+
+    monkeypatch.setattr(lib, "occ_map_states_at", counted)
+    for name in ("occ_map_state_at", "occ_lookup_state"):
+        monkeypatch.setattr(lib, name, forbidden)
+    return calls

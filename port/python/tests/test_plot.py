@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""Map.plot_slice: one pixel per voxel column, coloured by the C lookups' states."""
+"""Map.plot_slice: one pixel per voxel column, coloured by the states of one batch lookup."""
 import matplotlib
 import numpy as np
 import pytest
@@ -11,12 +11,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-def test_slice_pixels_are_the_voxel_states(tmp_path):
+def test_slice_pixels_are_the_voxel_states(tmp_path, batch_calls):
     m = occmap.Map(0.1, 1 << 22)
     pts = np.array([[1.05, y, 0.05] for y in (np.arange(-5, 5) + 0.5) * 0.1], np.float32)
     m.insert_cloud((0.05, 0.05, 0.05), pts)
     fig, ax = plt.subplots()
     img = m.plot_slice(0.05, ax=ax, bounds=(-0.2, 1.4, -0.6, 0.6))
+    assert batch_calls == [12 * 16]  # the whole slice in one C call (occ_map_states_at)
     a = img.get_array()
     assert a.shape == (12, 16, 3)  # 1.2 m x 1.6 m of 0.1 m columns
     assert img.get_extent() == pytest.approx([-0.2, 1.4, -0.6, 0.6])

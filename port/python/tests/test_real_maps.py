@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """The binding on the real maps against the C tool's answers (build/occmap info / query, one
 process per batch) and against tools/octomap_bt.py, an independent pure-Python .bt reader."""
+import ctypes as C
 import json
 import math
 
@@ -132,6 +133,65 @@ def test_state_at_equals_independent_reader(geb079):
     near_border = np.abs(pts / res - np.round(pts / res)) < 1e-4  # float vs double keys
     mismatch = (got != want) & ~near_border.any(axis=1)
     assert not mismatch.any(), pts[mismatch][:5]
+
+
+def _state_probes(m, seed):
+    """Points for state_at: random in the map's box grown by 10 % (every 64th far off the map),
+    on voxel borders and one float32 ulp either side, rows of a horizontal slice (the cursor's
+    best case: what plot_slice asks), and NaN / Inf in each coordinate."""
+    rng = np.random.default_rng(seed)
+    st = m.stats()
+    lo, hi = np.array(st["bbox_min"]), np.array(st["bbox_max"])
+    ext, res = hi - lo, float(m.resolution_m)
+    rand = rng.uniform(lo - 0.1 * ext, hi + 0.1 * ext, (6000, 3))
+    rand[63::64, 0] = rng.uniform(-1e6, 1e6, len(rand[63::64]))
+    face = np.floor(rng.uniform(lo, hi, (1000, 3)) / res) * res  # a face on each axis
+    faces = np.concatenate([np.nextafter(face.astype(np.float32), -np.inf),
+                            face.astype(np.float32),
+                            np.nextafter(face.astype(np.float32), np.inf)])
+    xs = np.arange(lo[0], hi[0], res)[:80]
+    ys = np.arange(lo[1], hi[1], res)[:50]
+    gx, gy = np.meshgrid(xs, ys)
+    rows = np.stack([gx, gy, np.full_like(gx, (lo[2] + hi[2]) / 2)], -1).reshape(-1, 3)
+    bad = np.array([[v, 1.0, 1.0] for v in (np.nan, np.inf, -np.inf)] +
+                   [[1.0, v, 1.0] for v in (np.nan, np.inf, -np.inf)] +
+                   [[1.0, 1.0, v] for v in (np.nan, np.inf, -np.inf)])
+    return np.concatenate([rand, faces, rows, bad]).astype(np.float32)
+
+
+def test_state_at_is_one_batch_equal_to_single_lookups_and_occmap_query(real, tool, tmp_path,
+                                                                         batch_calls):
+    """state_at answers all the points with one C call (occ_map_states_at), and each answer
+    equals the single-point calls (occ_map_state_at, a lookup cursor: one ctypes call per point
+    here) and `occmap query --point` (a separate process); NaN / Inf / off-map: UNKNOWN."""
+    from occmap import _structs as S
+    from occmap._lib import lib
+    path, m = real
+    pts = _state_probes(m, seed=23)
+    got = m.state_at(pts)
+    assert batch_calls == [len(pts)]
+    batch_calls.undo()  # the single-point functions back, for the references
+    vec = [S.Vec3(*map(float, p)) for p in pts]
+    single = np.array([lib.occ_map_state_at(m._ref, v) for v in vec], np.uint8)
+    lk = S.Lookup()
+    lib.occ_lookup_init(C.byref(lk), m._ref)
+    cursor = np.array([lib.occ_lookup_state(C.byref(lk), v) for v in vec], np.uint8)
+    assert (got == single).all(), pts[got != single][:5]
+    assert (got == cursor).all(), pts[got != cursor][:5]
+    finite = np.isfinite(pts).all(axis=1)
+    assert (got[~finite] == occmap.UNKNOWN).all() and (~finite).sum() == 9
+    assert (got[np.abs(pts).max(axis=1) > 1e5] == occmap.UNKNOWN).all()
+    assert min(np.bincount(got, minlength=3)) > 100, np.bincount(got)  # all three states
+    # The tool's number parser refuses subnormals (strtof's ERANGE): the ulp below / above 0.
+    sub = ((pts != 0) & (np.abs(pts) < np.finfo(np.float32).tiny)).any(axis=1)
+    asked = finite & ~sub
+    batch = tmp_path / "points.txt"
+    batch.write_text("".join(f"--point {_fmt(p)}\n" for p in pts[asked]))
+    answers = tool_json_lines(tool, "query", path, "--batch", batch, "--json")
+    names = {"unknown": occmap.UNKNOWN, "free": occmap.FREE, "occupied": occmap.OCCUPIED}
+    want = np.array([names[a["state"]] for a in answers], np.uint8)
+    assert len(want) == asked.sum() > 10_000
+    assert (got[asked] == want).all(), pts[asked][got[asked] != want][:5]
 
 
 def test_bt_round_trip_is_byte_identical(geb079):
