@@ -5,6 +5,10 @@
  * write path publishes exactly its end state (the view serializes to the writer's bytes), NOMEM
  * publishes nothing, snapshots are reused only once views close, sections, API errors, and
  * occ_map_check() on every view. The threaded stress is test_shared_stress.c.
+ * Built with -DOCC_SHARED=0 (tests/foundation.mk's noshared variant, the library built the same
+ * way) it checks instead that the mode is gone as the header promises: occ_map_share() answers
+ * OCC_ERR_UNSUPPORTED and changes nothing, the reader and writer-side calls refuse, and the map
+ * works as a plain map.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -45,6 +49,12 @@ static size_t serialize(const occ_map_t *m, uint8_t *buf, size_t cap)
     return b.len;
 }
 
+static occ_state_t state_in(const occ_view_t *v, occ_vec3_t p)
+{
+    return occ_map_state_at(occ_view_map(v), p);
+}
+
+#if OCC_SHARED
 /* The view answers exactly as the writer's map (serialized trees equal, checks hold). */
 static void assert_view_equals(const occ_view_t *view, const occ_map_t *m)
 {
@@ -63,10 +73,6 @@ static void share(unsigned n_readers)
     assert_int_equal(occ_map_share(&map, shmem + 3, need, n_readers), OCC_OK);
 }
 
-static occ_state_t state_in(const occ_view_t *v, occ_vec3_t p)
-{
-    return occ_map_state_at(occ_view_map(v), p);
-}
 
 static void test_errors(void **state)
 {
@@ -382,9 +388,46 @@ static void test_incremental(void **state)
                                              (size_t)map.inner.hwm * OCC_INNER_BLOCK_BYTES);
 }
 
+#else /* OCC_SHARED == 0 */
+
+/* Built without the mode: share refuses with OCC_ERR_UNSUPPORTED and leaves the map as it was;
+ * every other call of occ_shared.h answers as on a map that is not shared; writes work. */
+static void test_unsupported(void **state)
+{
+    (void)state;
+    const occ_vec3_t p = v3(0.35f, -0.45f, 0.15f);
+    assert_int_equal(occ_map_update(&map, p, 2.0f), OCC_OK);
+    const size_t n = serialize(&map, buf_a, sizeof buf_a);
+    const size_t need = occ_shared_bytes(&map, 2u);
+    assert_true(need > 0u && need <= sizeof shmem); /* the size formula stays */
+    assert_int_equal(occ_map_share(&map, shmem, need, 2u), OCC_ERR_UNSUPPORTED);
+    assert_int_equal(occ_map_share(&map, shmem, sizeof shmem, 1u), OCC_ERR_UNSUPPORTED);
+    assert_null(map.priv.shared);
+    assert_int_equal(serialize(&map, buf_b, sizeof buf_b), n);
+    assert_memory_equal(buf_a, buf_b, n);
+    occ_view_t v;
+    assert_int_equal(occ_read_begin(&map, 0u, &v), OCC_ERR_STATE);
+    assert_int_equal(state_in(&v, p), OCC_STATE_UNKNOWN); /* a refused view fails closed */
+    occ_read_end(&map, &v);
+    assert_int_equal(occ_map_write_begin(&map), OCC_ERR_STATE);
+    assert_int_equal(occ_map_write_end(&map), OCC_ERR_STATE);
+    assert_false(occ_map_publish(&map));
+    assert_int_equal(occ_map_version(&map), 0u);
+    occ_shared_info_t info;
+    assert_int_equal(occ_shared_info(&map, &info), OCC_ERR_STATE);
+    assert_int_equal(occ_map_update(&map, p, -4.0f), OCC_OK);
+    assert_int_equal(occ_map_state_at(&map, p), OCC_STATE_FREE);
+    occ_map_clear(&map);
+    assert_int_equal(occ_map_check(&map), OCC_OK);
+}
+#endif
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+#if !OCC_SHARED
+        cmocka_unit_test_setup(test_unsupported, setup),
+#else
         cmocka_unit_test_setup(test_errors, setup),
         cmocka_unit_test_setup(test_versions, setup),
         cmocka_unit_test_setup(test_reuse_after_close, setup),
@@ -392,6 +435,7 @@ int main(void)
         cmocka_unit_test_setup(test_section, setup),
         cmocka_unit_test_setup(test_write_paths, setup),
         cmocka_unit_test_setup(test_incremental, setup),
+#endif
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
