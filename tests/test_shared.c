@@ -85,6 +85,8 @@ static void test_errors(void **state)
     assert_true(need <= OCC_SHARED_BYTES(sizeof arena)); /* the static bound holds */
     assert_int_equal(occ_shared_bytes(&map, OCC_SHARED_MAX_READERS), need); /* slots are fixed */
     occ_view_t v;
+    assert_int_equal(occ_shared_latest_version(NULL), 0u);
+    assert_int_equal(occ_shared_latest_version(&map), 0u); /* not shared */
     assert_int_equal(occ_read_begin(&map, 0u, &v), OCC_ERR_STATE); /* not shared yet */
     assert_int_equal(occ_map_state_at(occ_view_map(&v), v3(0, 0, 0)), OCC_STATE_UNKNOWN);
     assert_int_equal(occ_map_write_begin(&map), OCC_ERR_STATE);
@@ -176,6 +178,49 @@ static void test_reuse_after_close(void **state)
     assert_int_equal(state_in(&v2, p), OCC_STATE_FREE);
     assert_view_equals(&v2, &map);
     occ_read_end(&map, &v2);
+}
+
+/* The freshness rule: while a view opened before the last publish stays open, every new version
+ * is deferred (no bound in number) and new views get the last published one; a reader sees how
+ * far behind it is from occ_shared_latest_version(); once that view closes the writer's next
+ * call publishes the latest. */
+static void test_freshness(void **state)
+{
+    (void)state;
+    share(2u);
+    occ_view_t old, cur;
+    assert_int_equal(occ_read_begin(&map, 0u, &old), OCC_OK); /* version 0, kept open */
+    assert_int_equal(occ_map_update(&map, v3(0.05f, 0.05f, 0.05f), 1.0f), OCC_OK); /* 1: out */
+    assert_int_equal(occ_shared_latest_version(&map), 1u);
+    for (unsigned i = 0; i < 40u; i++) { /* versions 2..41: the spare snapshot is pinned */
+        assert_int_equal(occ_map_update(&map, v3(0.05f + 0.1f * (float)i, 1.0f, 0.0f), 1.0f),
+                         OCC_OK);
+        assert_int_equal(occ_read_begin(&map, 1u, &cur), OCC_OK);
+        assert_int_equal(cur.version, 1u);
+        assert_int_equal(occ_shared_latest_version(&map) - cur.version, i + 1u); /* its age */
+        occ_read_end(&map, &cur);
+    }
+    occ_shared_info_t info;
+    assert_int_equal(occ_shared_info(&map, &info), OCC_OK);
+    assert_int_equal(info.version, 41u);
+    assert_int_equal(info.published_version, 1u);
+    assert_int_equal(info.deferred, 40u);
+    assert_int_equal(occ_shared_latest_version(&map) - old.version, 41u);
+    occ_read_end(&map, &old);
+    /* The first write call after the pinning view closed publishes (its own version). */
+    assert_int_equal(occ_map_update(&map, v3(-1.0f, -1.0f, 0.5f), -1.0f), OCC_OK);
+    assert_int_equal(occ_read_begin(&map, 1u, &cur), OCC_OK);
+    assert_int_equal(cur.version, 42u);
+    assert_int_equal(occ_shared_latest_version(&map), cur.version);
+    assert_view_equals(&cur, &map);
+    occ_read_end(&map, &cur);
+    /* Inside a section the latest completed version does not move until its end. */
+    assert_int_equal(occ_map_write_begin(&map), OCC_OK);
+    assert_int_equal(occ_map_update(&map, v3(2.0f, 2.0f, 0.5f), 1.0f), OCC_OK);
+    assert_int_equal(occ_shared_latest_version(&map), 42u);
+    assert_int_equal(occ_map_version(&map), 43u); /* what the section will publish as */
+    assert_int_equal(occ_map_write_end(&map), OCC_OK);
+    assert_int_equal(occ_shared_latest_version(&map), 43u);
 }
 
 /* A refused write publishes nothing: views and the published version stay as they were. */
@@ -413,6 +458,7 @@ static void test_unsupported(void **state)
     assert_int_equal(occ_map_write_end(&map), OCC_ERR_STATE);
     assert_false(occ_map_publish(&map));
     assert_int_equal(occ_map_version(&map), 0u);
+    assert_int_equal(occ_shared_latest_version(&map), 0u);
     occ_shared_info_t info;
     assert_int_equal(occ_shared_info(&map, &info), OCC_ERR_STATE);
     assert_int_equal(occ_map_update(&map, p, -4.0f), OCC_OK);
@@ -431,6 +477,7 @@ int main(void)
         cmocka_unit_test_setup(test_errors, setup),
         cmocka_unit_test_setup(test_versions, setup),
         cmocka_unit_test_setup(test_reuse_after_close, setup),
+        cmocka_unit_test_setup(test_freshness, setup),
         cmocka_unit_test_setup(test_nomem, setup),
         cmocka_unit_test_setup(test_section, setup),
         cmocka_unit_test_setup(test_write_paths, setup),

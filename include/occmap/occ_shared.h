@@ -16,6 +16,19 @@
  * applied or not, never half, whatever the writer does meanwhile (insert, evict, clear, load).
  * The view stays that version until occ_read_end(). occ_map_check() holds on every view.
  *
+ * Freshness: a view holds the version published when it opened. How far behind it is, a reader
+ * learns from occ_shared_latest_version(map) - view.version (versions the writer completed
+ * since; any thread or interrupt, one atomic load). Each completed version is published at once
+ * unless the spare snapshot is still pinned by a view opened before the previous publish (or a
+ * reader task is inside occ_read_begin() at that instant: a few instructions); it is then
+ * deferred, and goes out at the writer's first write call, occ_map_write_end() or
+ * occ_map_publish() after those views close. Deferrals have no bound in number (they last as
+ * long as such a view stays open), only in time: if every view closes within H seconds of
+ * opening and the writer calls one of those at least every P seconds, a view opened at any
+ * moment holds a version that was the writer's latest less than H + P ago (a reader task
+ * preempted inside occ_read_begin() adds the time until it runs again; an interrupt reader
+ * never does). Keep views short, and let an idle writer call occ_map_publish().
+ *
  * Design (why): published SNAPSHOTS. Shared memory holds OCC_SHARED_SNAPSHOTS (2) copies of the
  * arena; a version is published by bringing a snapshot no reader holds up to date (copying the
  * 16-byte granules of the arena written since that snapshot was last refreshed, which every
@@ -192,6 +205,13 @@ typedef struct {
     size_t copied_bytes_last;   /* bytes the last publish copied */
 } occ_shared_info_t;
 
+/* The latest version the writer completed (published or deferred: occ_shared_info()'s
+ * `version`), for any reader thread or interrupt at any time: an open view is
+ * occ_shared_latest_version(map) - view.version versions behind (the freshness rule at the top).
+ * Never less than the version of a view opened before the call. 0 for NULL or a map that is
+ * not shared (OCC_SHARED=0 included). Wait-free, O(1): one atomic 32-bit load. */
+uint32_t occ_shared_latest_version(const occ_map_t *map);
+
 /* Counters of a shared map (writer's thread). OCC_ERR_ARG for NULL, OCC_ERR_STATE when not
  * shared. O(readers). */
 occ_err_t occ_shared_info(const occ_map_t *map, occ_shared_info_t *out);
@@ -204,6 +224,7 @@ occ_err_t occ_shared_info(const occ_map_t *map, occ_shared_info_t *out);
  *       pieces written since the snapshot was last brought up to date), O(readers)
  *   occ_read_begin: stack <= 256 / 256 B; work: O(1), four atomic 32-bit accesses and a header copy
  *   occ_read_end, occ_map_write_begin, occ_map_version: stack <= 256 / 256 B; work: O(1)
+ *   occ_shared_latest_version: stack <= 256 / 256 B; work: O(1), one atomic 32-bit load
  *   occ_shared_bytes, occ_view_map: stack <= 256 / 256 B; work: O(1)
  *   occ_shared_info: stack <= 256 / 256 B; work: O(readers)
  */
