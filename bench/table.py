@@ -72,6 +72,18 @@ EXPECTED = [
         ("projective/fr1_rpy/frame_p99", "fr1_rpy per-frame time, p99", "none set"),
         ("projective/scratch_per_pixel", "projective scratch per pixel", "none set"),
     ]),
+    # Issue 20: ratio = plain / shared writer CPU time, so higher is better as in every row.
+    ("shared map (issue 20)", [
+        ("shared/writer_cpu/shared_vs_plain", "shared map writer CPU per scan, shared vs plain",
+         "shared <= 1.20x plain (ratio >= 0.83)"),
+        ("shared/writer_cpu/readers_vs_plain",
+         "shared map writer CPU per scan, shared with 4 readers vs plain",
+         "shared <= 1.20x plain (ratio >= 0.83)"),
+        ("shared/reader_latency/begin_end", "reader latency, occ_read_begin + occ_read_end",
+         "none set"),
+        ("shared/reader_latency/view", "reader latency, a whole view with its queries",
+         "none set"),
+    ]),
 ]
 OTHER_GROUP = "other rows (not in the issue's list)"
 NOT_MEASURED = "not measured"

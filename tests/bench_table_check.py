@@ -71,7 +71,7 @@ WANT_LINES = [
     "| trajectory lookup | not measured | not measured |  |  | occmap < 20 ns |  |  |  |",
 ]
 GROUPS = ["integration", "lookups", "collision / ray", "memory / scratch", "projective",
-          "other rows (not in the issue's list)"]
+          "shared map (issue 20)", "other rows (not in the issue's list)"]
 
 
 # (expected id, a bench's id, whether the first takes the second): bench/table.py's takes().
@@ -90,6 +90,9 @@ MATCH_CASES = [
     ("scratch/scan.dat/0.05/8MB", "scratch/scan.dat/0.05/8_mb", True),
     ("projective/fr1_rpy/frame_p50", "projective/fr1_rpy/frame_p99", False),
     ("query/raycast_10m", "query/ray_cast_10m", True),
+    ("shared/reader_latency/view", "shared/reader_latency/view/p99", True),
+    ("shared/reader_latency/begin_end", "shared/reader_latency/view/p50", False),
+    ("shared/writer_cpu/shared_vs_plain", "shared/writer_cpu/readers_vs_plain", False),
 ]
 
 
@@ -101,8 +104,8 @@ def matching():
         check(table.takes(e, b) == want, "takes(%s, %s) is %s" % (e, b, want))
     ids = table.expected_ids()
     overlap = [(x, y) for x in ids for y in ids if x != y and table.takes(x, y)]
-    check(len(ids) == 21 and len(set(ids)) == 21 and not overlap,
-          "21 distinct expected ids, none takes another's (%s)" % overlap)
+    check(len(ids) == 25 and len(set(ids)) == 25 and not overlap,
+          "25 distinct expected ids, none takes another's (%s)" % overlap)
 
 
 def run(*args):
@@ -129,7 +132,7 @@ def good_rows(out):
     for want in WANT_LINES:
         check(want in lines, "table.md has the line %s" % want)
     nm = [l for l in lines if "| not measured | not measured |" in l]
-    check(len(nm) == 21 - 4, "17 of the 21 expected rows read 'not measured' (%d)" % len(nm))
+    check(len(nm) == 25 - 4, "21 of the 25 expected rows read 'not measured' (%d)" % len(nm))
     at = [lines.index("| **%s** | | | | | | | | |" % g) if "| **%s** | | | | | | | | |" % g
           in lines else -1 for g in GROUPS]
     check(-1 not in at and at == sorted(at), "the groups come in the issue's order %s" % at)
@@ -139,12 +142,12 @@ def good_rows(out):
     check("table: rows no expected id takes (shown under \"other rows (not in the issue's list)\")"
           ": query/something_new (b.json)" in so, "stdout names the row no expected id takes")
     check(lines[0].startswith("Made by `make bench` on ") and lines[0].endswith(
-        ". Rows measured: 6 (target met: 1); expected rows not measured: 17."),
+        ". Rows measured: 6 (target met: 1); expected rows not measured: 21."),
         "header line: %s" % lines[0])
     with open(os.path.join(d, "table.json"), encoding="utf-8") as f:
         joined = json.load(f)
-    check(len(joined["rows"]) == 17 + 6 and joined["files"] == ["a.json", "b.json"],
-          "table.json joins 23 lines from a.json and b.json")
+    check(len(joined["rows"]) == 21 + 6 and joined["files"] == ["a.json", "b.json"],
+          "table.json joins 27 lines from a.json and b.json")
     rc, so2, _ = run("--render", os.path.join(d, "table.json"))
     check(rc == 0 and so2 == md, "--render of table.json is table.md")
 

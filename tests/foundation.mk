@@ -7,6 +7,7 @@
 #  * test-variant-float: the core rebuilt with -DOCC_VALUE_FLOAT=1 and the tree, pool, corruption
 #    and OctoMap oracle tests run against it (the issue: the oracle test passes with both).
 #  * test-variant-rayf: the core with -DOCC_RAY_DOUBLE=0 (firmware key arithmetic) against OctoMap.
+#  * test-variant-noshared: the core with -DOCC_SHARED=0 (issue 20) and test_shared, tree, pool.
 
 FOUNDATION_SCAN := $(BUILD)/data/foundation/scan.dat
 FOUNDATION_SCAN_BZ2 := /usr/share/doc/liboctomap-dev/examples/data/scan.dat.bz2
@@ -82,6 +83,9 @@ V8_TESTS := test_value test_tree_shadow test_tree_octomap test_pool test_corrupt
 $(eval $(call FOUNDATION_VARIANT,v8,-DOCC_VALUE_BITS=8,$(V8_TESTS)))
 # The firmware's float-only key arithmetic, against OctoMap within the documented border bound.
 $(eval $(call FOUNDATION_VARIANT,rayf,-DOCC_RAY_DOUBLE=0,test_tree_octomap))
+# Issue 20: the core without the shared-map mode (-DOCC_SHARED=0: no publish test in the write
+# paths); test_shared checks occ_map_share() answers OCC_ERR_UNSUPPORTED and the rest refuses.
+$(eval $(call FOUNDATION_VARIANT,noshared,-DOCC_SHARED=0,test_shared test_tree_shadow test_pool))
 
 TEST_STEPS += test-morton-bmi2
 TEST_BUILD_EXTRA += $(MORTON_BMI2_BIN)

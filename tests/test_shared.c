@@ -5,6 +5,10 @@
  * write path publishes exactly its end state (the view serializes to the writer's bytes), NOMEM
  * publishes nothing, snapshots are reused only once views close, sections, API errors, and
  * occ_map_check() on every view. The threaded stress is test_shared_stress.c.
+ * Built with -DOCC_SHARED=0 (tests/foundation.mk's noshared variant, the library built the same
+ * way) it checks instead that the mode is gone as the header promises: occ_map_share() answers
+ * OCC_ERR_UNSUPPORTED and changes nothing, the reader and writer-side calls refuse, and the map
+ * works as a plain map.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -45,6 +49,12 @@ static size_t serialize(const occ_map_t *m, uint8_t *buf, size_t cap)
     return b.len;
 }
 
+static occ_state_t state_in(const occ_view_t *v, occ_vec3_t p)
+{
+    return occ_map_state_at(occ_view_map(v), p);
+}
+
+#if OCC_SHARED
 /* The view answers exactly as the writer's map (serialized trees equal, checks hold). */
 static void assert_view_equals(const occ_view_t *view, const occ_map_t *m)
 {
@@ -63,10 +73,6 @@ static void share(unsigned n_readers)
     assert_int_equal(occ_map_share(&map, shmem + 3, need, n_readers), OCC_OK);
 }
 
-static occ_state_t state_in(const occ_view_t *v, occ_vec3_t p)
-{
-    return occ_map_state_at(occ_view_map(v), p);
-}
 
 static void test_errors(void **state)
 {
@@ -79,6 +85,8 @@ static void test_errors(void **state)
     assert_true(need <= OCC_SHARED_BYTES(sizeof arena)); /* the static bound holds */
     assert_int_equal(occ_shared_bytes(&map, OCC_SHARED_MAX_READERS), need); /* slots are fixed */
     occ_view_t v;
+    assert_int_equal(occ_shared_latest_version(NULL), 0u);
+    assert_int_equal(occ_shared_latest_version(&map), 0u); /* not shared */
     assert_int_equal(occ_read_begin(&map, 0u, &v), OCC_ERR_STATE); /* not shared yet */
     assert_int_equal(occ_map_state_at(occ_view_map(&v), v3(0, 0, 0)), OCC_STATE_UNKNOWN);
     assert_int_equal(occ_map_write_begin(&map), OCC_ERR_STATE);
@@ -170,6 +178,49 @@ static void test_reuse_after_close(void **state)
     assert_int_equal(state_in(&v2, p), OCC_STATE_FREE);
     assert_view_equals(&v2, &map);
     occ_read_end(&map, &v2);
+}
+
+/* The freshness rule: while a view opened before the last publish stays open, every new version
+ * is deferred (no bound in number) and new views get the last published one; a reader sees how
+ * far behind it is from occ_shared_latest_version(); once that view closes the writer's next
+ * call publishes the latest. */
+static void test_freshness(void **state)
+{
+    (void)state;
+    share(2u);
+    occ_view_t old, cur;
+    assert_int_equal(occ_read_begin(&map, 0u, &old), OCC_OK); /* version 0, kept open */
+    assert_int_equal(occ_map_update(&map, v3(0.05f, 0.05f, 0.05f), 1.0f), OCC_OK); /* 1: out */
+    assert_int_equal(occ_shared_latest_version(&map), 1u);
+    for (unsigned i = 0; i < 40u; i++) { /* versions 2..41: the spare snapshot is pinned */
+        assert_int_equal(occ_map_update(&map, v3(0.05f + 0.1f * (float)i, 1.0f, 0.0f), 1.0f),
+                         OCC_OK);
+        assert_int_equal(occ_read_begin(&map, 1u, &cur), OCC_OK);
+        assert_int_equal(cur.version, 1u);
+        assert_int_equal(occ_shared_latest_version(&map) - cur.version, i + 1u); /* its age */
+        occ_read_end(&map, &cur);
+    }
+    occ_shared_info_t info;
+    assert_int_equal(occ_shared_info(&map, &info), OCC_OK);
+    assert_int_equal(info.version, 41u);
+    assert_int_equal(info.published_version, 1u);
+    assert_int_equal(info.deferred, 40u);
+    assert_int_equal(occ_shared_latest_version(&map) - old.version, 41u);
+    occ_read_end(&map, &old);
+    /* The first write call after the pinning view closed publishes (its own version). */
+    assert_int_equal(occ_map_update(&map, v3(-1.0f, -1.0f, 0.5f), -1.0f), OCC_OK);
+    assert_int_equal(occ_read_begin(&map, 1u, &cur), OCC_OK);
+    assert_int_equal(cur.version, 42u);
+    assert_int_equal(occ_shared_latest_version(&map), cur.version);
+    assert_view_equals(&cur, &map);
+    occ_read_end(&map, &cur);
+    /* Inside a section the latest completed version does not move until its end. */
+    assert_int_equal(occ_map_write_begin(&map), OCC_OK);
+    assert_int_equal(occ_map_update(&map, v3(2.0f, 2.0f, 0.5f), 1.0f), OCC_OK);
+    assert_int_equal(occ_shared_latest_version(&map), 42u);
+    assert_int_equal(occ_map_version(&map), 43u); /* what the section will publish as */
+    assert_int_equal(occ_map_write_end(&map), OCC_OK);
+    assert_int_equal(occ_shared_latest_version(&map), 43u);
 }
 
 /* A refused write publishes nothing: views and the published version stay as they were. */
@@ -382,16 +433,56 @@ static void test_incremental(void **state)
                                              (size_t)map.inner.hwm * OCC_INNER_BLOCK_BYTES);
 }
 
+#else /* OCC_SHARED == 0 */
+
+/* Built without the mode: share refuses with OCC_ERR_UNSUPPORTED and leaves the map as it was;
+ * every other call of occ_shared.h answers as on a map that is not shared; writes work. */
+static void test_unsupported(void **state)
+{
+    (void)state;
+    const occ_vec3_t p = v3(0.35f, -0.45f, 0.15f);
+    assert_int_equal(occ_map_update(&map, p, 2.0f), OCC_OK);
+    const size_t n = serialize(&map, buf_a, sizeof buf_a);
+    const size_t need = occ_shared_bytes(&map, 2u);
+    assert_true(need > 0u && need <= sizeof shmem); /* the size formula stays */
+    assert_int_equal(occ_map_share(&map, shmem, need, 2u), OCC_ERR_UNSUPPORTED);
+    assert_int_equal(occ_map_share(&map, shmem, sizeof shmem, 1u), OCC_ERR_UNSUPPORTED);
+    assert_null(map.priv.shared);
+    assert_int_equal(serialize(&map, buf_b, sizeof buf_b), n);
+    assert_memory_equal(buf_a, buf_b, n);
+    occ_view_t v;
+    assert_int_equal(occ_read_begin(&map, 0u, &v), OCC_ERR_STATE);
+    assert_int_equal(state_in(&v, p), OCC_STATE_UNKNOWN); /* a refused view fails closed */
+    occ_read_end(&map, &v);
+    assert_int_equal(occ_map_write_begin(&map), OCC_ERR_STATE);
+    assert_int_equal(occ_map_write_end(&map), OCC_ERR_STATE);
+    assert_false(occ_map_publish(&map));
+    assert_int_equal(occ_map_version(&map), 0u);
+    assert_int_equal(occ_shared_latest_version(&map), 0u);
+    occ_shared_info_t info;
+    assert_int_equal(occ_shared_info(&map, &info), OCC_ERR_STATE);
+    assert_int_equal(occ_map_update(&map, p, -4.0f), OCC_OK);
+    assert_int_equal(occ_map_state_at(&map, p), OCC_STATE_FREE);
+    occ_map_clear(&map);
+    assert_int_equal(occ_map_check(&map), OCC_OK);
+}
+#endif
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+#if !OCC_SHARED
+        cmocka_unit_test_setup(test_unsupported, setup),
+#else
         cmocka_unit_test_setup(test_errors, setup),
         cmocka_unit_test_setup(test_versions, setup),
         cmocka_unit_test_setup(test_reuse_after_close, setup),
+        cmocka_unit_test_setup(test_freshness, setup),
         cmocka_unit_test_setup(test_nomem, setup),
         cmocka_unit_test_setup(test_section, setup),
         cmocka_unit_test_setup(test_write_paths, setup),
         cmocka_unit_test_setup(test_incremental, setup),
+#endif
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

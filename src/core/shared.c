@@ -33,6 +33,7 @@ typedef struct {
     uint8_t *snap[OCC_SHARED_SNAPSHOTS];   /* arena-sized copies */
     occ_map_t head[OCC_SHARED_SNAPSHOTS];  /* the header of the version each holds */
     uint32_t head_version[OCC_SHARED_SNAPSHOTS];
+    uint32_t latest;                       /* atomic: `version`, for readers */
     uint32_t pub;                          /* atomic: index of the published snapshot */
     uint32_t slot[OCC_SHARED_MAX_READERS]; /* atomic: SLOT_* per reader */
 } shared_t;
@@ -182,6 +183,7 @@ static bool try_publish(shared_t *const sh, const occ_map_t *const m)
 static void complete(shared_t *const sh, const occ_map_t *const m)
 {
     sh->version++;
+    occi_atomic_store(&sh->latest, sh->version); /* before the publish: latest >= any view */
     sh->pending = true;
     (void)try_publish(sh, m);
 }
@@ -370,6 +372,12 @@ uint32_t occ_map_version(const occ_map_t *const map)
         return 0u;
     }
     return sh->version + (sh->hold > 0u && sh->dirty ? 1u : 0u);
+}
+
+uint32_t occ_shared_latest_version(const occ_map_t *const map)
+{
+    const shared_t *const sh = map != NULL ? shared_of(map) : NULL;
+    return sh == NULL ? 0u : occi_atomic_load(&sh->latest);
 }
 
 occ_err_t occ_shared_info(const occ_map_t *const map, occ_shared_info_t *const out)

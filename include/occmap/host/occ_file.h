@@ -31,7 +31,9 @@ occ_err_t occ_file_probe(const char *path, const occ_map_config_t *base_cfg, occ
  * resolution and depth and the other parameters of `base_cfg` (NULL: defaults; snapshots carry
  * their own config). On error the map is left as it was (if it was initialized) and `msg` (may
  * be NULL) gets a one-line reason with the byte offset where known. `info` may be NULL.
- * Errors: OCC_ERR_IO, OCC_ERR_FORMAT, OCC_ERR_UNSUPPORTED, OCC_ERR_NOMEM (does not fit). */
+ * Errors: OCC_ERR_IO, OCC_ERR_FORMAT, OCC_ERR_UNSUPPORTED, OCC_ERR_NOMEM (does not fit).
+ * Never on a shared map (occ_shared.h): an init unshares it under its readers; read the file
+ * with occ_file_read_all() and load it with occ_io_read() instead (one version). */
 occ_err_t occ_file_load(const char *path, const occ_map_config_t *base_cfg, occ_map_t *map,
                         void *arena, size_t arena_bytes, char *msg, size_t msg_len);
 /* The same, also returning what the reader found (warnings, node count). */
