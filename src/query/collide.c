@@ -13,12 +13,12 @@
  * frame: the frames are one path, whose key `path` holds; blocks and masks in two arrays pack
  * to 5 B a frame (not 20: the walk's stack is on every collision check's call chain). */
 
-static inline unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsigned states,
+static OCC_ALWAYS_INLINE unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsigned states,
                                  uint32_t block, occ_key_t key, unsigned level)
 {
     const unsigned pm = level == 0u ? occ_q_leaf_match(m, occ_leaf_at(m, block), states)
                                     : occ_q_open_inner(m, block, states);
-    return pm != 0u ? pm & occ_q_touch_mask(m, v, key, level) : 0u;
+    return pm != 0u ? occ_q_touch_mask(m, v, key, level, pm) : 0u;
 }
 
 /* Below a start node (first voxel `key`, children in `block` at `level`): the first child

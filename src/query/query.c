@@ -159,7 +159,7 @@ static inline void push(occ_query_iter_t *it, occ_key_t pkey, unsigned level, ui
     }
     it->block[i] = block;
     if (pm != 0u) {
-        pm &= occ_q_touch_mask(m, it->vol, pkey, level);
+        pm = occ_q_touch_mask(m, it->vol, pkey, level, pm);
     }
     it->mask[i] = (uint8_t)pm;
     it->sp = (uint8_t)(i + 1u);
