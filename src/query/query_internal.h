@@ -152,11 +152,31 @@ static OCC_ALWAYS_INLINE unsigned occ_q_touch_mask(const occ_map_t *m, const occ
     return occi_q_touch_mask_cubes(m, v, pkey, level, want);
 }
 
-/* query.c: the cells a walk over the volume starts from: at most 8, at the smallest level
- * (>= min_level) whose cells are as wide as the volume's key range, in Morton order; *level gets
- * that level (depth_levels with the root as the one start). 0 when the volume misses the map. */
-unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
-                            occ_key_t start[8], unsigned *level);
+/* The cells a walk over a volume starts from: at most 8, at the smallest level (>= min_level)
+ * whose cells are as wide as the volume's key range, in Morton order. Kept as the first cell
+ * and the axes the others step along (20 B, not 96: the collision walk holds it on every
+ * check's call chain): cell t is one cell further on axis ax[j] when bit (na - 1 - j) of t is
+ * set. n = 0 when the volume misses the map; level = depth_levels with the root as the one
+ * start. */
+typedef struct {
+    occ_key_t first;
+    uint8_t n, level, na;
+    uint8_t ax[3];
+} occi_q_starts_t;
+
+/* query.c: the start cells of `vol`. */
+void occi_q_starts(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                   occi_q_starts_t *s);
+
+/* Start cell t < s->n. */
+static inline occ_key_t occi_q_start_key(const occi_q_starts_t *s, unsigned t)
+{
+    occ_key_t k = s->first;
+    for (unsigned j = 0; j < s->na; j++) {
+        k.k[s->ax[j]] += ((t >> (s->na - 1u - j)) & 1u) << s->level;
+    }
+    return k;
+}
 
 /* collide.c: the answer of a collision check that has not decided yet or failed: not safe,
  * not outside, an unobserved UNKNOWN node. Every collision entry point starts with it. */
