@@ -75,18 +75,6 @@ static inline void occ_touch_node(occ_map_t *const m, const occ_nodep_t n)
 #define OCC_PREFETCH(addr) ((void)(addr))
 #endif
 
-/* Keep a function out of line: a big frame that is not on every path (an exact volume test, a
- * camera set-up) then stays off the stack of its caller's deepest call chain (make cross,
- * tests/stack_budget.py: the chain is the sum of its frames). Or inline it always: a small
- * dispatcher's own frame then merges into its caller's. */
-#if defined(__GNUC__)
-#define OCC_NOINLINE __attribute__((noinline))
-#define OCC_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define OCC_NOINLINE
-#define OCC_ALWAYS_INLINE inline
-#endif
-
 /* `make lint` runs gcc -fanalyzer, which cannot follow an invariant kept across calls or loop
  * iterations. A function it misreads says why next to these and is wrapped in them (nothing
  * outside gcc >= 10, which alone knows the option). */

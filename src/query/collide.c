@@ -13,8 +13,9 @@
  * one below it are one array, not two (the walk's stack is on every collision check's call
  * chain). Neither the key nor the level is kept per frame: `path` holds the key bits. */
 
-static OCC_ALWAYS_INLINE unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsigned states,
-                                 uint32_t block, occ_key_t key, unsigned level)
+static OCC_ALWAYS_INLINE unsigned open_mask(const occ_map_t *m, const occ_volume_t *v,
+                                            unsigned states, uint32_t block, occ_key_t key,
+                                            unsigned level)
 {
     const unsigned pm = level == 0u ? occ_q_leaf_match(m, occ_leaf_at(m, block), states)
                                     : occ_q_open_inner(m, block, states);
