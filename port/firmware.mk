@@ -121,7 +121,8 @@ bench-m4: $(FW_DIR)/bench_m4.elf
 BENCH_STEPS += bench-m4
 .PHONY: bench-m4
 
-# The stack-budget checker against hand-made call graphs with hand-computed answers.
+# The stack-budget checker against hand-made call graphs with hand-computed answers (a planted
+# entry point over its class limit and a budget above its class limit must each fail).
 test-stack-budget:
 	@python3 tests/stack_budget_check.py
 TEST_STEPS += test-stack-budget
