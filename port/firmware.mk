@@ -122,7 +122,8 @@ BENCH_STEPS += bench-m4
 .PHONY: bench-m4
 
 # The stack-budget checker against hand-made call graphs with hand-computed answers (a planted
-# entry point over its class limit and a budget above its class limit must each fail).
+# entry point over its class limit, a budget above its class limit, an unstated entry point and
+# a statement without a work bound must each fail).
 test-stack-budget:
 	@python3 tests/stack_budget_check.py
 TEST_STEPS += test-stack-budget

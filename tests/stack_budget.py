@@ -19,7 +19,8 @@ matching row wins) in a class, with their enforced budgets.
 Fails (exit 1) when an entry point exceeds its budget or its class limit, a budget exceeds its
 class limit, a row names no known class, an entry point has no row, is declared but missing from
 the build (unless the budgets file says so), reaches a function whose stack is unknown or
-dynamic, or exceeds the stack bound its header states.
+dynamic, or has no statement in its header's Budgets section (a stack bound that holds and a
+work bound: "occ_x, occ_y: stack <= M4 / M0 B; work: ...").
 
 usage: stack_budget.py [--json OUT] BUDGETS HEADER_DIR TARGET=OBJ_ROOT=CFLAGS...
        (e.g. m4=build/cross/m4/src="-mcpu=.."); OUT gets every entry point's bounds and class
@@ -201,19 +202,31 @@ def public_functions(header_dir):
 
 
 STATED_RE = re.compile(r"^\s*\*\s+((?:occ_[\w*]+,?\s*)+):\s+stack <= ([\d,]+) / ([\d,]+) B")
+BUDGETS_RE = re.compile(r"^/\* ---- Budgets")
 
 
 def stated_bounds(header_dir):
-    """The headers' own statements (their "Budgets" sections): {header: [(patterns, m4, m0)]}."""
+    """The headers' own statements (their "Budgets" sections): {header: [(patterns, m4, m0,
+    work)]}; work is false when the statement (its line and the continuation lines up to the
+    next statement or the end of the section) gives no "work:" bound."""
     out = collections.defaultdict(list)
     for h in sorted(glob.glob(os.path.join(header_dir, "*.h"))):
+        section, cur = False, None
         for line in open(h, encoding="utf-8"):
+            section = section or BUDGETS_RE.match(line) is not None
+            if not section:
+                continue
             m = STATED_RE.match(line)
             if m:
                 pats = [p.strip() for p in m.group(1).replace(",", " ").split()]
-                out[os.path.basename(h)].append((pats, int(m.group(2).replace(",", "")),
-                                                 int(m.group(3).replace(",", ""))))
-    return out
+                cur = [pats, int(m.group(2).replace(",", "")), int(m.group(3).replace(",", "")),
+                       False]
+                out[os.path.basename(h)].append(cur)
+            if cur is not None and "work:" in line:
+                cur[3] = True
+            if "*/" in line:
+                break
+    return {k: [tuple(x) for x in v] for k, v in out.items()}
 
 
 def read_budgets(path, bad):
@@ -407,9 +420,9 @@ def write_json(path, targets, classes, rows):
 
 
 def check_stated(targets, names, header_dir, bad):
-    """The headers' stated bounds must hold; entry points without a statement are listed."""
+    """Every entry point's header states its stack bound, which must hold, and a work bound."""
     stated = stated_bounds(header_dir)
-    unstated, checked = [], 0
+    unstated, no_work, checked = [], [], 0
     for fn in sorted(names):
         if fn not in targets[0].frames:
             continue
@@ -417,16 +430,20 @@ def check_stated(targets, names, header_dir, bad):
                                                               for p in x[0])), None)
         if st is None:
             unstated.append(fn)
+            bad.append("%s has no statement in the Budgets section of %s" % (fn, names[fn]))
             continue
+        if not st[3]:
+            no_work.append(fn)
+            bad.append("%s: its statement in %s (%s) gives no work bound" % (
+                fn, names[fn], ", ".join(st[0])))
         checked += 1
         for i, t in enumerate(targets):
             b = t.worst(fn)[0]
             if b > st[1 + min(i, 1)]:
                 bad.append("%s: %d B on %s, but %s states <= %d B" % (fn, b, t.name, names[fn],
                                                                       st[1 + min(i, 1)]))
-    print("== stack bounds the headers state: %d entry points checked, %d without a statement%s"
-          % (checked, len(unstated), (": " + " ".join(unstated[:8]) +
-                                      (" ..." if len(unstated) > 8 else "")) if unstated else ""))
+    print("== stack and work bounds the headers state: %d entry points checked, %d without a "
+          "statement, %d without a work bound" % (checked, len(unstated), len(no_work)))
 
 
 def print_indirect(t, indirect):

@@ -5,8 +5,9 @@ format) with hand-computed answers: a chain sum through a static helper and a li
 (memset, whose frame comes from newlib's disassembly), an indirect call listed with '+', an
 entry point over budget, an entry point over its class limit (planted), a budget above its
 class limit, a row naming no class, recursion, a declared function missing from the build, a
-function without a budget, a header's stated stack bound below the chain. Prints PASS / FAIL
-lines; exit 1 on a failure.
+function without a budget, a header's Budgets section: a stated stack bound below the chain, an
+entry point without a statement, a statement without a work bound. Prints PASS / FAIL lines;
+exit 1 on a failure.
 
 usage: stack_budget_check.py   (needs arm-none-eabi-gcc / objdump, like make cross)"""
 import json
@@ -44,7 +45,12 @@ void occ_cb(void (*fn)(void));
 %s
 %s
 '''
-STATED = ""
+# The header's Budgets section (stack_budget.py reads the statements of that section only).
+STATED = '''/* ---- Budgets ----
+ *   occ_deep: stack <= 4096 / 4096 B; work: O(1)
+ *   occ_leaf, occ_cb: stack <= 24 / 24 B; work: O(1), the callback's
+ *       own on top
+ */'''
 CLASSES = "class q 1024 queries\nclass big 4096 the rest\n"
 
 failed = 0
@@ -120,7 +126,8 @@ def main():
         rc, out = run(tmp, budgets="occ_deep nosuch 1024 1024\n* q 1024 1024\n")
         check(rc == 1 and "occ_deep: class nosuch is not defined" in out,
               "a row naming no defined class fails")
-        rc, out = run(tmp, ci_extra=RECURSION, header_extra="void occ_loop(void);")
+        rc, out = run(tmp, ci_extra=RECURSION, header_extra="void occ_loop(void);",
+                      stated=STATED.replace("occ_leaf, occ_cb:", "occ_leaf, occ_cb, occ_loop:"))
         check(rc == 1 and "FAIL stack budget: m4: recursion: occ_loop -> again -> occ_loop" in out,
               "recursion fails, with its cycle")
         rc, out = run(tmp, header_extra="int occ_gone(int x);")
@@ -135,16 +142,26 @@ def main():
         check(rc == 0 and re.search(r"^  big +<= 4096 B +1 entry points; m4 occ_deep %d B" %
                                     (140 + ms), out, re.M) is not None,
               "the class summary names each class's deepest entry point")
-        rc, out = run(tmp, ci_extra='edge: { sourcename: "occ_leaf" targetname: "__aeabi_uldivmod" }')
+        rc, out = run(tmp, ci_extra='edge: { sourcename: "occ_leaf" targetname: "__aeabi_uldivmod" }',
+                      stated=STATED.replace("24 / 24 B", "4096 / 4096 B"))
         ul = uldivmod_chain()
         check(rc == 0 and row(out, "occ_leaf") == (16 + ul, "") and ul > 0,
               "a libcall edge without a label (GCC's __aeabi_uldivmod) counts: 16 + %d B" % ul)
-        rc, out = run(tmp, header_extra="/* Budgets\n *   occ_leaf, occ_cb: stack <= 24 / 24 B; work: O(1)\n */")
-        check(rc == 0 and "2 entry points checked, 1 without a statement" in out,
-              "a header's stated bound that holds passes (a pattern list, one without)")
-        rc, out = run(tmp, header_extra="/* Budgets\n *   occ_leaf: stack <= 15 / 15 B; work: O(1)\n */")
+        check("3 entry points checked, 0 without a statement, 0 without a work bound" in out,
+              "the header's statements that hold pass (a pattern list, a continued work bound)")
+        rc, out = run(tmp, stated=STATED.replace(" *   occ_deep: stack <= 4096 / 4096 B; work: O(1)\n",
+                                                 ""))
+        check(rc == 1 and "occ_deep has no statement in the Budgets section of x.h" in out,
+              "an entry point without a statement in its header fails")
+        rc, out = run(tmp, stated=STATED.replace("occ_deep: stack <= 4096 / 4096 B; work: O(1)",
+                                                 "occ_deep: stack <= 4096 / 4096 B;"))
+        check(rc == 1 and "occ_deep: its statement in x.h (occ_deep) gives no work bound" in out,
+              "a statement without a work bound fails")
+        rc, out = run(tmp, stated=STATED.replace("24 / 24 B", "15 / 15 B"))
         check(rc == 1 and "occ_leaf: 16 B on m4, but x.h states <= 15 B" in out,
               "a header stating one byte less than the chain fails")
+        rc, out = run(tmp, stated="/* occ_deep: stack <= 4096 / 4096 B; work: O(1) */\n" + STATED)
+        check(rc == 0, "a statement outside the Budgets section is not read")
         rc, out = run(tmp, budgets="occ_deep q 1024 1024\n* q 1024 1024\n")
         check(rc == 0 and "occ_deep m4 1024 > %d" % (-(-(140 + ms) * 105 // 100 // 64) * 64) in out,
               "a budget above the file's rule (+5 %, 64 B) is listed, not failed")
