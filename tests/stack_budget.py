@@ -409,7 +409,7 @@ def loose_rules(targets, rules, rows):
 
 def write_json(path, targets, classes, rows):
     data = {"targets": [t.name for t in targets],
-            "classes": {c: {"limit": v[0], "text": v[1]} for c, v in classes.items()},
+            "classes": [{"name": c, "limit": v[0], "text": v[1]} for c, v in classes.items()],
             "entries": {fn: {"class": r[0], "header": r[3],
                              "stack": dict(zip([t.name for t in targets], r[1])),
                              "budget": dict(zip([t.name for t in targets], r[2]))}
