@@ -130,9 +130,11 @@ static inline unsigned occ_q_open_inner(const occ_map_t *m, uint32_t block, unsi
  * (one voxel of slack for faces on a border); false when the bounds miss the map. */
 bool occi_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
 /* volume.c: which of the 8 children (at `level`) of the node with first voxel `pkey` touch a
- * sphere or a box volume: all 8 at once in closed form. */
-unsigned occi_q_touch_mask_closed(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+ * sphere / a box volume: all 8 at once in closed form. */
+unsigned occi_q_touch_mask_sphere(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
                                   unsigned level);
+unsigned occi_q_touch_mask_aabb(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                unsigned level);
 /* volume.c: the same for the other kinds, child by child (those in `want` only) with the exact
  * cube tests. */
 unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
@@ -141,13 +143,16 @@ unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_
 /* Which of the children in `want` (at `level`, bit s for child slot s) of the node with first
  * voxel `pkey` touch the volume (exact, as occ_volume_hits_box). The other kinds test only the
  * wanted children: their exact tests cost more than the mask that picks them. The dispatch is
- * inline and both tests out of line, so that a walk's deepest call chain holds only one of them
- * (make cross; on the host the closed form was already a call). */
+ * inline and the tests out of line, so that a walk's deepest call chain holds only one of them
+ * (make cross; on the host the sphere and box masks were already a call). */
 static OCC_ALWAYS_INLINE unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *v,
                                                    occ_key_t pkey, unsigned level, unsigned want)
 {
-    if (v->kind == OCC_VOL_SPHERE || v->kind == OCC_VOL_AABB) {
-        return want & occi_q_touch_mask_closed(m, v, pkey, level);
+    if (v->kind == OCC_VOL_SPHERE) {
+        return want & occi_q_touch_mask_sphere(m, v, pkey, level);
+    }
+    if (v->kind == OCC_VOL_AABB) {
+        return want & occi_q_touch_mask_aabb(m, v, pkey, level);
     }
     return occi_q_touch_mask_cubes(m, v, pkey, level, want);
 }

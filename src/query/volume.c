@@ -548,12 +548,16 @@ static inline unsigned aabb_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
     return xm & ym & zm;
 }
 
-unsigned occi_q_touch_mask_closed(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+unsigned occi_q_touch_mask_sphere(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
                                   unsigned level)
 {
-    const occ_vec3_t pc = occ_geom_center(m, pkey, level + 1u);
-    const float h = occ_q_half(m, level);
-    return v->kind == OCC_VOL_SPHERE ? sphere_touch(v, pc, h) : aabb_touch(v, pc, h);
+    return sphere_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
+}
+
+unsigned occi_q_touch_mask_aabb(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                unsigned level)
+{
+    return aabb_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
 }
 
 unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
