@@ -181,7 +181,9 @@ $(BUILD)/cross/m0/%.o: %.c | $(FW_HEADERS)
 
 cross-objs: $(DEPS_STAMP) $(CROSS_SRC:%.c=$(BUILD)/cross/m4/%.o) $(CROSS_SRC:%.c=$(BUILD)/cross/m0/%.o) $(CROSS_EXTRA)
 cross: cross-objs
-	@CROSS_M4_FLAGS="$(CROSS_M4)" CROSS_M0_FLAGS="$(CROSS_M0)" bash tests/cross_report.sh $(BUILD)/cross
+	@mkdir -p $(BUILD)/fw
+	@CROSS_M4_FLAGS="$(CROSS_M4)" CROSS_M0_FLAGS="$(CROSS_M0)" bash tests/cross_report.sh $(BUILD)/cross \
+	  $(BUILD)/fw/stack.json
 
 # The core must not reach for the heap, stdio or process exit.
 symcheck: $(BUILD)/libocc.a cross-objs

@@ -4,7 +4,10 @@
 // flips every round, so drift and cache warmth hit both alike):
 //   super rays: occ_map_insert_cloud(SUPER_RAYS) of scan.dat into a fresh map, 0.1 and 0.05 m;
 //   castRay:    occ_cast_ray 10 m from random free points of geb079.bt (ignore / stop at unknown);
-//   los:        occ_line_of_sight between free points 1..10.8 m apart on geb079.bt.
+//   los:        occ_line_of_sight between free points 1..10.8 m apart on geb079.bt;
+//   collide:    occ_collide_sphere (r 0.25 m), _capsule (1 m, r 0.3 m) and _obb (0.6 x 0.4 x
+//               0.2 m, random yaw) at the same free points, unknown unsafe;
+//   info gain:  occ_info_gain of a 115 x 60 deg, 6.5 m frustum (level 0) from free points.
 // Prints, per case, each side's median and range (min..max) over the rounds and the median and
 // quartiles of the per-round ratio new / old (< 1: the new code is faster). Both sides must give
 // the same answers (checked on every input first).
@@ -28,6 +31,10 @@ extern "C" decltype(occ_map_init) old_occ_map_init;
 extern "C" decltype(occ_map_insert_cloud) old_occ_map_insert_cloud;
 extern "C" decltype(occ_cast_ray) old_occ_cast_ray;
 extern "C" decltype(occ_line_of_sight) old_occ_line_of_sight;
+extern "C" decltype(occ_collide_sphere) old_occ_collide_sphere;
+extern "C" decltype(occ_collide_capsule) old_occ_collide_capsule;
+extern "C" decltype(occ_collide_obb) old_occ_collide_obb;
+extern "C" decltype(occ_info_gain) old_occ_info_gain;
 
 static double cpu_ms()
 {
@@ -155,6 +162,105 @@ static bool same_ray(const occ_ray_result_t &a, const occ_ray_result_t &b)
            std::memcmp(&a.end, &b.end, sizeof a.end) == 0;
 }
 
+static bool same_collision(const occ_collision_t &a, const occ_collision_t &b)
+{
+    return a.safe == b.safe && a.outside == b.outside &&
+           std::memcmp(&a.node.key, &b.node.key, sizeof a.node.key) == 0 &&
+           a.node.level == b.node.level && a.node.state == b.node.state;
+}
+
+static occ_vec3_t unit(occ_vec3_t d)
+{
+    const float n = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    return {d.x / n, d.y / n, d.z / n};
+}
+
+// One side's collision checks.
+struct CollideFns {
+    decltype(occ_collide_sphere) *sphere;
+    decltype(occ_collide_capsule) *capsule;
+    decltype(occ_collide_obb) *obb;
+};
+
+// Case c at point o (the centre; the capsule's first end), direction d (capsule, obb heading).
+static occ_err_t collide_one(const CollideFns &f, int c, const occ_map_t *m, occ_vec3_t o,
+                             occ_vec3_t d, occ_collision_t *col)
+{
+    if (c == 0) return f.sphere(m, o, 0.25f, OCC_UNKNOWN_UNSAFE, col);
+    if (c == 1) {
+        const occ_vec3_t u = unit(d);
+        return f.capsule(m, o, {o.x + u.x, o.y + u.y, o.z + u.z}, 0.3f, OCC_UNKNOWN_UNSAFE, col);
+    }
+    const occ_vec3_t u = unit({d.x, d.y, 0.0f});
+    const occ_vec3_t ax[3] = {{u.x, u.y, 0}, {-u.y, u.x, 0}, {0, 0, 1}};
+    const float half[3] = {0.3f, 0.2f, 0.1f};
+    return f.obb(m, o, half, ax, OCC_UNKNOWN_UNSAFE, col);
+}
+
+static void bench_collide(const occ_map_t &m, const std::vector<occ_vec3_t> &o,
+                          const std::vector<occ_vec3_t> &d, int rounds)
+{
+    const CollideFns olds = {old_occ_collide_sphere, old_occ_collide_capsule, old_occ_collide_obb};
+    const CollideFns news = {occ_collide_sphere, occ_collide_capsule, occ_collide_obb};
+    const char *names[3] = {"collide sphere r 0.25 m (20k)", "collide capsule 1 m r 0.3 m (20k)",
+                            "collide obb 0.6x0.4x0.2 m (20k)"};
+    for (int c = 0; c < 3; c++) {
+        for (size_t i = 0; i < o.size(); i++) {
+            occ_collision_t co, cn;
+            const occ_err_t eo = collide_one(olds, c, &m, o[i], d[i], &co);
+            const occ_err_t en = collide_one(news, c, &m, o[i], d[i], &cn);
+            if (eo != en || !same_collision(co, cn)) {
+                std::fprintf(stderr, "ab_split: %s %zu differs\n", names[c], i);
+                std::exit(1);
+            }
+        }
+        const auto all = [&](const CollideFns &f) {
+            return time_all(o.size(), [&](size_t i) {
+                occ_collision_t col;
+                collide_one(f, c, &m, o[i], d[i], &col);
+                return col.safe;
+            });
+        };
+        ab(names[c], rounds, [&] { return all(olds); }, [&] { return all(news); });
+    }
+}
+
+// Frustum 115 x 60 deg, 0..6.5 m, looking along d (level), from o.
+static occ_volume_t gain_frustum(occ_vec3_t o, occ_vec3_t d)
+{
+    const occ_vec3_t u = unit({d.x, d.y, 0.0f});
+    const occ_vec3_t ax[3] = {{u.x, u.y, 0}, {-u.y, u.x, 0}, {0, 0, 1}};
+    occ_volume_t v;
+    if (occ_volume_frustum(&v, o, ax, 2.007f, 1.047f, 0.0f, 6.5f) != OCC_OK) std::abort();
+    return v;
+}
+
+static void bench_info_gain(const occ_map_t &m, const std::vector<occ_vec3_t> &o,
+                            const std::vector<occ_vec3_t> &d, int rounds)
+{
+    const size_t n = 10;
+    for (size_t i = 0; i < n; i++) {
+        const occ_volume_t v = gain_frustum(o[i], d[i]);
+        occ_info_gain_t go, gn;
+        const occ_err_t eo = old_occ_info_gain(&m, &v, 0, 0, &go);
+        const occ_err_t en = occ_info_gain(&m, &v, 0, 0, &gn);
+        if (eo != en || go.unknown_cells != gn.unknown_cells || go.entropy_bits != gn.entropy_bits) {
+            std::fprintf(stderr, "ab_split: info gain %zu differs\n", i);
+            std::exit(1);
+        }
+    }
+    const auto all = [&](decltype(occ_info_gain) *gain) {
+        return time_all(n, [&](size_t i) {
+            const occ_volume_t v = gain_frustum(o[i], d[i]);
+            occ_info_gain_t g;
+            gain(&m, &v, 0, 0, &g);
+            return g.unknown_cells > 0u;
+        });
+    };
+    ab("info gain frustum 6.5 m (10)", rounds, [&] { return all(old_occ_info_gain); },
+       [&] { return all(occ_info_gain); });
+}
+
 static void bench_queries(const occ_map_t &m, int rounds)
 {
     const Box b = map_box(m);
@@ -226,6 +332,8 @@ static void bench_queries(const occ_map_t &m, int rounds)
     };
     ab("line of sight 1..10.8 m (20k)", rounds, [&] { return los_all(old_occ_line_of_sight); },
        [&] { return los_all(occ_line_of_sight); });
+    bench_collide(m, o, d, rounds);
+    bench_info_gain(m, o, d, rounds);
 }
 
 int main(int argc, char **argv)

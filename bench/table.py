@@ -385,16 +385,17 @@ def line_error(line):
     return row_error(line)
 
 
-def readme_split(path):
-    """README text as (before, section, after), section being what lies between the markers."""
+def readme_split(path, begin=BEGIN, end=END):
+    """README text as (before, section, after), section being what lies between the markers
+    (also port/baremetal/fw_table.py's, with its own markers)."""
     with open(path, encoding="utf-8") as f:
         text = f.read()
-    begins = [m.start() for m in re.finditer(re.escape(BEGIN) + "\n", text)]
-    ends = [m.start() for m in re.finditer("^" + re.escape(END) + "$", text, re.M)]
+    begins = [m.start() for m in re.finditer(re.escape(begin) + "\n", text)]
+    ends = [m.start() for m in re.finditer("^" + re.escape(end) + "$", text, re.M)]
     if len(begins) != 1 or len(ends) != 1 or ends[0] < begins[0]:
         raise TableError("%s: wants one line '%s' and, after it, one line '%s' (found %d and %d)"
-                         % (path, BEGIN, END, len(begins), len(ends)))
-    a = begins[0] + len(BEGIN) + 1
+                         % (path, begin, end, len(begins), len(ends)))
+    a = begins[0] + len(begin) + 1
     return text[:a], text[a:ends[0]], text[ends[0]:]
 
 

@@ -115,13 +115,38 @@ $(FW_DIR)/bench_m4.elf: $(FW_BENCH_OBJ) $(FW_DIR)/libocc_m4.a $(FW_LD)
 	$(CROSS_CC) $(FW_LDFLAGS) -u _printf_float -Wl,-Map=$@.map -o $@ $(FW_BENCH_OBJ) $(FW_DIR)/libocc_m4.a -lm
 QEMU_M4_ICOUNT := timeout --foreground -k 2 300 qemu-system-arm -M mps2-an386 -icount shift=0 \
                   -nographic -monitor none -serial null -semihosting-config enable=on,target=native -kernel
+# The output also goes to build/fw/bench_m4.log, which `make fw-readme` reads.
 bench-m4: $(FW_DIR)/bench_m4.elf
 	@command -v qemu-system-arm >/dev/null || { echo "SKIP bench-m4: qemu-system-arm not installed"; exit 77; }
-	@cd $(FW_DIR) && $(QEMU_M4_ICOUNT) bench_m4.elf
+	@set -o pipefail; cd $(FW_DIR) && $(QEMU_M4_ICOUNT) bench_m4.elf | tee bench_m4.log.tmp
+	@mv $(FW_DIR)/bench_m4.log.tmp $(FW_DIR)/bench_m4.log
 BENCH_STEPS += bench-m4
 .PHONY: bench-m4
 
-# The stack-budget checker against hand-made call graphs with hand-computed answers.
+# ---- the firmware numbers of the READMEs (port/baremetal/fw_table.py) -------------------------
+#   make fw-readme      after make cross (and make bench-m4: without its log the committed bench
+#                       rows are kept): port/baremetal/results/firmware.json from what they
+#                       measured, then README.md's Firmware tables and port/baremetal/README's
+#                       "How big" list rendered from it; commit the three together.
+#   make test-fw-table  both README sections are what the committed results render, a changed
+#                       digit fails that check, and the results do not understate a stack bound
+#                       the current build has (tests/fw_table_check.py).
+FW_RESULTS := port/baremetal/results/firmware.json
+fw-readme:
+	@[ -f $(FW_DIR)/stack.json ] || { echo "fw-readme: no $(FW_DIR)/stack.json: run make cross"; exit 1; }
+	@python3 port/baremetal/fw_table.py collect --stack $(FW_DIR)/stack.json --cross $(BUILD)/cross \
+	  --image $(FW_DIR)/example_m4.elf --bench $(FW_DIR)/bench_m4.log --out $(FW_RESULTS)
+	@python3 port/baremetal/fw_table.py readme --results $(FW_RESULTS) --readme README.md \
+	  --port-readme port/baremetal/README --write
+	@echo "fw-readme: commit $(FW_RESULTS), README.md and port/baremetal/README together"
+test-fw-table:
+	@python3 tests/fw_table_check.py $(BUILD)
+TEST_STEPS += test-fw-table
+.PHONY: fw-readme test-fw-table
+
+# The stack-budget checker against hand-made call graphs with hand-computed answers (a planted
+# entry point over its class limit, a budget above its class limit, an unstated entry point and
+# a statement without a work bound must each fail).
 test-stack-budget:
 	@python3 tests/stack_budget_check.py
 TEST_STEPS += test-stack-budget

@@ -11,15 +11,24 @@ An entry point is every function declared in include/occmap/*.h (host/ excluded)
 its frame plus the worst bound of its callees. Calls through function pointers (GCC's
 __indirect_call) count as 0 here and are listed: the caller adds its own callback's stack.
 Recursion anywhere below an entry point fails the check (no bound is claimed for a cycle).
-Fails (exit 1) when an entry point exceeds its budget (BUDGETS file), has no budget, is
-declared but missing from the build (unless the budgets file says so), or reaches a function
-whose stack is unknown or dynamic.
 
-usage: stack_budget.py BUDGETS HEADER_DIR TARGET=OBJ_ROOT=CFLAGS... (e.g. m4=build/cross/m4="-mcpu=..")
+The BUDGETS file is the one table that classifies the entry points: `class NAME LIMIT text`
+lines give each class its limit (issue 24: queries and sector updates 1 KB, integration and file
+loading 1.5 KB), and every row `PATTERN CLASS M4 M0` puts the entry points it matches (first
+matching row wins) in a class, with their enforced budgets.
+Fails (exit 1) when an entry point exceeds its budget or its class limit, a budget exceeds its
+class limit, a row names no known class, an entry point has no row, is declared but missing from
+the build (unless the budgets file says so), reaches a function whose stack is unknown or
+dynamic, or has no statement in its header's Budgets section (a stack bound that holds and a
+work bound: "occ_x, occ_y: stack <= M4 / M0 B; work: ...").
+
+usage: stack_budget.py [--json OUT] BUDGETS HEADER_DIR TARGET=OBJ_ROOT=CFLAGS...
+       (e.g. m4=build/cross/m4/src="-mcpu=.."); OUT gets every entry point's bounds and class
 """
 import collections
 import fnmatch
 import glob
+import json
 import os
 import re
 import subprocess
@@ -193,23 +202,36 @@ def public_functions(header_dir):
 
 
 STATED_RE = re.compile(r"^\s*\*\s+((?:occ_[\w*]+,?\s*)+):\s+stack <= ([\d,]+) / ([\d,]+) B")
+BUDGETS_RE = re.compile(r"^/\* ---- Budgets")
 
 
 def stated_bounds(header_dir):
-    """The headers' own statements (their "Budgets" sections): {header: [(patterns, m4, m0)]}."""
+    """The headers' own statements (their "Budgets" sections): {header: [(patterns, m4, m0,
+    work)]}; work is false when the statement (its line and the continuation lines up to the
+    next statement or the end of the section) gives no "work:" bound."""
     out = collections.defaultdict(list)
     for h in sorted(glob.glob(os.path.join(header_dir, "*.h"))):
+        section, cur = False, None
         for line in open(h, encoding="utf-8"):
+            section = section or BUDGETS_RE.match(line) is not None
+            if not section:
+                continue
             m = STATED_RE.match(line)
             if m:
                 pats = [p.strip() for p in m.group(1).replace(",", " ").split()]
-                out[os.path.basename(h)].append((pats, int(m.group(2).replace(",", "")),
-                                                 int(m.group(3).replace(",", ""))))
-    return out
+                cur = [pats, int(m.group(2).replace(",", "")), int(m.group(3).replace(",", "")),
+                       False]
+                out[os.path.basename(h)].append(cur)
+            if cur is not None and "work:" in line:
+                cur[3] = True
+            if "*/" in line:
+                break
+    return {k: [tuple(x) for x in v] for k, v in out.items()}
 
 
-def read_budgets(path):
-    rules, missing_ok = [], []
+def read_budgets(path, bad):
+    """Classes {name: (limit, text)}, rows [(pattern, class, m4, m0)], names not built."""
+    classes, rules, missing_ok = {}, [], []
     for line in open(path, encoding="utf-8"):
         line = line.split("#", 1)[0].strip()
         if not line:
@@ -217,9 +239,17 @@ def read_budgets(path):
         parts = line.split()
         if parts[0] == "not-built":
             missing_ok.extend(parts[1:])
+        elif parts[0] == "class":
+            classes[parts[1]] = (int(parts[2]), " ".join(parts[3:]))
         else:
-            rules.append((parts[0], int(parts[1]), int(parts[2]), int(parts[3])))
-    return rules, missing_ok
+            rules.append((parts[0], parts[1], int(parts[2]), int(parts[3])))
+    for pat, cls, m4, m0 in rules:
+        if cls not in classes:
+            bad.append("%s: class %s is not defined in %s" % (pat, cls, path))
+        elif max(m4, m0) > classes[cls][0]:
+            bad.append("%s: budget %d / %d B above its class %s limit of %d B" % (
+                pat, m4, m0, cls, classes[cls][0]))
+    return classes, rules, missing_ok
 
 
 class Target:
@@ -302,16 +332,16 @@ def source_line(site):
     return "%s:%s %s" % (m.group(1), m.group(2), lines[int(m.group(2)) - 1].strip()[:60])
 
 
-def print_table(targets, names, rules, missing_ok, budgets, bad):
-    """One row per entry point; returns {indirect call site: entry points} and the rows over
-    their class target."""
-    indirect, over = collections.defaultdict(set), []
+def print_table(targets, names, rules, classes, missing_ok, budgets, bad):
+    """One row per entry point; returns {indirect call site: entry points} and {entry point:
+    (class, [bound per target], [budget per target], header)}."""
+    indirect, rows = collections.defaultdict(set), {}
     head = "%-36s %-14s" % ("entry point", "header")
     for t in targets:
         head += " %6s %6s" % (t.name, "budget")
     print("== worst call-chain stack per public entry point, bytes (-fcallgraph-info=su; "
           "+ = calls a callback, its stack is the caller's to add)")
-    print(head + " %6s  deepest chain (%s)" % ("target", targets[0].name))
+    print(head + " %-17s deepest chain (%s)" % ("class (limit)", targets[0].name))
     for fn in sorted(names):
         rule = next((r for r in rules if fnmatch.fnmatchcase(fn, r[0])), None)
         if fn not in targets[0].frames:
@@ -321,30 +351,78 @@ def print_table(targets, names, rules, missing_ok, budgets, bad):
         if rule is None:
             bad.append("%s has no budget in %s" % (fn, budgets))
             continue
+        limit = classes.get(rule[1], (0, ""))[0]
         row = "%-36s %-14s" % (fn, names[fn].replace(".h", ""))
-        chain0 = ()
+        chain0, bounds, budgets_t = (), [], []
         for i, t in enumerate(targets):
             b, chain, sites = t.worst(fn)
             chain0 = chain0 or chain
             budget = rule[2 + min(i, 1)]
+            bounds.append(b)
+            budgets_t.append(budget)
             row += " %5d%s %6d" % (b, "+" if sites else " ", budget)
             for site in sites:
                 indirect[site].add(fn)
             if b > budget:
                 bad.append("%s: %d B on %s, budget %d B (%s)" % (fn, b, t.name, budget,
                                                                " > ".join(map(short, chain))))
-            if b > rule[1]:
-                over.append("%s %s %d B > %d B" % (fn, t.name, b, rule[1]))
-        print(row + " %6d%s " % (rule[1], "!" if any(o.startswith(fn + " ") for o in over)
-                                 else " ") + " > ".join(map(short, chain0[1:5])) +
-              (" ..." if len(chain0) > 5 else ""))
-    return indirect, over
+            if b > limit:
+                bad.append("%s: %d B on %s, above its class %s limit of %d B (%s)" % (
+                    fn, b, t.name, rule[1], limit, " > ".join(map(short, chain))))
+        rows[fn] = (rule[1], bounds, budgets_t, names[fn])
+        print(row + " %-17s " % ("%s (%d)" % (rule[1], limit)) +
+              " > ".join(map(short, chain0[1:5])) + (" ..." if len(chain0) > 5 else ""))
+    return indirect, rows
+
+
+def print_classes(targets, classes, rows):
+    """Per class: its limit and its deepest entry point per target."""
+    print("== classes (%s): limit, deepest entry point per target" % "/".join(
+        t.name for t in targets))
+    for cls, (limit, text) in classes.items():
+        members = [fn for fn, r in rows.items() if r[0] == cls]
+        worst = []
+        for i, t in enumerate(targets):
+            fn = max(members, key=lambda f: rows[f][1][i]) if members else None
+            worst.append("%s %s %d B" % (t.name, fn, rows[fn][1][i]) if fn else t.name + " -")
+        print("  %-12s <= %4d B  %3d entry points; %s  (%s)" % (cls, limit, len(members),
+                                                              "; ".join(worst), text))
+
+
+def loose_rules(targets, rules, rows):
+    """Rows whose budget is above the file's rule (the measured bound + 5 %, rounded up to 64 B;
+    at most the class limit): printed, so the budgets stay as low as the code allows."""
+    out = []
+    for pat, cls, m4, m0 in rules:
+        matched = [fn for fn in rows if next((r for r in rules if fnmatch.fnmatchcase(fn, r[0])),
+                                             None) == (pat, cls, m4, m0)]
+        if not matched:
+            continue
+        for i, t in enumerate(targets):
+            worst = max(rows[fn][1][i] for fn in matched)
+            want = -(-worst * 105 // 100 // 64) * 64 if worst > 0 else 64
+            want = max(want, -(-worst // 64) * 64)
+            if (m4, m0)[min(i, 1)] > want:
+                out.append("%s %s %d > %d" % (pat, t.name, (m4, m0)[min(i, 1)], want))
+    return out
+
+
+def write_json(path, targets, classes, rows):
+    data = {"targets": [t.name for t in targets],
+            "classes": [{"name": c, "limit": v[0], "text": v[1]} for c, v in classes.items()],
+            "entries": {fn: {"class": r[0], "header": r[3],
+                             "stack": dict(zip([t.name for t in targets], r[1])),
+                             "budget": dict(zip([t.name for t in targets], r[2]))}
+                        for fn, r in sorted(rows.items())}}
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(data, f, indent=1, sort_keys=True)
+        f.write("\n")
 
 
 def check_stated(targets, names, header_dir, bad):
-    """The headers' stated bounds must hold; entry points without a statement are listed."""
+    """Every entry point's header states its stack bound, which must hold, and a work bound."""
     stated = stated_bounds(header_dir)
-    unstated, checked = [], 0
+    unstated, no_work, checked = [], [], 0
     for fn in sorted(names):
         if fn not in targets[0].frames:
             continue
@@ -352,16 +430,20 @@ def check_stated(targets, names, header_dir, bad):
                                                               for p in x[0])), None)
         if st is None:
             unstated.append(fn)
+            bad.append("%s has no statement in the Budgets section of %s" % (fn, names[fn]))
             continue
+        if not st[3]:
+            no_work.append(fn)
+            bad.append("%s: its statement in %s (%s) gives no work bound" % (
+                fn, names[fn], ", ".join(st[0])))
         checked += 1
         for i, t in enumerate(targets):
             b = t.worst(fn)[0]
             if b > st[1 + min(i, 1)]:
                 bad.append("%s: %d B on %s, but %s states <= %d B" % (fn, b, t.name, names[fn],
                                                                       st[1 + min(i, 1)]))
-    print("== stack bounds the headers state: %d entry points checked, %d without a statement%s"
-          % (checked, len(unstated), (": " + " ".join(unstated[:8]) +
-                                      (" ..." if len(unstated) > 8 else "")) if unstated else ""))
+    print("== stack and work bounds the headers state: %d entry points checked, %d without a "
+          "statement, %d without a work bound" % (checked, len(unstated), len(no_work)))
 
 
 def print_indirect(t, indirect):
@@ -376,24 +458,32 @@ def print_indirect(t, indirect):
 
 
 def main():
-    budgets, header_dir = sys.argv[1], sys.argv[2]
+    args = sys.argv[1:]
+    json_out = None
+    if args[:1] == ["--json"]:
+        json_out, args = args[1], args[2:]
+    budgets, header_dir = args[0], args[1]
     targets = []
-    for spec in sys.argv[3:]:
+    for spec in args[2:]:
         name, root, cflags = spec.split("=", 2)
         targets.append(Target(name, root, cflags))
-    rules, missing_ok = read_budgets(budgets)
-    names = public_functions(header_dir)
     bad = []
-    indirect, over = print_table(targets, names, rules, missing_ok, budgets, bad)
+    classes, rules, missing_ok = read_budgets(budgets, bad)
+    names = public_functions(header_dir)
+    indirect, rows = print_table(targets, names, rules, classes, missing_ok, budgets, bad)
     check_stated(targets, names, header_dir, bad)
     print_indirect(targets[0], indirect)
-    print("== above the class target of issue 24 (! in the table; the budget file says why): %s"
-          % ("none" if not over else "; ".join(over)))
+    print_classes(targets, classes, rows)
+    loose = loose_rules(targets, rules, rows)
+    print("== budgets above the rule of %s (measured + 5 %%, rounded up to 64 B): %s" % (
+        os.path.basename(budgets), "none" if not loose else "; ".join(loose)))
     for t in targets:
         for p in sorted(set(t.problems)):
             bad.append("%s: %s" % (t.name, p))
     for b in bad:
         print("FAIL stack budget: " + b)
+    if json_out is not None:
+        write_json(json_out, targets, classes, rows)
     n = len([n for n in names if n in targets[0].frames])
     print("%s stack budget: %d entry points on %s, budgets in %s" % (
         "FAIL" if bad else "PASS", n, "/".join(t.name for t in targets), budgets))

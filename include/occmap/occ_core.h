@@ -457,24 +457,29 @@ bool occ_value_observed(occ_value_t v);
  *   occ_map_read, occ_map_read_key: stack <= 192 / 256 B; work: one descent, <= depth_levels blocks
  *       read
  *   occ_map_state_at: stack <= 128 / 192 B; work: one descent, <= depth_levels blocks read
- *   occ_map_update, occ_map_update_key: stack <= 1,024 / 1,024 B; work: one path: <= depth_levels
+ *   occ_map_update, occ_map_update_key: stack <= 768 / 768 B; work: one path: <= depth_levels
  *       blocks, allocates <= depth-1 inner + 1 leaf
- *   occ_map_observe_key: stack <= 960 / 960 B; work: as occ_map_update_key
- *   occ_map_observe_codes: stack <= 960 / 960 B; work: n codes x <= depth_levels blocks (about n
+ *   occ_map_observe_key: stack <= 640 / 704 B; work: as occ_map_update_key
+ *   occ_map_observe_codes: stack <= 640 / 704 B; work: n codes x <= depth_levels blocks (about n
  *       when clustered)
- *   occ_map_observe_need: stack <= 960 / 960 B; work: n codes x <= depth_levels blocks, read only
+ *   occ_map_observe_need: stack <= 640 / 704 B; work: n codes x <= depth_levels blocks, read only
  *   occ_map_set_key, occ_map_forget_key: stack <= 704 / 704 B; work: one path + the blocks of the
  *       subtree it releases
  *   occ_map_stats: stack <= 448 / 512 B; work: every node once
  *   occ_map_check: stack <= 384 / 448 B; work: every node + every free block once
- *   occ_walk_next: stack <= 256 / 256 B; work: O(1) amortized per node
- *   occ_map_node_root, occ_map_node_child: stack <= 256 / 256 B; work: one block read
- *   occ_map_init, occ_map_clear, occ_map_config_default: stack <= 256 / 256 B;
- *   occ_map_pool_stats, occ_walk_begin, occ_walk_status: stack <= 256 / 256 B;
- *   occ_walk_skip_children: stack <= 256 / 256 B; work: O(1), no tree walk
- *   occ_map_key, occ_map_key_range, occ_map_key_center: stack <= 256 / 256 B;
- *   occ_key_at_level, occ_map_node_size, occ_morton_*: stack <= 256 / 256 B;
- *   occ_value_*, occ_arena_blocks_for_bytes, occ_err_str: stack <= 256 / 256 B; work: O(1), no map
+ *   occ_walk_next: stack <= 128 / 128 B; work: O(1) amortized per node
+ *   occ_map_node_root, occ_map_node_child: stack <= 128 / 128 B; work: one block read
+ *   occ_map_init, occ_map_clear, occ_map_config_default: stack <= 128 / 192 B; work: O(1): the
+ *       pools and the root are reset, the arena is not touched (a shared map: + one publish,
+ *       occ_shared.h)
+ *   occ_map_pool_stats, occ_walk_begin, occ_walk_status: stack <= 128 / 128 B; work: O(1), no
+ *       tree walk
+ *   occ_walk_skip_children: stack <= 128 / 128 B; work: O(1), no tree walk
+ *   occ_map_key, occ_map_key_range, occ_map_key_center: stack <= 192 / 192 B; work: O(1): one
+ *       key conversion per axis, no map access
+ *   occ_key_at_level, occ_map_node_size, occ_morton_*: stack <= 128 / 128 B; work: O(1), no map
+ *       access
+ *   occ_value_*, occ_arena_blocks_for_bytes, occ_err_str: stack <= 64 / 64 B; work: O(1), no map
  *       access
  *   occ_map_state_of: stack <= 128 / 192 B; work: O(1), no map access
  */

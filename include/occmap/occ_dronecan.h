@@ -409,7 +409,7 @@ occ_err_t occ_dronecan_range_rx_frame(occ_dronecan_range_rx_t *rx, const occ_can
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_dronecan_poll_map: stack <= 960 / 960 B; work: occ_sectors_compute (occ_sectors.h), then
+ *   occ_dronecan_poll_map: stack <= 896 / 960 B; work: occ_sectors_compute (occ_sectors.h), then
  *       what occ_dronecan_poll sends
  *   occ_dronecan_poll, occ_dronecan_publish_sectors: stack <= 512 / 512 B; work: O(sectors): a
  *       Proximity transfer per sector with an obstacle, NodeStatus when due
@@ -420,7 +420,7 @@ occ_err_t occ_dronecan_range_rx_frame(occ_dronecan_range_rx_t *rx, const occ_can
  *   occ_dronecan_range_beam, occ_dronecan_range_rx_init: stack <= 512 / 512 B; work: O(n_mounts)
  *       (rx_init: O(n_mounts^2))
  *   occ_dronecan_*: stack <= 512 / 512 B; work: O(1) or O(payload bytes); no map access
- *   occ_float16_*: stack <= 256 / 256 B; work: O(1) or O(payload bytes); no map access
+ *   occ_float16_*: stack <= 64 / 128 B; work: O(1) or O(payload bytes); no map access
  */
 
 #ifdef __cplusplus

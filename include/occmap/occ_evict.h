@@ -155,7 +155,7 @@ occ_err_t occ_map_evict_for(occ_map_t *map, const occ_vec3_t *center,
  *   occ_map_evict: stack <= 768 / 768 B; work: <= budget_blocks + depth block visits per call (no
  *       budget: a whole sweep)
  *   occ_map_evict_for: stack <= 768 / 768 B; work: a whole sweep if needed (ignores budget_blocks)
- *   occ_evict_out_init, occ_evict_policy_default: stack <= 256 / 256 B; work: O(1)
+ *   occ_evict_out_init, occ_evict_policy_default: stack <= 64 / 64 B; work: O(1)
  */
 
 #ifdef __cplusplus

@@ -376,14 +376,14 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
  *   occ_map_insert_cloud, occ_map_insert_rays: stack <= 1,472 / 1,536 B; work: n_points rays x <= 3
  *       (ceil(max_ray / res) + 2) + 2 voxels, then one path per distinct voxel
- *   occ_map_insert_projective: stack <= 1,344 / 1,344 B (its context, tables and walk stack are
+ *   occ_map_insert_projective: stack <= 832 / 832 B (its context, tables and walk stack are
  *       in the scratch); work: O(pixels) for the pyramid and end points, the walk as stated above
  *       (at most every voxel of the frustum within max range), then the tree update
- *   occ_ray_keys: stack <= 448 / 512 B; work: <= occ_ray_max_keys() keys, no map access
+ *   occ_ray_keys: stack <= 384 / 512 B; work: <= occ_ray_max_keys() keys, no map access
  *   occ_insert_scratch_bytes_scan: stack <= 256 / 320 B; work: O(n_points) (FAST_DISCRETE: + its
  *       coarse box)
  *   occ_insert_scratch_bytes: stack <= 256 / 320 B; work: O(1)
- *   occ_ray_max_keys, occ_insert_params_default: stack <= 256 / 256 B; work: O(1)
+ *   occ_ray_max_keys, occ_insert_params_default: stack <= 128 / 192 B; work: O(1)
  */
 
 #ifdef __cplusplus

@@ -168,13 +168,13 @@ uint32_t occ_crc32(uint32_t crc, const void *data, size_t len);
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_io_load, occ_io_read: stack <= 1,536 / 1,536 B; work: two passes over the input bytes
+ *   occ_io_load, occ_io_read: stack <= 1,472 / 1,472 B; work: two passes over the input bytes
  *       (O(len)), no recursion
- *   occ_io_probe: stack <= 1,216 / 1,216 B; work: one pass over the input bytes, no map
+ *   occ_io_probe: stack <= 960 / 1,024 B; work: one pass over the input bytes, no map
  *   occ_io_write: stack <= 896 / 896 B; work: two passes over the nodes; output in chunks of <= 128
  *       B
  *   occ_io_octomap_nodes: stack <= 704 / 704 B; work: one pass over the nodes
- *   occ_io_detect, occ_io_buf_write, occ_crc32: stack <= 256 / 256 B; work: O(1) / O(len)
+ *   occ_io_detect, occ_io_buf_write, occ_crc32: stack <= 64 / 64 B; work: O(1) / O(len)
  */
 
 #ifdef __cplusplus

@@ -341,9 +341,9 @@ uint64_t occ_mav_feed_next_due(const occ_mav_feed_t *f);
  *   occ_mav_feed_poll: stack <= 960 / 1,024 B; work: one message: occ_sectors_compute
  *       (occ_sectors.h) when OBSTACLE_DISTANCE is due
  *   occ_mav_feed_rx: stack <= 768 / 832 B; work: one frame, O(payload)
- *   occ_mav_parser_push: stack <= 384 / 384 B; work: O(1) per byte, O(log n) per frame
+ *   occ_mav_parser_push: stack <= 320 / 384 B; work: O(1) per byte, O(log n) per frame
  *   occ_mav_feed_pose: stack <= 320 / 448 B; work: O(1)
- *   occ_mav_*: stack <= 384 / 384 B; work: O(1) or O(payload bytes); no map access
+ *   occ_mav_*: stack <= 320 / 384 B; work: O(1) or O(payload bytes); no map access
  */
 
 #ifdef __cplusplus

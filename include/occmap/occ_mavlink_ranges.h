@@ -122,9 +122,9 @@ occ_err_t occ_mav_beams_sensor_pose(const occ_mav_beams_t *beams, const occ_pose
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_mav_ranges_decode: stack <= 1,024 / 1,024 B; work: one message: <= 72 beams
+ *   occ_mav_ranges_decode: stack <= 960 / 1,024 B; work: one message: <= 72 beams
  *   occ_mav_sensor_mount: stack <= 640 / 768 B; work: O(1)
- *   occ_mav_beams_sensor_pose, occ_mav_ranges_init: stack <= 384 / 384 B; work: O(1)
+ *   occ_mav_beams_sensor_pose, occ_mav_ranges_init: stack <= 320 / 384 B; work: O(1)
  */
 
 #ifdef __cplusplus

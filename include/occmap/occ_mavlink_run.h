@@ -159,14 +159,16 @@ void occ_mav_feed_set_status(occ_mav_feed_t *f, uint8_t system_status);
 /* ---- Budgets (issue 24) -------------------------------------------------------------------
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call.
- *   occ_mav_pose_rx_take: stack <= 704 / 768 B (cosf's argument reduction in
+ *   occ_mav_pose_rx_take: stack <= 704 / 832 B (cosf's argument reduction in
  *       occ_quat_from_euler); work: O(1)
- *   occ_mav_encode_statustext: stack <= 256 / 256 B; work: O(text length), at most 50 bytes
- *   occ_timesync_take: stack <= 256 / 256 B; work: O(window), 8 replies
- *   occ_mav_encode_timesync, occ_mav_decode_timesync: stack <= 256 / 256 B; work: O(1)
- *   occ_timesync_init, occ_timesync_request: stack <= 256 / 256 B; work: O(1)
- *   occ_mav_pose_rx_config_default, occ_mav_pose_rx_init: stack <= 256 / 256 B; work: O(1)
- *   occ_mav_is_pose_msg, occ_mav_feed_set_status: stack <= 256 / 256 B; work: O(1)
+ *   occ_mav_encode_statustext: stack <= 320 / 384 B; work: O(text length), at most 50 bytes
+ *   occ_timesync_take: stack <= 128 / 192 B; work: O(window), 8 replies
+ *   occ_mav_encode_timesync, occ_mav_decode_timesync: stack <= 320 / 384 B; work: O(1)
+ *   occ_mav_encode_obstacle_3d: stack <= 320 / 384 B; work: O(1): one OBSTACLE_DISTANCE_3D frame
+ *       (a 28-byte payload)
+ *   occ_timesync_init, occ_timesync_request: stack <= 128 / 192 B; work: O(1)
+ *   occ_mav_pose_rx_config_default, occ_mav_pose_rx_init: stack <= 320 / 384 B; work: O(1)
+ *   occ_mav_is_pose_msg, occ_mav_feed_set_status: stack <= 320 / 384 B; work: O(1)
  */
 
 #ifdef __cplusplus

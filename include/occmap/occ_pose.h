@@ -155,15 +155,18 @@ occ_pose_t occ_pose_interpolate(const occ_pose_t *a, const occ_pose_t *b, float 
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
  *   occ_pose_history_at: stack <= 768 / 896 B; work: O(log cap)
- *   occ_pose_history_push, occ_pose_history_init: stack <= 320 / 384 B;
+ *   occ_pose_history_push, occ_pose_history_init: stack <= 320 / 384 B; work: O(1) (init does
+ *       not touch the storage)
  *   occ_pose_history_count, occ_pose_history_span: stack <= 320 / 384 B; work: O(1)
  *   occ_pose_interpolate: stack <= 640 / 768 B; work: O(1), no map access
  *   occ_quat_from_axis_angle, occ_quat_from_euler: stack <= 576 / 704 B; work: O(1), no map access
- *   occ_pose_identity, occ_pose_check, occ_pose_compose: stack <= 320 / 384 B;
- *   occ_pose_invert, occ_pose_apply, occ_pose_rotate: stack <= 320 / 384 B;
+ *   occ_pose_identity, occ_pose_check, occ_pose_compose: stack <= 320 / 384 B; work: O(1), no
+ *       map access
+ *   occ_pose_invert, occ_pose_apply, occ_pose_rotate: stack <= 320 / 384 B; work: O(1), no map
+ *       access
  *   occ_pose_yaw, occ_pose_from_ned, occ_pose_to_ned: stack <= 320 / 384 B; work: O(1), no map
  *       access
- *   occ_quat_identity, occ_quat_to_euler, occ_quat_normalize: stack <= 192 / 192 B; work: O(1), no
+ *   occ_quat_identity, occ_quat_to_euler, occ_quat_normalize: stack <= 128 / 192 B; work: O(1), no
  *       map access
  */
 

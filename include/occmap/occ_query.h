@@ -419,29 +419,32 @@ occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned 
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_collide_sphere, occ_collide_aabb, occ_collide_obb: stack <= 1,344 / 1,408 B;
- *   occ_collide_capsule: stack <= 1,344 / 1,408 B; work: <= 8 start cells, each one descent, then
- *       the blocking blocks touching the volume, stopping at the first hit
- *   occ_collide_volume: stack <= 1,024 / 1,088 B; work: <= 8 start cells, each one descent, then
+ *   occ_collide_sphere, occ_collide_aabb, occ_collide_obb: stack <= 960 / 960 B; work: the
+ *       volume in O(1), then <= 8 start cells, each one descent, then the blocking blocks
+ *       touching the volume (the obb's children tested one by one), stopping at the first hit
+ *   occ_collide_capsule: stack <= 960 / 960 B; work: the volume in O(1), then <= 8 start cells,
+ *       each one descent, then the blocking blocks touching the capsule (children tested one
+ *       by one), stopping at the first hit
+ *   occ_collide_volume: stack <= 640 / 640 B; work: <= 8 start cells, each one descent, then
  *       the blocking blocks touching the volume, stopping at the first hit
  *   occ_cast_ray, occ_line_of_sight: stack <= 512 / 512 B; work: voxels crossed, <= 3 (range / res
  *       + 2) + 2 (range: max_range_m, else to the map border), each looked up unless its node holds
  *       nothing blocking
- *   occ_distance_to_obstacle: stack <= 512 / 576 B; work: O(nodes opened x log cap)
- *   occ_nearest_*: stack <= 384 / 384 B; work: O(nodes opened x log cap)
- *   occ_query_count: stack <= 1,088 / 1,152 B; work: amortized O(depth) per node touched
- *   occ_query_next: stack <= 768 / 832 B; work: amortized O(depth) per node touched
- *   occ_info_gain: stack <= 1,152 / 1,280 B; work: the cells reported (x the ray length in voxels
+ *   occ_distance_to_obstacle: stack <= 512 / 512 B; work: O(nodes opened x log cap)
+ *   occ_nearest_*: stack <= 320 / 320 B; work: O(nodes opened x log cap)
+ *   occ_query_count: stack <= 960 / 1,024 B; work: amortized O(depth) per node touched
+ *   occ_query_next: stack <= 640 / 704 B; work: amortized O(depth) per node touched
+ *   occ_info_gain: stack <= 1,024 / 1,024 B; work: the cells reported (x the ray length in voxels
  *       with OCC_GAIN_OCCLUSION)
- *   occ_lookup_index_state, occ_lookup_index_read: stack <= 256 / 256 B; work: one table load +
+ *   occ_lookup_index_state, occ_lookup_index_read: stack <= 192 / 256 B; work: one table load +
  *       <= level block reads
  *   occ_lookup_index_states: stack <= 320 / 384 B; work: per point one table load + <= level
  *       block reads
  *   occ_lookup_index_need: stack <= 384 / 384 B; work: every node down to the level once
  *   occ_lookup_index_pick: stack <= 384 / 384 B; work: every node once per level tried
- *   occ_lookup_index_build: stack <= 512 / 576 B; work: every node down to the level twice +
+ *   occ_lookup_index_build: stack <= 576 / 576 B; work: every node down to the level twice +
  *       every table cell once
- *   occ_lookup_index_status: stack <= 256 / 256 B; work: O(1)
+ *   occ_lookup_index_status: stack <= 192 / 256 B; work: O(1)
  *   occ_lookup_read, occ_lookup_state: stack <= 256 / 256 B; work: the levels below the highest key
  *       bit that differs from the last lookup
  *   occ_map_states_at: stack <= 320 / 320 B; work: per point the levels below the highest key bit
@@ -450,10 +453,11 @@ occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned 
  *   occ_query_status, occ_lookup_init, occ_lookup_status: stack <= 256 / 256 B; work: O(1)
  *   occ_volume_frustum: stack <= 704 / 832 B; work: O(1), no map access
  *   occ_volume_obb_yaw: stack <= 640 / 704 B; work: O(1), no map access
- *   occ_volume_hits_box: stack <= 320 / 448 B; work: O(1), no map access
- *   occ_volume_aabb, occ_volume_sphere, occ_volume_obb: stack <= 256 / 256 B;
- *   occ_volume_capsule, occ_volume_segment: stack <= 256 / 256 B;
- *   occ_volume_holds_box: stack <= 256 / 256 B; work: O(1), no map access
+ *   occ_volume_hits_box: stack <= 256 / 320 B; work: O(1), no map access
+ *   occ_volume_aabb, occ_volume_sphere, occ_volume_obb: stack <= 192 / 256 B; work: O(1), no
+ *       map access
+ *   occ_volume_capsule, occ_volume_segment: stack <= 192 / 256 B; work: O(1), no map access
+ *   occ_volume_holds_box: stack <= 192 / 256 B; work: O(1), no map access
  */
 
 #ifdef __cplusplus

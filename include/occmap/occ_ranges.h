@@ -112,9 +112,9 @@ occ_err_t occ_map_insert_ranges(occ_map_t *map, const occ_pose_t *map_from_senso
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_map_insert_ranges: stack <= 1,536 / 1,792 B; work: beams x rays per beam x <= 3 (max / res
+ *   occ_map_insert_ranges: stack <= 1,472 / 1,536 B; work: beams x rays per beam x <= 3 (max / res
  *       + 2) + 2 voxels, then one path per distinct voxel
- *   occ_ranges_scratch_bytes: stack <= 256 / 256 B; work: O(n_beams)
+ *   occ_ranges_scratch_bytes: stack <= 128 / 192 B; work: O(n_beams)
  */
 
 #ifdef __cplusplus

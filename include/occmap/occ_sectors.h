@@ -141,9 +141,9 @@ occ_err_t occ_sectors_compute(const occ_map_t *map, const occ_pose_t *map_from_b
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_sectors_compute: stack <= 896 / 896 B; work: nodes between the vehicle and the nearest
+ *   occ_sectors_compute: stack <= 832 / 896 B; work: nodes between the vehicle and the nearest
  *       non-free space per sector, each one descent (+ band_below / res + 1 voxel reads)
- *   occ_sectors_config_default, occ_sectors_config_check: stack <= 256 / 256 B; work: O(1)
+ *   occ_sectors_config_default, occ_sectors_config_check: stack <= 64 / 64 B; work: O(1)
  */
 
 #ifdef __cplusplus

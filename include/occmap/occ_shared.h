@@ -219,14 +219,14 @@ occ_err_t occ_shared_info(const occ_map_t *map, occ_shared_info_t *out);
 /* ---- Budgets (issue 24) -------------------------------------------------------------------
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call.
- *   occ_map_share: stack <= 256 / 256 B; work: one copy of the carved blocks into a snapshot
- *   occ_map_write_end, occ_map_publish: stack <= 256 / 256 B; work: one publish (the 16-byte
+ *   occ_map_share: stack <= 128 / 128 B; work: one copy of the carved blocks into a snapshot
+ *   occ_map_write_end, occ_map_publish: stack <= 128 / 128 B; work: one publish (the 16-byte
  *       pieces written since the snapshot was last brought up to date), O(readers)
- *   occ_read_begin: stack <= 256 / 256 B; work: O(1), four atomic 32-bit accesses and a header copy
- *   occ_read_end, occ_map_write_begin, occ_map_version: stack <= 256 / 256 B; work: O(1)
- *   occ_shared_latest_version: stack <= 256 / 256 B; work: O(1), one atomic 32-bit load
- *   occ_shared_bytes, occ_view_map: stack <= 256 / 256 B; work: O(1)
- *   occ_shared_info: stack <= 256 / 256 B; work: O(readers)
+ *   occ_read_begin: stack <= 192 / 256 B; work: O(1), four atomic 32-bit accesses and a header copy
+ *   occ_read_end, occ_map_write_begin, occ_map_version: stack <= 192 / 256 B; work: O(1)
+ *   occ_shared_latest_version: stack <= 64 / 64 B; work: O(1), one atomic 32-bit load
+ *   occ_shared_bytes, occ_view_map: stack <= 64 / 64 B; work: O(1)
+ *   occ_shared_info: stack <= 64 / 64 B; work: O(readers)
  */
 
 #ifdef __cplusplus

@@ -147,8 +147,9 @@ def call_cycles(elf, core_funcs):
     return [c for c in sccs if any(f.split(".")[0] in core_funcs for f in c)]
 
 
-def main():
-    elf, root = sys.argv[1], sys.argv[2]
+def image_modules(elf, root):
+    """{module: [text, data, bss]} of the image (its link map) and the image's own objects;
+    also port/baremetal/fw_table.py's source of the core's size in the image."""
     CORE.update(core_paths(root))
     sizes = parse_map(elf + ".map")
     mods = collections.defaultdict(lambda: [0, 0, 0])
@@ -159,6 +160,12 @@ def main():
             mods[name][k] += s[k]
         if name.startswith(("src/", "port/", "tests/")):
             objs.append(name)
+    return mods, objs
+
+
+def main():
+    elf, root = sys.argv[1], sys.argv[2]
+    mods, objs = image_modules(elf, root)
     print("== firmware image %s (Cortex-M4F, -Os): size per module, bytes" % elf)
     print("%-36s %8s %8s %8s" % ("module", "text", "data", "bss"))
     core = [0, 0, 0]

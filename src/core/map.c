@@ -24,19 +24,21 @@ static bool in_value_range(const float x)
     return occ_finite(x) && x > -31.0f && x < 31.0f;
 }
 
+bool occi_map_config_ok(const occ_map_config_t *const cfg)
+{
+    return occ_finite(cfg->resolution_m) && cfg->resolution_m > 0.0f && cfg->depth_levels >= 1u &&
+           cfg->depth_levels <= OCC_MAX_DEPTH && in_value_range(cfg->hit) && cfg->hit > 0.0f &&
+           in_value_range(cfg->miss) && cfg->miss < 0.0f && in_value_range(cfg->clamp_min) &&
+           in_value_range(cfg->clamp_max) && cfg->clamp_min < cfg->clamp_max &&
+           in_value_range(cfg->free_max) && in_value_range(cfg->occupied_min) &&
+           !(cfg->free_max > cfg->occupied_min);
+}
+
 occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, void *const arena,
                        const size_t arena_bytes)
 {
-    if (map == NULL || cfg == NULL || (arena == NULL && arena_bytes != 0u)) {
-        return OCC_ERR_ARG;
-    }
-    if (!occ_finite(cfg->resolution_m) || !(cfg->resolution_m > 0.0f) ||
-        cfg->depth_levels < 1u || cfg->depth_levels > OCC_MAX_DEPTH ||
-        !in_value_range(cfg->hit) || !(cfg->hit > 0.0f) || !in_value_range(cfg->miss) ||
-        !(cfg->miss < 0.0f) || !in_value_range(cfg->clamp_min) ||
-        !in_value_range(cfg->clamp_max) || !(cfg->clamp_min < cfg->clamp_max) ||
-        !in_value_range(cfg->free_max) || !in_value_range(cfg->occupied_min) ||
-        cfg->free_max > cfg->occupied_min) {
+    if (map == NULL || cfg == NULL || (arena == NULL && arena_bytes != 0u) ||
+        !occi_map_config_ok(cfg)) {
         return OCC_ERR_ARG;
     }
     map->cfg = *cfg;

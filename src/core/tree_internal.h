@@ -301,4 +301,9 @@ void occi_tree_expand(occ_map_t *m, occ_nodep_t node, unsigned level);
  * 8 entries are uniform and equal. Returns true when the node's value or flags changed. */
 bool occi_tree_refresh(occ_map_t *m, occ_nodep_t node, unsigned level);
 
+/* map.c: occ_map_init's rules for a config (resolution, depth, sensor model), without a map:
+ * the file loaders check a header's config with it (a probe map and arena were 270 B on their
+ * call chains, make cross). */
+bool occi_map_config_ok(const occ_map_config_t *cfg);
+
 #endif /* OCC_TREE_INTERNAL_H_INCLUDED */

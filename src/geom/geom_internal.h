@@ -16,6 +16,18 @@
 #include <string.h>
 #include "occmap/occmap.h"
 
+/* Keep a function out of line: a big frame that is not on every path (an exact volume test, a
+ * camera set-up) then stays off the stack of its caller's deepest call chain (make cross,
+ * tests/stack_budget.py: the chain is the sum of its frames). Or inline it always: a small
+ * dispatcher's own frame then merges into its caller's. */
+#if defined(__GNUC__)
+#define OCC_NOINLINE __attribute__((noinline))
+#define OCC_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define OCC_NOINLINE
+#define OCC_ALWAYS_INLINE inline
+#endif
+
 #if OCC_RAY_DOUBLE
 typedef double occ_real_t;
 #define OCC_REAL_MAX DBL_MAX

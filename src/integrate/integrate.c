@@ -480,10 +480,12 @@ static uint8_t *align8(void *const p)
 }
 
 /* The scan's sorted, collapsed codes; FAST_DISCRETE's coarse pass (d > 0); then one coherent
- * batch update in Morton order (all or nothing, except in automatic mode). */
-static occ_err_t collapse_and_apply(occ_ictx_t *const x, const occ_insert_params_t *const params,
-                                    const occ_vec3_t *const origin, const bool dense,
-                                    occ_bitset_t *const bs, occ_bitset_t *const cbs)
+ * batch update in Morton order (all or nothing, except in automatic mode). Out of line: inlined,
+ * its locals stayed in occ_map_insert_rays' frame under the ray traversal too (make cross). */
+OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
+                                                 const occ_insert_params_t *const params,
+                                                 const occ_vec3_t *const origin, const bool dense,
+                                                 occ_bitset_t *const bs, occ_bitset_t *const cbs)
 {
     occ_insert_result_t *const r = x->r;
     occ_code_t *codes, *spare; /* spare: free scratch after the fine codes, for the coarse ones */

@@ -89,9 +89,12 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
 }
 
 /* Group the whole free nodes by level into the free gap between the two output ends (each
- * group stays in walk order: sorted). Returns the group array, or NULL when the gap is short. */
-static occ_code_t *group_nodes(occ_proj_t *x, size_t start[OCC_MAX_DEPTH + 2u])
+ * group stays in walk order: sorted; group l from x->start[l]). Returns the group array, or
+ * NULL when the gap is short. Out of line: its fill counters stay off the stack of apply's
+ * tree update (make cross). */
+OCC_NOINLINE static occ_code_t *group_nodes(occ_proj_t *x)
 {
+    size_t *const start = x->start;
     if (x->cap - x->nh - x->nv - x->nn < x->nn) {
         return NULL;
     }
@@ -111,8 +114,9 @@ static occ_code_t *group_nodes(occ_proj_t *x, size_t start[OCC_MAX_DEPTH + 2u])
 }
 
 /* The pool check for every write of the call (bounds as if no node existed), then the writes. */
-static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OCC_MAX_DEPTH + 2u])
+static occ_err_t apply(occ_proj_t *x, const occ_code_t *g)
 {
+    const size_t *const start = x->start;
     occ_map_t *const m = x->map;
     const unsigned depth = m->cfg.depth_levels;
     uint64_t inner = 0, leaf = 0, i, f;
@@ -195,8 +199,7 @@ static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
     if (hits_fit) {
         occi_proj_walk(x);
     }
-    size_t start[OCC_MAX_DEPTH + 2u];
-    const occ_code_t *const g = !hits_fit || x->overflow ? NULL : group_nodes(x, start);
+    const occ_code_t *const g = !hits_fit || x->overflow ? NULL : group_nodes(x);
     const size_t slots = x->nh + x->nv + 2u * x->nn;
     x->r->insert.scratch_used += 8u * (slots > x->hwm ? slots : x->hwm);
     if (g == NULL) {
@@ -204,48 +207,61 @@ static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
     }
     x->nv = occi_proj_drop_hits(x->out + x->nh, x->nv, x->out, x->nh);
     count_output(x);
-    return apply(x, g, start);
+    return apply(x, g);
 }
 
+/* The camera's voxel is in the map (occ_map_insert_projective refuses it otherwise, before it
+ * needs any scratch). Out of line: its ray geometry is not needed again until the context
+ * holds its own copy. */
+OCC_NOINLINE static bool camera_in_map(const occ_map_t *map, const occ_proj_camera_t *camera,
+                                       occ_raygeo_t *g)
+{
+    occi_raygeo_init(g, map);
+    const float t[3] = {camera->t.x, camera->t.y, camera->t.z};
+    uint32_t kt[3];
+    return occi_raygeo_key(g, t, kt);
+}
+
+/* The counters and the context live in the scratch (x->res, x->start): off the stack of the
+ * tree update, the deepest chain of every integration (make cross). */
 occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *image,
                                     const occ_proj_camera_t *camera, void *scratch,
                                     const size_t scratch_bytes, occ_proj_result_t *out)
 {
-    occ_proj_result_t res;
-    memset(&res, 0, sizeof res);
     if (out != NULL) {
-        *out = res;
+        memset(out, 0, sizeof *out);
     }
     if (map == NULL || image == NULL || camera == NULL || !image_ok(image) || !camera_ok(camera)) {
         return OCC_ERR_ARG;
     }
     occ_raygeo_t g;
-    occi_raygeo_init(&g, map);
-    const float t[3] = {camera->t.x, camera->t.y, camera->t.z};
-    uint32_t kt[3];
-    if (!occi_raygeo_key(&g, t, kt)) {
+    if (!camera_in_map(map, camera, &g)) {
         return OCC_ERR_RANGE;
     }
-    res.pixels = (size_t)image->width * image->height;
+    const size_t pixels = (size_t)image->width * image->height;
+    if (out != NULL) {
+        out->pixels = pixels;
+    }
     size_t used = 0;
     occ_proj_t *const x = context_in(scratch, scratch_bytes, &used);
-    occ_err_t e = OCC_ERR_SCRATCH;
-    if (x != NULL) {
-        x->map = map;
-        x->im = image;
-        x->cam = camera;
-        x->r = &res;
-        x->g = g;
-        x->max2 = camera->max_range_m * camera->max_range_m;
-        x->min2 = camera->min_range_m * camera->min_range_m;
-        x->far = 1024.0f * camera->max_range_m;
-        x->keep = 1.0f - camera->noise_rel;
-        x->m0 = 0.8660254f * map->cfg.resolution_m;
-        e = run(x, (unsigned char *)scratch + used, scratch_bytes - used);
-        res.insert.scratch_used += used;
+    if (x == NULL) {
+        return OCC_ERR_SCRATCH;
     }
+    x->map = map;
+    x->im = image;
+    x->cam = camera;
+    x->r = &x->res;
+    x->res.pixels = pixels;
+    x->g = g;
+    x->max2 = camera->max_range_m * camera->max_range_m;
+    x->min2 = camera->min_range_m * camera->min_range_m;
+    x->far = 1024.0f * camera->max_range_m;
+    x->keep = 1.0f - camera->noise_rel;
+    x->m0 = 0.8660254f * map->cfg.resolution_m;
+    const occ_err_t e = run(x, (unsigned char *)scratch + used, scratch_bytes - used);
+    x->res.insert.scratch_used += used;
     if (out != NULL) {
-        *out = res;
+        *out = x->res;
     }
     return e;
 }

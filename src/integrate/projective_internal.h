@@ -62,8 +62,10 @@ typedef struct {
     size_t cap, nh, nv, nn, hwm;
     size_t hit_cur;         /* the walk's cursor over the sorted hits */
     size_t per_level[OCC_MAX_DEPTH + 1u];
+    size_t start[OCC_MAX_DEPTH + 2u]; /* the free nodes grouped by level: group l from start[l] */
     bool overflow;
-    occ_proj_result_t *r;
+    occ_proj_result_t *r;   /* = &res */
+    occ_proj_result_t res;  /* the call's counters, copied out at the end */
     occ_proj_frame_t walk[OCC_MAX_DEPTH + 1u]; /* the walk's stack (the context is in scratch) */
 } occ_proj_t;
 

@@ -127,13 +127,6 @@ static occ_err_t parse_body(occ_cursor_t *const c, const parsed_t *const p, occ_
     return e;
 }
 
-static bool config_ok(const occ_map_config_t *const cfg)
-{
-    uint64_t scratch[16];
-    occ_map_t probe;
-    return occ_map_init(&probe, cfg, scratch, sizeof scratch) != OCC_ERR_ARG;
-}
-
 /* One full pass (header + body) over the bytes; map == NULL is the dry run. */
 static occ_err_t pass(const void *const buf, const size_t len, const occ_map_config_t *const base,
                       occ_map_t *const map, occ_io_info_t *const info, parsed_t *const p)
@@ -178,7 +171,7 @@ occ_err_t occ_io_probe(const void *const buf, const size_t len, const occ_map_co
     }
     info_reset(info);
     const occ_map_config_t base = base_cfg != NULL ? *base_cfg : occ_map_config_default();
-    if (buf == NULL || !config_ok(&base)) {
+    if (buf == NULL || !occi_map_config_ok(&base)) {
         info->error = "invalid argument";
         return OCC_ERR_ARG;
     }

@@ -77,10 +77,8 @@ occ_err_t occi_snap_header_parse(occ_cursor_t *const c, occ_snap_header_t *const
     cfg->occupied_min = occi_rd_f32(p + 40);
     h->inner_blocks = occi_rd_u32(p + 44);
     h->leaf_blocks = occi_rd_u32(p + 48);
-    /* Config validity (occ_map_init's rules) on a tiny scratch arena; no map is touched. */
-    uint64_t scratch[16];
-    occ_map_t probe;
-    if (occ_map_init(&probe, cfg, scratch, sizeof scratch) == OCC_ERR_ARG) {
+    /* Config validity: occ_map_init's rules. */
+    if (!occi_map_config_ok(cfg)) {
         return occ_cursor_fail(c, 13u, "invalid config (resolution, depth or sensor model)");
     }
     c->pos = OCC_SNAPSHOT_HEADER_BYTES;

@@ -8,54 +8,54 @@
  */
 #include "query_internal.h"
 
-/* The open blocks of walk_below, one per level below the start node (a frame's children's
- * level is implicit: one below the frame under it). Neither the key nor the level is kept per
- * frame: the frames are one path, whose key `path` holds; blocks and masks in two arrays pack
- * to 5 B a frame (not 20: the walk's stack is on every collision check's call chain). */
+/* walk_below's open blocks live in walk's blk[] (blk[L]: children block of the path node at level
+ * L), with masks[L] the children of blk[L] still to visit: the path above the start node and the
+ * one below it are one array, not two (the walk's stack is on every collision check's call
+ * chain). Neither the key nor the level is kept per frame: `path` holds the key bits. */
 
-static inline unsigned open_mask(const occ_map_t *m, const occ_volume_t *v, unsigned states,
-                                 uint32_t block, occ_key_t key, unsigned level)
+static OCC_ALWAYS_INLINE unsigned open_mask(const occ_map_t *m, const occ_volume_t *v,
+                                            unsigned states, uint32_t block, occ_key_t key,
+                                            unsigned level)
 {
     const unsigned pm = level == 0u ? occ_q_leaf_match(m, occ_leaf_at(m, block), states)
                                     : occ_q_open_inner(m, block, states);
-    return pm != 0u ? pm & occ_q_touch_mask(m, v, key, level) : 0u;
+    return pm != 0u ? occ_q_touch_mask(m, v, key, level, pm) : 0u;
 }
 
-/* Below a start node (first voxel `key`, children in `block` at `level`): the first child
- * voxel or uniform node that blocks and touches, into *out. */
-static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_key_t key,
-                       unsigned level, uint32_t block, occ_query_node_t *out)
+/* Below a start node at level `top` (first voxel `path`, children in blk[top]): the first child
+ * voxel or uniform node that blocks and touches, into *out. Writes blk[] and masks[] at levels
+ * <= top only: walk keeps the path above in them. */
+static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_key_t path,
+                       unsigned top, uint32_t *blk, uint8_t *masks, occ_query_node_t *out)
 {
-    uint32_t blocks[OCC_MAX_DEPTH];
-    uint8_t masks[OCC_MAX_DEPTH]; /* children still to visit: blocking and touching the volume */
-    occ_key_t path = key;         /* bits above each frame's level: the path down to it */
-    unsigned sp = 1;
-    blocks[0] = block;
-    masks[0] = (uint8_t)open_mask(m, v, states, block, key, level);
-    while (sp > 0u) {
-        const unsigned mk = masks[sp - 1u];
+    unsigned at = top; /* the node whose children are being visited */
+    masks[top] = (uint8_t)open_mask(m, v, states, blk[top], path, top - 1u);
+    for (;;) {
+        const unsigned mk = masks[at];
         if (mk == 0u) {
-            sp--;
+            if (at == top) {
+                return false;
+            }
+            at++;
             continue;
         }
         const unsigned slot = occ_first_slot(mk);
-        masks[sp - 1u] = (uint8_t)(mk & (mk - 1u));
-        const unsigned l = level - (sp - 1u);
+        masks[at] = (uint8_t)(mk & (mk - 1u));
+        const unsigned l = at - 1u;              /* the child's level */
         const uint32_t keep = ~((2u << l) - 1u); /* bits above level l */
         path.k[0] = (path.k[0] & keep) | ((slot & 1u) << l);
         path.k[1] = (path.k[1] & keep) | (((slot >> 1) & 1u) << l);
         path.k[2] = (path.k[2] & keep) | (((slot >> 2) & 1u) << l);
-        const occ_entry_t e = occ_entry_at(m, blocks[sp - 1u], l, slot);
+        const occ_entry_t e = occ_entry_at(m, blk[at], l, slot);
         if (e.child == OCC_NONE) { /* a voxel, or a uniform node: it blocks and touches */
             occi_q_fill_node(m, path, l, e.value, e.flags, true, out);
             return true;
         }
-        OCC_ASSERT(sp < OCC_MAX_DEPTH && l >= 1u);
-        blocks[sp] = e.child;
-        masks[sp] = (uint8_t)open_mask(m, v, states, e.child, path, l - 1u);
-        sp++;
+        OCC_ASSERT(l >= 1u);
+        blk[l] = e.child;
+        masks[l] = (uint8_t)open_mask(m, v, states, e.child, path, l - 1u);
+        at = l;
     }
-    return false;
 }
 
 /* The start cells (query.c) in Morton order, each reached from the root along the path of the
@@ -66,22 +66,25 @@ static bool walk_below(const occ_map_t *m, const occ_volume_t *v, unsigned state
 OCC_ANALYZER_UNINIT_OFF
 static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ_query_node_t *out)
 {
-    occ_key_t start[8];
-    unsigned lc;
-    const unsigned n = occi_q_start_cells(m, v, 0u, start, &lc);
+    occi_q_starts_t st;
+    occi_q_starts(m, v, 0u, &st);
+    const unsigned lc = st.level;
+    occ_key_t prev = st.first;
     const unsigned depth = m->cfg.depth_levels;
     uint32_t blk[OCC_MAX_DEPTH + 1u]; /* blk[L]: children block of the path node at level L */
+    uint8_t masks[OCC_MAX_DEPTH + 1u]; /* walk_below's children still to visit, per level */
     unsigned stopped = depth + 1u;     /* level where the previous descent ended */
-    for (unsigned t = 0; t < n; t++) {
-        const occ_key_t key = start[t];
+    for (unsigned t = 0; t < st.n; t++) {
+        const occ_key_t key = occi_q_start_key(&st, t);
         unsigned level = depth;
         uint32_t child = m->priv.root_child;
         occ_value_t val = m->priv.root_value;
         uint8_t flags = m->priv.root_flags;
         bool check = true;
         if (t > 0u) {
-            const uint32_t x = (key.k[0] ^ start[t - 1u].k[0]) | (key.k[1] ^ start[t - 1u].k[1]) |
-                               (key.k[2] ^ start[t - 1u].k[2]);
+            const uint32_t x = (key.k[0] ^ prev.k[0]) | (key.k[1] ^ prev.k[1]) |
+                               (key.k[2] ^ prev.k[2]);
+            prev = key;
             const unsigned hb = occ_bit_length32(x) - 1u; /* x != 0: distinct cells */
             if (hb < stopped) {
                 continue; /* inside the node the previous descent ended at: done with it */
@@ -116,7 +119,8 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
             occi_q_fill_node(m, nk, level, val, flags, true, out);
             return true;
         }
-        if (walk_below(m, v, states, nk, level - 1u, child, out)) {
+        blk[level] = child;
+        if (walk_below(m, v, states, nk, level, blk, masks, out)) {
             return true;
         }
     }

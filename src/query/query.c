@@ -27,15 +27,16 @@ static bool same_above(occ_key_t a, occ_key_t b, unsigned level)
            ((a.k[2] ^ b.k[2]) >> level) == 0u;
 }
 
-unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
-                            occ_key_t start[8], unsigned *level)
+void occi_q_starts(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                   occi_q_starts_t *s)
 {
     const unsigned depth = map->cfg.depth_levels;
-    *level = depth;
+    memset(s, 0, sizeof *s);
+    s->level = (uint8_t)depth;
     uint32_t lo[3];
     uint32_t hi[3];
     if (!occi_q_bounds_keys(map, vol, lo, hi)) {
-        return 0u; /* nothing of the map is near the volume */
+        return; /* nothing of the map is near the volume */
     }
     /* Smallest level whose cells are at least as wide as the key range: the range then spans
      * at most two cells per axis. */
@@ -45,52 +46,35 @@ unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsig
     }
     unsigned lc = occ_bit_length32(ext); /* 2^lc > ext */
     lc = lc < min_level ? min_level : lc; /* never start below the level nodes are reported at */
+    s->n = 1u;
     if (lc >= depth) {
-        start[0].k[0] = start[0].k[1] = start[0].k[2] = 0u;
-        return 1u;
+        return; /* the root */
     }
-    *level = lc;
+    s->level = (uint8_t)lc;
     /* The cells c0 or c0 + 1 per axis. In Morton order the axis whose +1 flips the highest bit
      * (z before y before x on ties) is the most significant, so count in that bit order. */
-    uint32_t c0[3];
-    unsigned ax[3];
+    unsigned rank[3] = {0u, 0u, 0u};
     unsigned na = 0;
     for (unsigned i = 0; i < 3u; i++) {
-        c0[i] = lo[i] >> lc;
-        if ((hi[i] >> lc) != c0[i]) {
-            ax[na++] = i;
+        const uint32_t c0 = lo[i] >> lc;
+        s->first.k[i] = c0 << lc;
+        if ((hi[i] >> lc) != c0) {
+            rank[na] = (occ_bit_length32(c0 ^ (c0 + 1u)) - 1u) * 3u + i;
+            s->ax[na++] = (uint8_t)i;
         }
-    }
-    unsigned rank[3] = {0u, 0u, 0u};
-    for (unsigned j = 0; j < na; j++) {
-        /* cppcheck-suppress uninitvar ; ax[0..na) were written by the loop above, j < na */
-        const uint32_t x = c0[ax[j]] ^ (c0[ax[j]] + 1u);
-        rank[j] = (occ_bit_length32(x) - 1u) * 3u + ax[j];
     }
     for (unsigned j = 1; j < na; j++) { /* most significant first */
         for (unsigned q = j; q > 0u && rank[q] > rank[q - 1u]; q--) {
             const unsigned tr = rank[q];
-            const unsigned ta = ax[q];
+            const uint8_t ta = s->ax[q];
             rank[q] = rank[q - 1u];
-            ax[q] = ax[q - 1u];
+            s->ax[q] = s->ax[q - 1u];
             rank[q - 1u] = tr;
-            ax[q - 1u] = ta;
+            s->ax[q - 1u] = ta;
         }
     }
-    /* Doubling from the least significant axis: cell t has bit (na - 1 - j) of t set when it
-     * is one further on axis ax[j], so the list comes out in Morton order. */
-    start[0].k[0] = c0[0] << lc;
-    start[0].k[1] = c0[1] << lc;
-    start[0].k[2] = c0[2] << lc;
-    unsigned n = 1u;
-    for (unsigned j = na; j-- > 0u;) {
-        for (unsigned t = 0; t < n; t++) {
-            start[n + t] = start[t];
-            start[n + t].k[ax[j]] += (uint32_t)1 << lc;
-        }
-        n *= 2u;
-    }
-    return n;
+    s->na = (uint8_t)na;
+    s->n = (uint8_t)(1u << na);
 }
 
 occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_volume_t *vol,
@@ -106,7 +90,6 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
     if (pred.states == 0u) {
         pred.states = (uint8_t)OCC_PRED_ANY;
     }
-    const unsigned depth = map->cfg.depth_levels;
     it->map = map;
     it->vol = vol;
     it->pred = pred;
@@ -117,9 +100,13 @@ occ_err_t occ_query_begin(occ_query_iter_t *it, const occ_map_t *map, const occ_
     it->path.k[0] = it->path.k[1] = it->path.k[2] = 0u;
     it->istart = 0;
     it->gen = map->write_gen;
-    unsigned lc = depth;
-    it->nstart = (uint8_t)occi_q_start_cells(map, vol, pred.min_level, it->start, &lc);
-    it->start_level = (uint8_t)lc;
+    occi_q_starts_t st;
+    occi_q_starts(map, vol, pred.min_level, &st);
+    for (unsigned t = 0; t < st.n; t++) {
+        it->start[t] = occi_q_start_key(&st, t);
+    }
+    it->nstart = st.n;
+    it->start_level = st.level;
     return OCC_OK;
 }
 
@@ -159,7 +146,7 @@ static inline void push(occ_query_iter_t *it, occ_key_t pkey, unsigned level, ui
     }
     it->block[i] = block;
     if (pm != 0u) {
-        pm &= occ_q_touch_mask(m, it->vol, pkey, level);
+        pm = occ_q_touch_mask(m, it->vol, pkey, level, pm);
     }
     it->mask[i] = (uint8_t)pm;
     it->sp = (uint8_t)(i + 1u);

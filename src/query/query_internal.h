@@ -110,38 +110,9 @@ static inline unsigned occ_q_leaf_match(const occ_map_t *m, const occ_leaf_block
 
 /* max(d, 0) for finite d, without a branch: compilers turn `d > 0 ? d : 0` into a jump here,
  * and the sign of a neighbour's distance is a coin toss for the predictor. */
-static inline float occ_q_pos(float d)
+static OCC_ALWAYS_INLINE float occ_q_pos(float d)
 {
     return (d + fabsf(d)) * 0.5f;
-}
-
-/* Which children (half edge h) of a node centred at pc touch a sphere / a box: per axis the
- * squared distance to the lower and upper half (or their overlap), combined over the 8 slots. */
-static inline unsigned occ_q_sphere_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
-{
-    const occ_vec3_t c = v->u.sphere.c;
-    const float r2 = v->u.sphere.r * v->u.sphere.r;
-    float d;
-    d = occ_q_pos(fabsf(c.x - (pc.x - h)) - h);
-    const float x0 = d * d;
-    d = occ_q_pos(fabsf(c.x - (pc.x + h)) - h);
-    const float x1 = d * d;
-    d = occ_q_pos(fabsf(c.y - (pc.y - h)) - h);
-    const float y0 = d * d;
-    d = occ_q_pos(fabsf(c.y - (pc.y + h)) - h);
-    const float y1 = d * d;
-    d = occ_q_pos(fabsf(c.z - (pc.z - h)) - h);
-    const float z0 = d * d;
-    d = occ_q_pos(fabsf(c.z - (pc.z + h)) - h);
-    const float z1 = d * d;
-    const float xy00 = x0 + y0;
-    const float xy10 = x1 + y0;
-    const float xy01 = x0 + y1;
-    const float xy11 = x1 + y1;
-    return (xy00 + z0 <= r2 ? 0x01u : 0u) | (xy10 + z0 <= r2 ? 0x02u : 0u) |
-           (xy01 + z0 <= r2 ? 0x04u : 0u) | (xy11 + z0 <= r2 ? 0x08u : 0u) |
-           (xy00 + z1 <= r2 ? 0x10u : 0u) | (xy10 + z1 <= r2 ? 0x20u : 0u) |
-           (xy01 + z1 <= r2 ? 0x40u : 0u) | (xy11 + z1 <= r2 ? 0x80u : 0u);
 }
 
 /* occ_q_inner_match for a block a walk opens: its child indices are asked for at once, so that on
@@ -155,52 +126,62 @@ static inline unsigned occ_q_open_inner(const occ_map_t *m, uint32_t block, unsi
     return occ_q_inner_match(b, states);
 }
 
-/* 1 when the closed intervals [a0, a1] and [b0, b1] overlap; & rather than && so that it
- * compiles without a jump (see occ_q_pos). */
-static inline unsigned occ_q_overlap(float a0, float a1, float b0, float b1)
-{
-    return (unsigned)(a0 <= b1) & (unsigned)(a1 >= b0);
-}
-
-static inline unsigned occ_q_aabb_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
-{
-    const float e = 2.0f * h;
-    const unsigned xm = 0x55u * occ_q_overlap(pc.x - e, pc.x, v->bmin.x, v->bmax.x) |
-                        0xAAu * occ_q_overlap(pc.x, pc.x + e, v->bmin.x, v->bmax.x);
-    const unsigned ym = 0x33u * occ_q_overlap(pc.y - e, pc.y, v->bmin.y, v->bmax.y) |
-                        0xCCu * occ_q_overlap(pc.y, pc.y + e, v->bmin.y, v->bmax.y);
-    const unsigned zm = 0x0Fu * occ_q_overlap(pc.z - e, pc.z, v->bmin.z, v->bmax.z) |
-                        0xF0u * occ_q_overlap(pc.z, pc.z + e, v->bmin.z, v->bmax.z);
-    return xm & ym & zm;
-}
-
 /* volume.c: key range [lo, hi] per axis of the voxels that can touch the volume's closed bounds
  * (one voxel of slack for faces on a border); false when the bounds miss the map. */
 bool occi_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3], uint32_t hi[3]);
-/* volume.c: occ_q_touch_mask for the other kinds, child by child with the exact cube tests. */
+/* volume.c: which of the 8 children (at `level`) of the node with first voxel `pkey` touch a
+ * sphere / a box volume: all 8 at once in closed form. */
+unsigned occi_q_touch_mask_sphere(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                  unsigned level);
+unsigned occi_q_touch_mask_aabb(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                unsigned level);
+/* volume.c: the same for the other kinds, child by child (those in `want` only) with the exact
+ * cube tests. */
 unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                                 unsigned level);
+                                 unsigned level, unsigned want);
 
-/* Which of the 8 children (at `level`) of the node with first voxel `pkey` touch the volume
- * (bit s for child slot s; exact, as occ_volume_hits_box). Spheres and boxes inline: they are
- * the common collision volumes. */
-static inline unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                                        unsigned level)
+/* Which of the children in `want` (at `level`, bit s for child slot s) of the node with first
+ * voxel `pkey` touch the volume (exact, as occ_volume_hits_box). The other kinds test only the
+ * wanted children: their exact tests cost more than the mask that picks them. The dispatch is
+ * inline and the tests out of line, so that a walk's deepest call chain holds only one of them
+ * (make cross; on the host the sphere and box masks were already a call). */
+static OCC_ALWAYS_INLINE unsigned occ_q_touch_mask(const occ_map_t *m, const occ_volume_t *v,
+                                                   occ_key_t pkey, unsigned level, unsigned want)
 {
     if (v->kind == OCC_VOL_SPHERE) {
-        return occ_q_sphere_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
+        return want & occi_q_touch_mask_sphere(m, v, pkey, level);
     }
     if (v->kind == OCC_VOL_AABB) {
-        return occ_q_aabb_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
+        return want & occi_q_touch_mask_aabb(m, v, pkey, level);
     }
-    return occi_q_touch_mask_cubes(m, v, pkey, level);
+    return occi_q_touch_mask_cubes(m, v, pkey, level, want);
 }
 
-/* query.c: the cells a walk over the volume starts from: at most 8, at the smallest level
- * (>= min_level) whose cells are as wide as the volume's key range, in Morton order; *level gets
- * that level (depth_levels with the root as the one start). 0 when the volume misses the map. */
-unsigned occi_q_start_cells(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
-                            occ_key_t start[8], unsigned *level);
+/* The cells a walk over a volume starts from: at most 8, at the smallest level (>= min_level)
+ * whose cells are as wide as the volume's key range, in Morton order. Kept as the first cell
+ * and the axes the others step along (20 B, not 96: the collision walk holds it on every
+ * check's call chain): cell t is one cell further on axis ax[j] when bit (na - 1 - j) of t is
+ * set. n = 0 when the volume misses the map; level = depth_levels with the root as the one
+ * start. */
+typedef struct {
+    occ_key_t first;
+    uint8_t n, level, na;
+    uint8_t ax[3];
+} occi_q_starts_t;
+
+/* query.c: the start cells of `vol`. */
+void occi_q_starts(const occ_map_t *map, const occ_volume_t *vol, unsigned min_level,
+                   occi_q_starts_t *s);
+
+/* Start cell t < s->n. */
+static inline occ_key_t occi_q_start_key(const occi_q_starts_t *s, unsigned t)
+{
+    occ_key_t k = s->first;
+    for (unsigned j = 0; j < s->na; j++) {
+        k.k[s->ax[j]] += ((t >> (s->na - 1u - j)) & 1u) << s->level;
+    }
+    return k;
+}
 
 /* collide.c: the answer of a collision check that has not decided yet or failed: not safe,
  * not outside, an unobserved UNKNOWN node. Every collision entry point starts with it. */

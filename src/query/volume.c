@@ -197,7 +197,9 @@ occ_err_t occ_volume_frustum(occ_volume_t *v, occ_vec3_t origin, const occ_vec3_
 }
 
 /* ---- exact node tests ------------------------------------------------------------------------- */
-static inline float point_box_d2(occ_vec3_t p, occ_vec3_t c, float h)
+/* Always inline: called, its vector arguments went through the stack under the capsule test,
+ * the deepest of the walks' exact tests (make cross). */
+static OCC_ALWAYS_INLINE float point_box_d2(occ_vec3_t p, occ_vec3_t c, float h)
 {
     const float dx = occ_q_pos(fabsf(p.x - c.x) - h);
     const float dy = occ_q_pos(fabsf(p.y - c.y) - h);
@@ -288,7 +290,7 @@ static float point_segment_d2(occ_vec3_t p, occ_vec3_t a, occ_vec3_t b)
     return vdot(q, q);
 }
 
-static bool segment_hits_box(occ_vec3_t a, occ_vec3_t b, occ_vec3_t c, float h)
+OCC_NOINLINE static bool segment_hits_box(occ_vec3_t a, occ_vec3_t b, occ_vec3_t c, float h)
 {
     float tmin = 0.0f;
     float tmax = 1.0f;
@@ -317,7 +319,7 @@ static bool segment_hits_box(occ_vec3_t a, occ_vec3_t b, occ_vec3_t c, float h)
     return true;
 }
 
-static bool obb_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
+OCC_NOINLINE static bool obb_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
 {
     const occ_vec3_t d = vsub(c, v->u.obb.c);
     const occ_vec3_t *ax = v->u.obb.axis;
@@ -345,7 +347,14 @@ static bool obb_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
     return true;
 }
 
-static bool frustum_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
+/* Edge direction k of a frustum: 0..3 its side edges (near to far corner), 4 left, 5 up. */
+static occ_vec3_t frustum_edge(const occ_volume_t *v, unsigned k)
+{
+    return k < 4u ? vsub(v->u.frustum.corner[4u + k], v->u.frustum.corner[k])
+                  : (k == 4u ? v->u.frustum.left : v->u.frustum.up);
+}
+
+OCC_NOINLINE static bool frustum_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
 {
     for (unsigned i = 0; i < 6u; i++) {
         const occ_vec3_t n = v->u.frustum.n[i];
@@ -353,19 +362,15 @@ static bool frustum_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
             return false;
         }
     }
-    /* Edge x edge axes: box axes x frustum edge directions (4 side edges, left, up). */
-    occ_vec3_t e[6];
-    for (unsigned k = 0; k < 4u; k++) {
-        e[k] = vsub(v->u.frustum.corner[4u + k], v->u.frustum.corner[k]);
-    }
-    e[4] = v->u.frustum.left;
-    e[5] = v->u.frustum.up;
+    /* Edge x edge axes: box axes x frustum edge directions (4 side edges, left, up), each
+     * edge worked out where it is used (an array of the 6 would sit on the walks' stack). */
     for (unsigned i = 0; i < 3u; i++) {
         const occ_vec3_t w = v3(i == 0u ? 1.0f : 0.0f, i == 1u ? 1.0f : 0.0f, i == 2u ? 1.0f : 0.0f);
         for (unsigned k = 0; k < 6u; k++) {
-            const occ_vec3_t l = vcross(w, e[k]);
+            const occ_vec3_t e = frustum_edge(v, k);
+            const occ_vec3_t l = vcross(w, e);
             const float ll = vdot(l, l);
-            if (ll < 1e-10f * maxf(vdot(e[k], e[k]), 1.0f)) {
+            if (ll < 1e-10f * maxf(vdot(e, e), 1.0f)) {
                 continue;
             }
             float lo = vdot(l, v->u.frustum.corner[0]);
@@ -385,7 +390,16 @@ static bool frustum_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
     return true;
 }
 
-static inline bool hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
+OCC_NOINLINE static bool capsule_hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
+{
+    return segment_box_d2(v->u.capsule.a, v->u.capsule.b, c, h) <= v->u.capsule.r * v->u.capsule.r;
+}
+
+/* The bounds first (most cubes fail there), then the kind's exact test. Those of the obb,
+ * capsule, segment and frustum are out of line: inlined, all their frames together sat under
+ * every walk that calls this (the collision checks, the iterator: make cross), where only the
+ * largest of them is ever in use. */
+static OCC_ALWAYS_INLINE bool hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
 {
     if (c.x - h > v->bmax.x || c.x + h < v->bmin.x || c.y - h > v->bmax.y ||
         c.y + h < v->bmin.y || c.z - h > v->bmax.z || c.z + h < v->bmin.z) {
@@ -399,8 +413,7 @@ static inline bool hits_box(const occ_volume_t *v, occ_vec3_t c, float h)
     case OCC_VOL_OBB:
         return obb_hits_box(v, c, h);
     case OCC_VOL_CAPSULE:
-        return segment_box_d2(v->u.capsule.a, v->u.capsule.b, c, h) <=
-               v->u.capsule.r * v->u.capsule.r;
+        return capsule_hits_box(v, c, h);
     case OCC_VOL_SEGMENT:
         return segment_hits_box(v->u.capsule.a, v->u.capsule.b, c, h);
     case OCC_VOL_FRUSTUM:
@@ -487,13 +500,74 @@ bool occi_q_bounds_keys(const occ_map_t *m, const occ_volume_t *v, uint32_t lo[3
     return true;
 }
 
+/* Which children (half edge h) of a node centred at pc touch a sphere / a box: per axis the
+ * squared distance to the lower and upper half (or their overlap), combined over the 8 slots. */
+static inline unsigned sphere_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
+{
+    const occ_vec3_t c = v->u.sphere.c;
+    const float r2 = v->u.sphere.r * v->u.sphere.r;
+    float d;
+    d = occ_q_pos(fabsf(c.x - (pc.x - h)) - h);
+    const float x0 = d * d;
+    d = occ_q_pos(fabsf(c.x - (pc.x + h)) - h);
+    const float x1 = d * d;
+    d = occ_q_pos(fabsf(c.y - (pc.y - h)) - h);
+    const float y0 = d * d;
+    d = occ_q_pos(fabsf(c.y - (pc.y + h)) - h);
+    const float y1 = d * d;
+    d = occ_q_pos(fabsf(c.z - (pc.z - h)) - h);
+    const float z0 = d * d;
+    d = occ_q_pos(fabsf(c.z - (pc.z + h)) - h);
+    const float z1 = d * d;
+    const float xy00 = x0 + y0;
+    const float xy10 = x1 + y0;
+    const float xy01 = x0 + y1;
+    const float xy11 = x1 + y1;
+    return (xy00 + z0 <= r2 ? 0x01u : 0u) | (xy10 + z0 <= r2 ? 0x02u : 0u) |
+           (xy01 + z0 <= r2 ? 0x04u : 0u) | (xy11 + z0 <= r2 ? 0x08u : 0u) |
+           (xy00 + z1 <= r2 ? 0x10u : 0u) | (xy10 + z1 <= r2 ? 0x20u : 0u) |
+           (xy01 + z1 <= r2 ? 0x40u : 0u) | (xy11 + z1 <= r2 ? 0x80u : 0u);
+}
+
+/* 1 when the closed intervals [a0, a1] and [b0, b1] overlap; & rather than && so that it
+ * compiles without a jump (see occ_q_pos). */
+static inline unsigned overlap(float a0, float a1, float b0, float b1)
+{
+    return (unsigned)(a0 <= b1) & (unsigned)(a1 >= b0);
+}
+
+static inline unsigned aabb_touch(const occ_volume_t *v, occ_vec3_t pc, float h)
+{
+    const float e = 2.0f * h;
+    const unsigned xm = 0x55u * overlap(pc.x - e, pc.x, v->bmin.x, v->bmax.x) |
+                        0xAAu * overlap(pc.x, pc.x + e, v->bmin.x, v->bmax.x);
+    const unsigned ym = 0x33u * overlap(pc.y - e, pc.y, v->bmin.y, v->bmax.y) |
+                        0xCCu * overlap(pc.y, pc.y + e, v->bmin.y, v->bmax.y);
+    const unsigned zm = 0x0Fu * overlap(pc.z - e, pc.z, v->bmin.z, v->bmax.z) |
+                        0xF0u * overlap(pc.z, pc.z + e, v->bmin.z, v->bmax.z);
+    return xm & ym & zm;
+}
+
+unsigned occi_q_touch_mask_sphere(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                  unsigned level)
+{
+    return sphere_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
+}
+
+unsigned occi_q_touch_mask_aabb(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
+                                unsigned level)
+{
+    return aabb_touch(v, occ_geom_center(m, pkey, level + 1u), occ_q_half(m, level));
+}
+
 unsigned occi_q_touch_mask_cubes(const occ_map_t *m, const occ_volume_t *v, occ_key_t pkey,
-                                 unsigned level)
+                                 unsigned level, unsigned want)
 {
     const float h = occ_q_half(m, level);
     const occ_vec3_t pc = occ_geom_center(m, pkey, level + 1u);
     unsigned mask = 0u;
-    for (unsigned s = 0; s < 8u; s++) {
+    for (unsigned rest = want; rest != 0u; rest &= rest - 1u) {
+        const unsigned s = occ_first_slot(rest);
         occ_vec3_t c;
         c.x = pc.x + ((s & 1u) ? h : -h);
         c.y = pc.y + ((s & 2u) ? h : -h);

@@ -148,10 +148,38 @@ static bool back_project(const occ_depth_image_t *im, const occ_depth_params_t *
     return out->points <= buf->cap;
 }
 
+/* The points of the step grid in the scratch (from its first 4-aligned byte: *pts), *n of them
+ * in its first *used bytes; the counters into out (if non-NULL). OCC_ERR_SCRATCH when they do
+ * not fit. Out of line: its counters and loop state are not on the stack under the integration
+ * (make cross). */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static occ_err_t project_points(const occ_depth_image_t *im, const occ_depth_params_t *dp,
+                                const occ_pose_t *pose, void *scratch, const size_t scratch_bytes,
+                                occ_vec3_t **pts, size_t *n, size_t *used, occ_depth_result_t *out)
+{
+    occ_depth_result_t r;
+    memset(&r, 0, sizeof r);
+    const point_buf_t buf = point_buf(scratch, scratch_bytes);
+    const bool fit = back_project(im, dp, pose, &buf, &r);
+    if (fit) {
+        r.scratch_points = buf.skip + r.points * sizeof(occ_vec3_t);
+    }
+    if (out != NULL) {
+        *out = r;
+    }
+    *pts = buf.pts;
+    *n = r.points;
+    *used = r.scratch_points;
+    return fit ? OCC_OK : OCC_ERR_SCRATCH;
+}
+
 /* OCC_INSERT_PROJECTIVE: the image as the projective integrator's view of the step grid (pixel
  * (i, j) is the image's (i step, j step); intrinsics divided by the step) and the pose as a
- * rotation matrix. Kept out of line: inlined, its camera and result stayed on the stack under
- * the ray-cast methods' whole integration too (make cross). */
+ * rotation matrix; the counters into out (if non-NULL). Kept out of line: inlined, its camera
+ * and result stayed on the stack under the ray-cast methods' whole integration too (make
+ * cross). */
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
@@ -188,25 +216,27 @@ static occ_err_t insert_projective(occ_map_t *map, const occ_depth_image_t *im,
     cam.noise_rel = insert->proj_noise_rel;
     occ_proj_result_t pr;
     const occ_err_t e = occ_map_insert_projective(map, &pim, &cam, scratch, scratch_bytes, &pr);
-    r->pixels_sampled = pr.pixels;
-    r->pixels_no_reading = pr.pixels_no_reading;
-    r->pixels_too_close = pr.pixels_too_close;
-    r->pixels_beyond_max = pr.pixels_beyond_max;
-    r->points = pr.pixels - pr.pixels_no_reading - pr.pixels_too_close;
-    r->insert = pr.insert;
+    if (r != NULL) {
+        r->pixels_sampled = pr.pixels;
+        r->pixels_no_reading = pr.pixels_no_reading;
+        r->pixels_too_close = pr.pixels_too_close;
+        r->pixels_beyond_max = pr.pixels_beyond_max;
+        r->points = pr.pixels - pr.pixels_no_reading - pr.pixels_too_close;
+        r->insert = pr.insert;
+    }
     return e;
 }
 
+/* Nothing but the insert parameters stays in this frame: it sits on top of the integration,
+ * the deepest call chain of the library (make cross, the 1.5 KB class). */
 occ_err_t occ_map_insert_depth(occ_map_t *map, const occ_depth_image_t *image,
                                const occ_depth_params_t *depth,
                                const occ_pose_t *map_from_camera,
                                const occ_insert_params_t *insert, void *scratch,
                                const size_t scratch_bytes, occ_depth_result_t *out)
 {
-    occ_depth_result_t r;
-    memset(&r, 0, sizeof r);
     if (out != NULL) {
-        *out = r;
+        memset(out, 0, sizeof *out);
     }
     if (map == NULL || image == NULL || depth == NULL || map_from_camera == NULL ||
         insert == NULL || !image_ok(image) || !params_ok(depth) ||
@@ -214,29 +244,20 @@ occ_err_t occ_map_insert_depth(occ_map_t *map, const occ_depth_image_t *image,
         return OCC_ERR_ARG;
     }
     if (insert->method == OCC_INSERT_PROJECTIVE) {
-        const occ_err_t e =
-            insert_projective(map, image, depth, map_from_camera, insert, scratch, scratch_bytes, &r);
-        if (out != NULL) {
-            *out = r;
-        }
+        return insert_projective(map, image, depth, map_from_camera, insert, scratch, scratch_bytes,
+                                 out);
+    }
+    occ_vec3_t *pts = NULL;
+    size_t n = 0, used = 0;
+    const occ_err_t e = project_points(image, depth, map_from_camera, scratch, scratch_bytes, &pts,
+                                       &n, &used, out);
+    if (e != OCC_OK) {
         return e;
     }
-    const point_buf_t buf = point_buf(scratch, scratch_bytes);
-    if (!back_project(image, depth, map_from_camera, &buf, &r)) {
-        if (out != NULL) {
-            *out = r;
-        }
-        return OCC_ERR_SCRATCH;
-    }
-    r.scratch_points = buf.skip + r.points * sizeof(occ_vec3_t);
     occ_insert_params_t p = *insert;
     p.max_range_m = depth->max_range_m;
-    unsigned char *const rest =
-        scratch != NULL ? (unsigned char *)scratch + r.scratch_points : NULL;
-    const occ_err_t e = occ_map_insert_cloud(map, &map_from_camera->p, buf.pts, r.points, &p,
-                                             rest, scratch_bytes - r.scratch_points, &r.insert);
-    if (out != NULL) {
-        *out = r;
-    }
-    return e;
+    unsigned char *const rest = scratch != NULL ? (unsigned char *)scratch + used : NULL;
+    /* occ_map_insert_cloud without its frame: the same call */
+    return occ_map_insert_rays(map, &map_from_camera->p, pts, NULL, n, &p, rest,
+                               scratch_bytes - used, out != NULL ? &out->insert : NULL);
 }

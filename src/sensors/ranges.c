@@ -128,16 +128,21 @@ static bool count_rays(const occ_range_beam_t *const beams, const size_t n, size
     return true;
 }
 
-/* Each beam's rays as map-frame end points and hit flags; the beams_ counters. Kept out of
- * line: inlined, its cone directions and sin/cos frame stayed on the stack under the whole
- * integration (occ_map_insert_ranges 1,736 -> 1,4xx B on Cortex-M4, make cross). */
+/* Each beam's rays as map-frame end points and hit flags; the rays and beams_ counters into
+ * out (if non-NULL). Kept out of line: inlined, its cone directions and sin/cos frame stayed on
+ * the stack under the whole integration (occ_map_insert_ranges 1,736 -> 1,4xx B on Cortex-M4,
+ * make cross), and so does its result when the caller passes none. */
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
 static void build_rays(const occ_pose_t *const pose, const occ_range_beam_t *const beams,
                        const size_t n, occ_vec3_t *const ends, bool *const hit,
-                       occ_ranges_result_t *const r)
+                       occ_ranges_result_t *const out)
 {
+    occ_ranges_result_t local;
+    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
+    occ_ranges_result_t *const r = out != NULL ? out : &local;
+    memset(r, 0, sizeof *r);
     size_t w = 0;
     for (size_t i = 0; i < n; i++) {
         const occ_range_beam_t *const b = &beams[i];
@@ -184,10 +189,9 @@ occ_err_t occ_map_insert_ranges(occ_map_t *const map, const occ_pose_t *const ma
                                 const occ_insert_params_t *const params, void *const scratch,
                                 const size_t scratch_bytes, occ_ranges_result_t *const out)
 {
-    occ_ranges_result_t local;
-    /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
-    occ_ranges_result_t *const r = out != NULL ? out : &local;
-    memset(r, 0, sizeof *r);
+    if (out != NULL) {
+        memset(out, 0, sizeof *out);
+    }
     size_t rays = 0;
     float max_m = 0.0f;
     if (map == NULL || params == NULL || (beams == NULL && n_beams > 0u) ||
@@ -208,8 +212,8 @@ occ_err_t occ_map_insert_ranges(occ_map_t *const map, const occ_pose_t *const ma
     }
     occ_vec3_t *const ends = (occ_vec3_t *)(void *)(base + pad);
     bool *const hit = (bool *)(void *)(base + pad + rays * sizeof(occ_vec3_t));
-    build_rays(map_from_sensor, beams, n_beams, ends, hit, r);
+    build_rays(map_from_sensor, beams, n_beams, ends, hit, out);
     uint8_t *const rest = base + pad + own;
     return occ_map_insert_rays(map, &map_from_sensor->p, ends, hit, rays, params, rest,
-                               scratch_bytes - pad - own, &r->insert);
+                               scratch_bytes - pad - own, out != NULL ? &out->insert : NULL);
 }
