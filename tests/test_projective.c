@@ -213,11 +213,12 @@ static void test_end_points_never_free(void **state)
                                       2u, 1.0f / 5000.0f};
         const occ_proj_camera_t k = camera_of(&f[i].pose, cam.fx, cam.fy, cam.cx, cam.cy, 0.3f,
                                               5.0f);
-        occ_vec3_t *pts = NULL;
-        const size_t np = projref_end_points(&pim, &k, &pts);
+        occ_key_t *pts = NULL;
+        const size_t np = projref_end_keys(&map_a, &pim, &k, &pts);
         size_t bad = 0;
         for (size_t p = 0; p < np; p++) {
-            bad += occ_map_state_at(&map_a, pts[p]) != OCC_STATE_OCCUPIED ? 1u : 0u;
+            const occ_vec3_t c = occ_map_key_center(&map_a, pts[p], 0u);
+            bad += occ_map_state_at(&map_a, c) != OCC_STATE_OCCUPIED ? 1u : 0u;
         }
         free(pts);
         printf("  frame %zu: %zu end points, %zu not occupied, %zu free voxels, %zu whole nodes\n",

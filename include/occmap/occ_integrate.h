@@ -257,9 +257,10 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * The rule, per voxel (exact; the walk only decides whole nodes where every voxel below would
  * get the same answer, so the result equals applying it to every voxel of the map):
  *  - pixel depth d (metres along z): U16 raw * depth_scale_m (raw 0: no reading); F32 as given
- *    (0, NaN, negative, -Inf: no reading; +Inf or > 1024 max_range_m: d = 2 max_range_m). A
- *    pixel (i, j) back-projects to c = ((i - cx) * d / fx, (j - cy) * d / fy, d) (float, left to
- *    right); |c|^2 (float) not finite: no reading; |c| < min_range_m: no reading (blind zone);
+ *    (0, NaN, negative, -Inf: no reading; +Inf or > 1024 max_range_m: d = 2 max_range_m). Pixel
+ *    (i, j) has the ray a_i = (i - cx) / fx, b_j = (j - cy) / fy and the camera-frame point
+ *    c = (a_i d, b_j d, d) with |c|^2 = (d d) (a_i a_i + (b_j b_j + 1)) (float, as written);
+ *    |c|^2 not finite: no reading; |c|^2 < min_range_m^2: no reading (blind zone);
  *  - the voxel's centre C (OctoMap's float centre per axis) goes to the camera frame:
  *    w = C - t, q_k = r[0][k] w_0 + r[1][k] w_1 + r[2][k] w_2 (float, left to right), and its
  *    pixel is i = floor(fx * (q_0 / q_2) + cx + 0.5), j = floor(fy * (q_1 / q_2) + cy + 0.5);
@@ -268,8 +269,15 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  *    q_0^2 + q_1^2 + q_2^2 <= max_range_m^2 (float): strictly in front of the surface by the
  *    margin m(d) = m0 + noise_rel * d, m0 = 0.8660254f * cfg.resolution_m (half the voxel diagonal: a pixel's own
  *    end voxel is never free by that pixel), noise_rel the caller's depth noise (fraction of d);
- *  - the voxel is OCCUPIED (cfg.hit) iff it holds the end point p = r c + t (float, left to right)
- *    of some pixel with a reading and |c| <= max_range_m; hits win over FREE (OctoMap's rule);
+ *  - the voxel is OCCUPIED (cfg.hit) iff it is the end voxel of some pixel with a reading and
+ *    |c|^2 <= max_range_m^2: the voxel of the point t + r c, computed from the camera's voxel
+ *    in float so that every pixel costs a few vector operations: per map axis a,
+ *    key_a = kt_a + floor(d (U_a(i) + V_a(j)) + F_a) with U_a(i) = (r[a][0] a_i) rf,
+ *    V_a(j) = (r[a][1] b_j + r[a][2]) rf, rf = (float)(1 / res), kt the camera's key and
+ *    F_a = (float)(t_a / res - floor(t_a / res)) (the map's key arithmetic: double on hosts).
+ *    That is the map key of t + r c up to float rounding relative to the distance (below 1e-6
+ *    of a voxel per voxel of distance); an end point outside the map, or farther than 2^22
+ *    voxels, marks nothing (points_skipped). Hits win over FREE (OctoMap's rule);
  *  - every other voxel is unchanged: behind or within the margin of its pixel's surface, at
  *    "no reading" pixels (never free: unknown stays unknown), outside the image (the border is
  *    the pixel grid: centre rounding to a pixel outside [0, width) x [0, height)), behind the
@@ -291,16 +299,18 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  *
  * Scratch (caller's, any alignment): a fixed part (OCC_PROJ_FIXED_BYTES: alignment, an 8 KiB
  * repeat filter for end points, the radix sort's histograms, the call's context and the
- * walk's per-level constants and stack (4 KiB, kept off the stack)), 4 bytes per pixel (the depths), 8 bytes per pyramid cell
- * (min and max, levels 1.. of halved sides: at most OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells) and the output, in 8-byte slots: the end
- * points' codes after the repeat filter (twice while they are sorted), then one per voxel
- * update and two per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it for n_out
- * slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers the TUM frames in
- * `make bench` (measured at most 0.47 slots per pixel: the pioneer frames at 0.05 m, every pixel
- * a hit; bench/projective.cpp prints what they used) and an 8x8 ToF array at 0.05 m to 3 m
- * (tests/test_projective.c). For 640 x 480 the whole formula is 11.3 bytes per
- * pixel. A frame that needs more slots is refused with OCC_ERR_SCRATCH (map unchanged): pass
- * more. out->insert.scratch_used says what a call used.
+ * walk's per-level constants and stack (4 KiB, kept off the stack)), 4 bytes per pixel (the
+ * depths), 8 bytes per pyramid cell (min and max, levels 1.. of halved sides: at most
+ * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells), 48 bytes per image column (the pixel
+ * pass's per-column tables and row buffers, OCC_PROJ_COLUMN_BYTES) and the output, in 8-byte
+ * slots: the end points' codes after the repeat filter (twice while they are sorted), then one
+ * per voxel update and two per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it
+ * for n_out slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers the TUM frames in
+ * `make bench` (bench/projective.cpp prints what they used) and an 8x8 ToF array at 0.05 m to
+ * 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 11.4 bytes per pixel, of
+ * which a frame of the pioneer sequence used at most 10.2. A frame that needs more slots is
+ * refused with OCC_ERR_SCRATCH (map unchanged): pass more. out->insert.scratch_used says what
+ * a call used.
  *
  * Work, bounded per call: O(pixels) for the pyramid; the walk tests a node in O(1) (8 corner
  * projections, at most 4 pyramid cells) and descends only where its answer is mixed, so it
@@ -315,9 +325,10 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
 #define OCC_PROJ_FIXED_BYTES                                                               \
     (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u + \
      OCC_PROJ_LEVELS_BYTES + OCC_PROJ_CTX_BYTES)
-#define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                               \
-    (OCC_PROJ_FIXED_BYTES + 8u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
-     8u * (size_t)(n_out))
+#define OCC_PROJ_COLUMN_BYTES(w) (48u * (size_t)(w) + 256u)
+#define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                                 \
+    (OCC_PROJ_FIXED_BYTES + 48u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
+     OCC_PROJ_COLUMN_BYTES(w) + 8u * (size_t)(n_out))
 #define OCC_PROJ_OUT_DEFAULT(w, h) ((size_t)(w) * (size_t)(h) / 2u + 16384u)
 
 typedef enum {

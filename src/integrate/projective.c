@@ -61,19 +61,22 @@ typedef char occ_proj_levels_fit[sizeof(occ_proj_levels_t) <= OCC_PROJ_LEVELS_BY
 typedef char occ_proj_ctx_fit[sizeof(occ_proj_t) <= OCC_PROJ_CTX_BYTES && OCC_PROJ_CTX_BYTES % 8u == 0u ? 1 : -1];
 
 /* Carve the scratch: the filter and the sort's histograms (8-byte aligned), the depths and
- * the pyramid (floats), then the output (8-byte codes). false when it cannot hold all that and
- * one output slot. */
+ * the pyramid (floats), the pixel pass's tables (16-byte aligned), then the output (8-byte
+ * codes). false when it cannot hold all that and one output slot. */
 static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
 {
     if (scratch == NULL) {
         return false;
     }
     const uintptr_t a = (uintptr_t)scratch;
-    const size_t skip = (size_t)((8u - (a & 7u)) & 7u);
+    const size_t skip = (size_t)((16u - (a & 15u)) & 15u);
     const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u + OCC_PROJ_LEVELS_BYTES;
     const size_t px = (size_t)x->im->width * x->im->height;
-    const size_t floats = 4u * px + occi_proj_pyramid_bytes(x->im->width, x->im->height);
-    const size_t head = skip + fixed + ((floats + 7u) & ~(size_t)7u);
+    /* level 0 plus 4 floats: the row loop writes up to 3 past a row (the next row's, later
+     * rewritten; past the last row: this pad) */
+    const size_t floats = 4u * px + 16u + occi_proj_pyramid_bytes(x->im->width, x->im->height);
+    const size_t tables = skip + ((fixed + floats + 15u) & ~(size_t)15u);
+    const size_t head = tables + occi_proj_pixels_bytes(x->im->width);
     if (bytes < head + 8u) {
         return false;
     }
@@ -81,7 +84,9 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     x->filter = (occ_code_t *)(void *)base;
     x->hist = (uint32_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u);
     x->lv = (occ_proj_levels_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u);
-    *mem = (float *)(void *)(base + fixed);
+    x->d0 = (float *)(void *)(base + fixed);
+    *mem = x->d0 + px + 4u;
+    occi_proj_pixels_carve(x, (unsigned char *)scratch + tables);
     x->out = (occ_code_t *)(void *)((unsigned char *)scratch + head);
     x->cap = (bytes - head) / 8u;
     x->r->insert.scratch_used = head;
@@ -183,6 +188,18 @@ static occ_proj_t *context_in(void *scratch, const size_t bytes, size_t *used)
     return x;
 }
 
+/* The camera's voxel, its position in it (voxels) and the key side, for the end points. */
+static void camera_voxel(occ_proj_t *x, const float t[3], const uint32_t kt[3])
+{
+    x->rf = (float)x->g.rf;
+    x->kside = (int32_t)((uint32_t)1 << x->g.depth);
+    for (unsigned a = 0; a < 3u; a++) {
+        x->kcam[a] = (int32_t)kt[a];
+        const occ_rr_t s = (occ_rr_t)t[a] * x->g.rf - ((occ_rr_t)kt[a] - x->g.tmv_r);
+        x->kfrac[a] = (float)s;
+    }
+}
+
 /* Pyramid, end points, walk, then the writes, in the scratch after the context. */
 static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
 {
@@ -190,9 +207,10 @@ static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
     if (!carve(x, rest, rest_bytes, &mem)) {
         return OCC_ERR_SCRATCH;
     }
+    const bool hits_fit = occi_proj_pixels(x);
     occi_proj_build(x, mem);
-    const bool hits_fit = occi_proj_hits(x);
     if (hits_fit) {
+        occi_proj_hits_sort(x);
         occi_proj_walk(x);
     }
     size_t start[OCC_MAX_DEPTH + 2u];
@@ -237,10 +255,13 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
         x->r = &res;
         x->g = g;
         x->max2 = camera->max_range_m * camera->max_range_m;
+        const float hit_m = OCC_PROJ_HIT_VOXELS * map->cfg.resolution_m;
+        x->max2_hit = x->max2 < hit_m * hit_m ? x->max2 : hit_m * hit_m;
         x->min2 = camera->min_range_m * camera->min_range_m;
         x->far = 1024.0f * camera->max_range_m;
         x->keep = 1.0f - camera->noise_rel;
         x->m0 = 0.8660254f * map->cfg.resolution_m;
+        camera_voxel(x, t, kt);
         e = run(x, (unsigned char *)scratch + used, scratch_bytes - used);
         res.insert.scratch_used += used;
     }

@@ -34,82 +34,6 @@ size_t occi_proj_pyramid_bytes(const uint32_t w, const uint32_t h)
     return 8u * cells;
 }
 
-/* Depth of pixel (i, j) in metres, NaN for "no reading" (classified by the caller). */
-static float raw_depth(const occ_proj_t *x, const uint32_t i, const uint32_t j)
-{
-    const occ_proj_image_t *const im = x->im;
-    const unsigned char *const p = (const unsigned char *)im->data +
-                                   (size_t)j * im->row_stride_bytes +
-                                   (size_t)i * im->pixel_stride_bytes;
-    if (im->format == OCC_PROJ_U16) {
-        uint16_t raw;
-        memcpy(&raw, p, sizeof raw);
-        return raw == 0u ? NAN : (float)raw * im->depth_scale_m;
-    }
-    float d;
-    memcpy(&d, p, sizeof d);
-    if (d > x->far) {
-        d = 2.0f * x->cam->max_range_m; /* +Inf: "no return within range" */
-    }
-    return d;
-}
-
-/* near2, far2: |c|^2 <= d^2 (1 + (A / fx)^2 + (B / fy)^2) with A, B the largest pixel offsets
- * from the principal point, and |c|^2 >= d^2 (c[2] = d); a 1 % margin covers every rounding
- * (relative 1e-6 here). Non-finite bounds only make the tests fail: the exact path then. */
-static void sure_range(occ_proj_t *x)
-{
-    const occ_proj_camera_t *const k = x->cam;
-    const float a0 = fabsf(k->cx), a1 = fabsf((float)(x->im->width - 1u) - k->cx);
-    const float b0 = fabsf(k->cy), b1 = fabsf((float)(x->im->height - 1u) - k->cy);
-    const float a = hi_of(a0, a1) / k->fx, b = hi_of(b0, b1) / k->fy;
-    const float kk = (1.0f + a * a + b * b) * 1.01f;
-    x->far2 = 0.99f * (x->max2 / kk);
-    x->near2 = 1.01f * x->min2;
-}
-
-/* Level 0: the depth of every pixel with a usable reading, -inf otherwise; counters. */
-static void fill_level0(occ_proj_t *x)
-{
-    const uint32_t w = x->im->width, h = x->im->height;
-    occ_proj_result_t *const r = x->r;
-    x->dmin = INFINITY;
-    x->dmax = -INFINITY;
-    for (uint32_t j = 0; j < h; j++) {
-        for (uint32_t i = 0; i < w; i++) {
-            const float d = raw_depth(x, i, j);
-            float *const slot = &x->d0[(size_t)j * w + i];
-            *slot = -INFINITY;
-            if (!(d > 0.0f)) {
-                r->pixels_no_reading++;
-                continue;
-            }
-            const float dd = d * d;
-            if (dd > x->near2 && dd < x->far2) {
-                *slot = d; /* within range for sure: no back-projection */
-                x->dmin = d < x->dmin ? d : x->dmin;
-                x->dmax = d > x->dmax ? d : x->dmax;
-                continue;
-            }
-            float c[3];
-            occ_proj_back(x->cam, i, j, d, c);
-            const float r2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-            if (!isfinite(r2)) {
-                r->pixels_no_reading++;
-                continue;
-            }
-            if (r2 < x->min2) {
-                r->pixels_too_close++;
-                continue;
-            }
-            r->pixels_beyond_max += r2 > x->max2 ? 1u : 0u;
-            *slot = d;
-            x->dmin = d < x->dmin ? d : x->dmin;
-            x->dmax = d > x->dmax ? d : x->dmax;
-        }
-    }
-}
-
 /* Level l from level l - 1 (src min / max; at level 1 both are d0). */
 static void reduce(const float *smn, const float *smx, const uint32_t sw, const uint32_t sh,
                    float *dmn, float *dmx, const uint32_t dw, const uint32_t dh)
@@ -131,14 +55,11 @@ static void reduce(const float *smn, const float *smx, const uint32_t sw, const 
 void occi_proj_build(occ_proj_t *const x, float *const mem)
 {
     const uint32_t w = x->im->width, h = x->im->height;
-    x->d0 = mem;
-    sure_range(x);
-    fill_level0(x);
     x->mn[0] = x->d0;
     x->mx[0] = x->d0;
     x->lw[0] = w;
     x->lh[0] = h;
-    float *next = mem + (size_t)w * h;
+    float *next = mem;
     unsigned l = 0;
     while (x->lw[l] > 1u || x->lh[l] > 1u) {
         OCC_ASSERT(l + 1u < OCC_PROJ_MAX_LEVELS);
@@ -152,6 +73,7 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
         l++;
     }
     x->levels = l + 1u;
+    x->dmax = x->mx[l][0]; /* -inf: no reading at all */
 }
 
 void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_t i1,

@@ -237,27 +237,6 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
     return NODE_MIXED;
 }
 
-/* The per-voxel rule (occ_integrate.h) for the voxel whose centre is q in the camera frame
- * (q = R^T w, w its centre minus the camera position, map frame: OctoMap's float centre - t). */
-static bool voxel_free(const occ_proj_t *x, const float q[3], const float zcap)
-{
-    const occ_proj_camera_t *const cam = x->cam;
-    if (!(q[2] > 0.0f) || !(q[2] < zcap)) {
-        return false; /* behind the camera, or not in front of any depth it can project to */
-    }
-    const float u = cam->fx * (q[0] / q[2]) + cam->cx + 0.5f;
-    const float v = cam->fy * (q[1] / q[2]) + cam->cy + 0.5f;
-    if (!(u >= 0.0f && u < x->wf && v >= 0.0f && v < x->hf)) {
-        return false;
-    }
-    /* u, v >= 0: truncation is floor */
-    const float d = x->d0[(size_t)v * x->im->width + (size_t)u];
-    if (!(d > 0.0f) || !(q[2] < occ_proj_front(x, d))) {
-        return false;
-    }
-    return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= x->max2;
-}
-
 /* Is there an output slot left? (Else the call ends with OCC_ERR_SCRATCH.) */
 static bool room(occ_proj_t *x)
 {
@@ -289,47 +268,31 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
     }
 }
 
-/* The 8 voxels of a MIXED level-1 node, free or not by the rule (hits are occi_proj_hits');
- * all 8 free: one whole level-1 node (the same updates, fewer slots). cap: foot_t's. */
-static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
-                         const bool may_merge, const float cap)
+/* The voxels of a MIXED node at level 1 or 2, by the rule (occi_proj_bulk; hits are
+ * occi_proj_pixels'). Whole free nodes where every voxel below is free and holds no end point
+ * (the same updates, fewer slots): the node itself (level 2; level 1 when may_merge) or its
+ * level-1 children; the other free voxels one by one. */
+static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
+                       const unsigned level, const bool may_merge)
 {
-    const float zcap = occ_proj_front(x, cap); /* front() is monotone in the depth */
-    const occ_proj_camera_t *const cam = x->cam;
-    const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
-    float wc[3][2]; /* per axis the two voxel centres' offsets from the camera */
-    for (unsigned a = 0; a < 3u; a++) {
-        wc[a][0] = occi_raygeo_center(&x->g, k[a]) - t[a];
-        wc[a][1] = occi_raygeo_center(&x->g, k[a] | 1u) - t[a];
-    }
-    /* q[b] = r[0][b] w[0] + r[1][b] w[1] + r[2][b] w[2] (to_cam's sum order), from the
-     * per-axis products and the shared partial sums of the first two */
-    float pr[3][2][3], p01[4][3];
-    for (unsigned a = 0; a < 3u; a++) {
-        for (unsigned c = 0; c < 2u; c++) {
-            for (unsigned b = 0; b < 3u; b++) {
-                pr[a][c][b] = cam->r[a][b] * wc[a][c];
-            }
-        }
-    }
-    for (unsigned s = 0; s < 4u; s++) {
-        for (unsigned b = 0; b < 3u; b++) {
-            p01[s][b] = pr[0][s & 1u][b] + pr[1][s >> 1][b];
-        }
-    }
-    unsigned mask = 0;
-    for (unsigned s = 0; s < 8u; s++) {
-        const float *const a01 = p01[s & 3u], *const a2 = pr[2][s >> 2];
-        const float q[3] = {a01[0] + a2[0], a01[1] + a2[1], a01[2] + a2[2]};
-        mask |= voxel_free(x, q, zcap) ? 1u << s : 0u;
-    }
-    if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
-        emit_node(x, code, 1u);
+    const uint64_t mask = occi_proj_bulk(x, k, level);
+    const unsigned n = 1u << (3u * level);
+    const uint64_t all = n == 64u ? ~(uint64_t)0 : (((uint64_t)1 << n) - 1u);
+    if (mask == all && may_merge && !holds_hit(x, code, level)) {
+        emit_node(x, code, level);
         return;
     }
-    for (unsigned s = 0; s < 8u; s++) {
-        if (((mask >> s) & 1u) != 0u && room(x)) {
-            x->out[x->nh + x->nv++] = code | s;
+    for (unsigned c = 0; c < n / 8u; c++) {
+        const unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
+        const occ_code_t cc = code | ((occ_code_t)c << 3);
+        if (byte == 0xFFu && (level == 2u || may_merge) && !holds_hit(x, cc, 1u)) {
+            emit_node(x, cc, 1u);
+            continue;
+        }
+        for (unsigned v = 0; v < 8u; v++) {
+            if (((byte >> v) & 1u) != 0u && room(x)) {
+                x->out[x->nh + x->nv++] = cc | v;
+            }
         }
     }
 }
@@ -343,7 +306,7 @@ void occi_proj_walk(occ_proj_t *const x)
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
         if (test_node(x, k0, 1u, x->dmax, &f) != NODE_SKIP) {
-            visit_voxels(x, k0, 0u, false, f.cap); /* the root is no coarse node */
+            visit_bulk(x, k0, 0u, 1u, false); /* the root is no coarse node */
         }
         return;
     }
@@ -371,8 +334,8 @@ void occi_proj_walk(occ_proj_t *const x)
         }
         if (cls == NODE_FREE) {
             emit_node(x, code, l);
-        } else if (cls == NODE_MIXED && l == 1u) {
-            visit_voxels(x, k, code, true, f.cap);
+        } else if (cls == NODE_MIXED && l <= 2u) {
+            visit_bulk(x, k, code, l, true);
         } else if (cls == NODE_MIXED) {
             OCC_ASSERT(sp <= OCC_MAX_DEPTH);
             st[sp].k[0] = k[0];

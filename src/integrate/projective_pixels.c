@@ -1,0 +1,322 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* projective_pixels.c - one pass over the image, a row at a time: each pixel's depth (level 0
+ * of the pyramid), its counters, and its end point's voxel. A voxel repeated from the left or
+ * the upper neighbour is dropped at once, the rest go through a small repeat filter to the
+ * output as hit codes (sorted and collapsed afterwards). The row loops are branch-free so that
+ * a host compiler vectorises them; the arithmetic is the header's, lane for lane. */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "projective_internal.h"
+
+/* A key offset no pixel gets (offsets are clamped to +-OCC_PROJ_KEY_LIM). */
+#define NO_VOXEL INT32_MIN
+
+/* Bytes of one array of n 4-byte cells, rounded up to 16 (each array starts 16-byte aligned). */
+static size_t cells16(const size_t n)
+{
+    return (4u * n + 15u) & ~(size_t)15u;
+}
+
+size_t occi_proj_pixels_bytes(const uint32_t w)
+{
+    /* asq, u[3], dr, nw: w cells padded to 4; kc[3], kp[3]: column -1 and w padded to 4 */
+    return 6u * cells16(w) + 6u * cells16((size_t)w + 4u);
+}
+
+void occi_proj_pixels_carve(occ_proj_t *const x, unsigned char *mem)
+{
+    const uint32_t w = x->im->width;
+    x->px.asq = (float *)(void *)mem;
+    mem += cells16(w);
+    for (unsigned a = 0; a < 3u; a++) {
+        x->px.u[a] = (float *)(void *)mem;
+        mem += cells16(w);
+    }
+    x->px.dr = (float *)(void *)mem;
+    mem += cells16(w);
+    for (unsigned a = 0; a < 3u; a++) {
+        x->px.kc[a] = (int32_t *)(void *)mem;
+        mem += cells16((size_t)w + 4u);
+        x->px.kp[a] = (int32_t *)(void *)mem;
+        mem += cells16((size_t)w + 4u);
+    }
+    x->px.nw = (int32_t *)(void *)mem;
+}
+
+/* Per-column tables of the frame (a_i = (i - cx) / fx): a_i^2 and the map-frame direction's
+ * parts per axis in voxels, r[a][0] a_i rf. */
+static void columns(occ_proj_t *x)
+{
+    const occ_proj_camera_t *const k = x->cam;
+    const float rf = x->rf;
+    const uint32_t w = x->im->width, n = (w + 3u) & ~3u;
+    for (uint32_t i = 0; i < w; i++) {
+        const float a = ((float)i - k->cx) / k->fx;
+        x->px.asq[i] = a * a;
+        for (unsigned ax = 0; ax < 3u; ax++) {
+            x->px.u[ax][i] = (k->r[ax][0] * a) * rf;
+        }
+    }
+    for (uint32_t i = w; i < n; i++) { /* the pad lanes: depth 0, no reading */
+        x->px.asq[i] = 0.0f;
+        x->px.u[0][i] = x->px.u[1][i] = x->px.u[2][i] = 0.0f;
+        x->px.dr[i] = 0.0f;
+    }
+}
+
+/* Row j's depths as floats (0 = no reading) into px.dr. */
+static void load_row(const occ_proj_t *x, const uint32_t j)
+{
+    const occ_proj_image_t *const im = x->im;
+    const unsigned char *const row = (const unsigned char *)im->data + (size_t)j * im->row_stride_bytes;
+    float *const dr = x->px.dr;
+    const uint32_t w = im->width;
+    if (im->format == OCC_PROJ_U16) {
+        const float scale = im->depth_scale_m;
+        if (im->pixel_stride_bytes == 2u) {
+            for (uint32_t i = 0; i < w; i++) {
+                uint16_t raw;
+                memcpy(&raw, row + 2u * (size_t)i, 2u);
+                dr[i] = (float)raw * scale; /* raw 0: 0, no reading */
+            }
+            return;
+        }
+        for (uint32_t i = 0; i < w; i++) {
+            uint16_t raw;
+            memcpy(&raw, row + (size_t)i * im->pixel_stride_bytes, 2u);
+            dr[i] = (float)raw * scale;
+        }
+        return;
+    }
+    const float far = x->far, beyond = 2.0f * x->cam->max_range_m;
+    for (uint32_t i = 0; i < w; i++) {
+        float d;
+        memcpy(&d, row + (size_t)i * im->pixel_stride_bytes, 4u);
+        dr[i] = d > far ? beyond : d; /* +Inf or absurdly far: no return within range */
+    }
+}
+
+/* A row's inputs for the lane loop: per map axis the row's part of the direction (voxels) and
+ * the camera's position in its voxel, the camera's key, and the ranges. */
+typedef struct {
+    float bsq1, v[3], f[3], min2, max2, max2h;
+    int32_t t[3], side;
+} row_consts_t;
+
+/* Counters of one row: no reading, too close, beyond max range, end point outside the map. */
+typedef struct {
+    uint32_t none, close, beyond, outside;
+} row_counts_t;
+
+/* The lane loop over n pixels (a multiple of 4): branch-free, restrict-qualified, so that a
+ * host compiler vectorises it (the header's arithmetic, lane for lane). A hit farther than
+ * OCC_PROJ_HIT_VOXELS voxels is outside every map: with that bound the offsets always
+ * convert to int32. */
+static void classify_lanes(const uint32_t n, const row_consts_t *const c,
+                           const float *restrict dr, const float *restrict asq,
+                           const float *restrict u0, const float *restrict u1,
+                           const float *restrict u2, float *restrict d0row, int32_t *restrict k0,
+                           int32_t *restrict k1, int32_t *restrict k2, row_counts_t *const cnt)
+{
+    const float bsq1 = c->bsq1, min2 = c->min2, max2 = c->max2, max2h = c->max2h;
+    const float v0 = c->v[0], v1 = c->v[1], v2 = c->v[2], f0 = c->f[0], f1 = c->f[1], f2 = c->f[2];
+    const int32_t t0 = c->t[0], t1 = c->t[1], t2 = c->t[2], side = c->side;
+    uint32_t none = 0, close = 0, beyond = 0, outside = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        const float d = dr[i];
+        const float r2 = (d * d) * (asq[i] + bsq1);
+        const int has = d > 0.0f, fin = r2 <= FLT_MAX, near = r2 < min2, in = r2 <= max2;
+        const int valid = has & fin & !near, hit = valid & (r2 <= max2h);
+        d0row[i] = valid ? d : -INFINITY;
+        none += (uint32_t)!(has & fin);
+        close += (uint32_t)(has & fin & near);
+        beyond += (uint32_t)(valid & !in);
+        const float ds = hit ? d : 0.0f; /* no hit: the camera's own voxel, dropped below */
+        const float e0 = ds * (u0[i] + v0) + f0, e1 = ds * (u1[i] + v1) + f1,
+                    e2 = ds * (u2[i] + v2) + f2;
+        int32_t q0 = (int32_t)e0, q1 = (int32_t)e1, q2 = (int32_t)e2;
+        q0 -= (int32_t)(e0 < (float)q0); /* truncation to floor */
+        q1 -= (int32_t)(e1 < (float)q1);
+        q2 -= (int32_t)(e2 < (float)q2);
+        const int inside = (q0 + t0 >= 0) & (q0 + t0 < side) & (q1 + t1 >= 0) &
+                           (q1 + t1 < side) & (q2 + t2 >= 0) & (q2 + t2 < side);
+        outside += (uint32_t)(valid & in & !(hit & inside));
+        const int mark = hit & inside;
+        k0[i] = mark ? q0 : NO_VOXEL;
+        k1[i] = mark ? q1 : NO_VOXEL;
+        k2[i] = mark ? q2 : NO_VOXEL;
+    }
+    cnt->none += none;
+    cnt->close += close;
+    cnt->beyond += beyond;
+    cnt->outside += outside;
+}
+
+/* Row j: level 0, counters, and per end point its key offsets from the camera's voxel
+ * (NO_VOXEL where the pixel marks no hit), over the row padded to a multiple of 4 (the pad
+ * lanes read depth 0 and are taken off the counters). */
+static void classify_row(occ_proj_t *const x, const uint32_t j, float *const d0row)
+{
+    const occ_proj_camera_t *const k = x->cam;
+    const float b = ((float)j - k->cy) / k->fy;
+    row_consts_t c;
+    c.bsq1 = b * b + 1.0f;
+    for (unsigned a = 0; a < 3u; a++) {
+        c.v[a] = (k->r[a][1] * b + k->r[a][2]) * x->rf;
+        c.f[a] = x->kfrac[a];
+        c.t[a] = x->kcam[a];
+    }
+    c.min2 = x->min2;
+    c.max2 = x->max2;
+    c.max2h = x->max2_hit;
+    c.side = x->kside;
+    const uint32_t n = (x->im->width + 3u) & ~3u;
+    row_counts_t cnt = {0u, 0u, 0u, 0u};
+    classify_lanes(n, &c, x->px.dr, x->px.asq, x->px.u[0], x->px.u[1], x->px.u[2], d0row,
+                   x->px.kc[0], x->px.kc[1], x->px.kc[2], &cnt);
+    occ_proj_result_t *const r = x->r;
+    r->pixels_no_reading += cnt.none - (n - x->im->width);
+    r->pixels_too_close += cnt.close;
+    r->pixels_beyond_max += cnt.beyond;
+    r->insert.points_skipped += cnt.outside;
+}
+
+/* New-voxel flags over n lanes: a marked pixel whose voxel is not its left or upper
+ * neighbour's (c: this row's offsets, from column -1; p: the previous row's). */
+static void flag_lanes(const uint32_t n, const int32_t *restrict c0, const int32_t *restrict c1,
+                       const int32_t *restrict c2, const int32_t *restrict p0,
+                       const int32_t *restrict p1, const int32_t *restrict p2,
+                       int32_t *restrict nw)
+{
+    for (uint32_t i = 1; i <= n; i++) {
+        const int32_t left = (c0[i] == c0[i - 1u]) & (c1[i] == c1[i - 1u]) & (c2[i] == c2[i - 1u]);
+        const int32_t up = (c0[i] == p0[i]) & (c1[i] == p1[i]) & (c2[i] == p2[i]);
+        nw[i - 1u] = (c0[i] != NO_VOXEL) & (left == 0) & (up == 0);
+    }
+}
+
+static void flag_new(occ_proj_t *const x)
+{
+    const uint32_t n = (x->im->width + 3u) & ~3u; /* pad lanes hold NO_VOXEL */
+    flag_lanes(n, x->px.kc[0] - 1, x->px.kc[1] - 1, x->px.kc[2] - 1, x->px.kp[0] - 1,
+               x->px.kp[1] - 1, x->px.kp[2] - 1, x->px.nw);
+}
+
+/* Slot of a code in the repeat filter. */
+static size_t filter_slot(const occ_code_t c)
+{
+    return (size_t)((c ^ (c >> 17) ^ (c >> 31)) & (OCC_PROJ_FILTER_N - 1u));
+}
+
+/* Morton code bits of axis 0 (axis a: shifted by a). */
+#define MORTON_AXIS0 0x1249249249249249ull
+
+/* The code of key k (hit bit set): from the last emitted voxel's when each axis moved by at
+ * most one (a masked add or subtract on that axis' bits), else the full encode. */
+static occ_code_t code_of(occ_proj_t *const x, const uint32_t k[3])
+{
+    occ_code_t c = x->px.last_code;
+    unsigned a = 0;
+    for (; a < 3u && c != 0u; a++) {
+        const occ_code_t m = (occ_code_t)MORTON_AXIS0 << a, one = (occ_code_t)1 << a;
+        if (k[a] == x->px.last_key[a] + 1u) {
+            c = (((c | ~m) + one) & m) | (c & ~m);
+        } else if (k[a] + 1u == x->px.last_key[a]) {
+            c = (((c & m) - one) & m) | (c & ~m);
+        } else if (k[a] != x->px.last_key[a]) {
+            break;
+        }
+    }
+    if (a < 3u || c == 0u) {
+        const occ_key_t key = {{k[0], k[1], k[2]}};
+        c = occ_morton_encode(key) | OCC_CODE_HIT_BIT;
+    }
+    x->px.last_code = c;
+    memcpy(x->px.last_key, k, sizeof x->px.last_key);
+    return c;
+}
+
+/* One end point's code to the output (unless the repeat filter has it); false when the output
+ * cannot hold it and the sort's temporary. */
+static bool emit(occ_proj_t *const x, const uint32_t i, size_t *const n)
+{
+    const uint32_t k[3] = {(uint32_t)(x->kcam[0] + x->px.kc[0][i]),
+                           (uint32_t)(x->kcam[1] + x->px.kc[1][i]),
+                           (uint32_t)(x->kcam[2] + x->px.kc[2][i])};
+    const occ_code_t code = code_of(x, k);
+    const occ_key_t key = {{k[0], k[1], k[2]}}; /* the check's only (tests) */
+    OCC_ASSERT(code == (occ_morton_encode(key) | OCC_CODE_HIT_BIT));
+    (void)key;
+    const size_t s = filter_slot(code);
+    if (x->filter[s] == code) {
+        return true;
+    }
+    x->filter[s] = code;
+    if (2u * (*n + 1u) > x->cap) {
+        return false;
+    }
+    x->out[(*n)++] = code;
+    return true;
+}
+
+/* The flagged pixels' codes to the output; false when it is full. */
+static bool emit_row(occ_proj_t *const x, size_t *const n)
+{
+    const int32_t *const nw = x->px.nw;
+    const uint32_t w4 = (x->im->width + 3u) & ~3u;
+    for (uint32_t i0 = 0; i0 < w4; i0 += 4u) {
+        uint64_t lo, hi;
+        memcpy(&lo, nw + i0, 8u); /* four flags at a time: most are 0 */
+        memcpy(&hi, nw + i0 + 2u, 8u);
+        if ((lo | hi) == 0u) {
+            continue;
+        }
+        for (uint32_t i = i0; i < i0 + 4u; i++) {
+            if (nw[i] != 0 && !emit(x, i, n)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+/* The previous row's offsets become the upper neighbours (swap the buffers). */
+static void next_row(occ_proj_t *const x)
+{
+    for (unsigned a = 0; a < 3u; a++) {
+        int32_t *const t = x->px.kp[a];
+        x->px.kp[a] = x->px.kc[a];
+        x->px.kc[a] = t;
+    }
+}
+
+bool occi_proj_pixels(occ_proj_t *const x)
+{
+    const uint32_t w = x->im->width, h = x->im->height;
+    for (size_t i = 0; i < OCC_PROJ_FILTER_N; i++) {
+        x->filter[i] = 0u; /* a hit code always has bit 63: 0 is never one */
+    }
+    for (unsigned a = 0; a < 3u; a++) {
+        for (uint32_t i = 0; i <= w; i++) {
+            x->px.kp[a][i] = NO_VOXEL;
+            x->px.kc[a][i] = NO_VOXEL;
+        }
+        x->px.kp[a]++; /* views from column 0: column -1 stays NO_VOXEL for every row */
+        x->px.kc[a]++;
+    }
+    x->px.last_code = 0u; /* none yet (a hit code always has bit 63) */
+    columns(x);
+    bool fit = true;
+    size_t n = 0;
+    for (uint32_t j = 0; j < h; j++) {
+        load_row(x, j);
+        classify_row(x, j, x->d0 + (size_t)j * w);
+        flag_new(x);
+        fit = fit && emit_row(x, &n);
+        next_row(x);
+    }
+    x->nh = n;
+    return fit;
+}
