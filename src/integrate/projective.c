@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* projective.c - occ_map_insert_projective(): check the call, lay out the scratch, build the
  * pyramid, walk, then the all-or-nothing pool check and the writes (whole free nodes through
- * the coarse applier, voxels through the batch applier). */
+ * the core's frame pass: hits, free voxels and whole nodes merged in one walk of the tree). */
 #include <math.h>
 #include <string.h>
 
 #include "projective_internal.h"
-#include "coarse_internal.h"
+#include "../core/tree_internal.h"
 
 /* The header's fixed term names the filter's 8 KiB. */
 typedef char proj_filter_matches_header[OCC_PROJ_FILTER_N * 8u == 8192u ? 1 : -1];
@@ -93,68 +93,44 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     return true;
 }
 
-/* Group the whole free nodes by level into the free gap between the two output ends (each
- * group stays in walk order: sorted). Returns the group array, or NULL when the gap is short. */
-static occ_code_t *group_nodes(occ_proj_t *x, size_t start[OCC_MAX_DEPTH + 2u])
+/* The whole free nodes came from the back of the output in walk order: reversed in place they
+ * are sorted by code. */
+static const occ_code_t *sorted_nodes(occ_proj_t *x)
 {
-    if (x->cap - x->nh - x->nv - x->nn < x->nn) {
-        return NULL;
+    occ_code_t *const n = x->out + x->cap - x->nn;
+    for (size_t i = 0, j = x->nn; i + 1u < j; i++, j--) {
+        const occ_code_t t = n[i];
+        n[i] = n[j - 1u];
+        n[j - 1u] = t;
     }
-    occ_code_t *const g = x->out + x->nh + x->nv;
-    start[0] = 0;
-    for (unsigned l = 0; l <= OCC_MAX_DEPTH; l++) {
-        start[l + 1u] = start[l] + x->per_level[l];
-    }
-    size_t fill[OCC_MAX_DEPTH + 1u];
-    memcpy(fill, start, sizeof fill);
-    for (size_t n = 1; n <= x->nn; n++) {
-        const occ_code_t e = x->out[x->cap - n];
-        const unsigned l = ((unsigned)__builtin_ctzll(e) + 1u) / 3u; /* the marker bit */
-        g[fill[l]++] = e & ~(((occ_code_t)1 << (3u * l)) - 1u);
-    }
-    return g;
+    return n;
 }
 
-/* The pool check for every write of the call (bounds as if no node existed), then the writes. */
-static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OCC_MAX_DEPTH + 2u])
+/* The writes: hits, free voxels and whole free nodes in one pass over the tree (its pool check
+ * first: a bound as if no node on the paths existed), one version of a shared map. */
+static occ_err_t apply(occ_proj_t *x)
 {
     occ_map_t *const m = x->map;
-    const unsigned depth = m->cfg.depth_levels;
-    uint64_t inner = 0, leaf = 0, i, f;
-    for (unsigned l = 1; l < depth; l++) {
-        occi_coarse_need(g + start[l], x->per_level[l], l, depth, &i, &f);
-        inner += i;
-        leaf += f;
-    }
-    occ_code_t *const fv = x->out + x->nh;
-    occi_coarse_need(fv, x->nv, 0u, depth, &i, &f);
-    inner += i;
-    leaf += f;
-    occi_coarse_need(x->out, x->nh, 0u, depth, &i, &f);
-    inner += i;
-    leaf += f;
-    if (inner > OCC_NONE || leaf > OCC_NONE ||
-        !occi_pool_can_supply(m, (uint32_t)inner, (uint32_t)leaf)) {
-        m->oom_count++;
-        return OCC_ERR_NOMEM;
-    }
-    const occ_value_t miss = occ_value_from_logodds(m->cfg.miss);
-    /* A shared map publishes the frame's coarse and voxel updates as one version. */
+    occi_frame_t f;
+    f.hits = x->out;
+    f.nh = x->nh;
+    f.voxels = x->out + x->nh;
+    f.nv = x->nv;
+    f.nodes = sorted_nodes(x);
+    f.nn = x->nn;
+    f.voxel_delta = occi_delta_from_logodds(m->cfg.miss);
+    f.node_delta = f.voxel_delta;
     const bool shared = m->priv.shared != NULL && occ_map_write_begin(m) == OCC_OK;
-    for (unsigned l = depth - 1u; l >= 1u; l--) {
-        x->r->insert.coarse_updated +=
-            occi_coarse_apply(m, g + start[l], x->per_level[l], l, miss);
-    }
-    size_t changed = 0, changed_hits = 0;
-    occ_err_t e = occ_map_observe_codes(m, fv, x->nv, &changed);
-    if (e == OCC_OK) {
-        e = occ_map_observe_codes(m, x->out, x->nh, &changed_hits);
-    }
-    OCC_ASSERT(e == OCC_OK); /* the check above covers both */
+    occi_frame_out_t fo;
+    const occ_err_t e = occi_tree_apply_frame(m, &f, &fo);
     if (shared) {
         (void)occ_map_write_end(m);
     }
-    x->r->insert.voxels_changed = changed + changed_hits;
+    occ_insert_result_t *const r = &x->r->insert;
+    r->voxels_free = x->nv - fo.dropped;
+    r->voxels_updated = r->voxels_free + x->nh;
+    r->voxels_changed = fo.changed;
+    r->coarse_updated = e == OCC_OK ? x->nn : 0u;
     return e;
 }
 
@@ -162,9 +138,7 @@ static occ_err_t apply(occ_proj_t *x, const occ_code_t *g, const size_t start[OC
 static void count_output(occ_proj_t *x)
 {
     occ_insert_result_t *const r = &x->r->insert;
-    r->voxels_free = x->nv;
     r->voxels_occupied = x->nh;
-    r->voxels_updated = x->nv + x->nh;
     r->voxel_visits = x->r->nodes_tested;
     r->rays_clipped = x->r->pixels_beyond_max;
     r->points_integrated = x->r->pixels - x->r->pixels_no_reading - x->r->pixels_too_close -
@@ -213,16 +187,13 @@ static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
         occi_proj_hits_sort(x);
         occi_proj_walk(x);
     }
-    size_t start[OCC_MAX_DEPTH + 2u];
-    const occ_code_t *const g = !hits_fit || x->overflow ? NULL : group_nodes(x, start);
-    const size_t slots = x->nh + x->nv + 2u * x->nn;
+    const size_t slots = x->nh + x->nv + x->nn;
     x->r->insert.scratch_used += 8u * (slots > x->hwm ? slots : x->hwm);
-    if (g == NULL) {
+    if (!hits_fit || x->overflow) {
         return OCC_ERR_SCRATCH;
     }
-    x->nv = occi_proj_drop_hits(x->out + x->nh, x->nv, x->out, x->nh);
     count_output(x);
-    return apply(x, g, start);
+    return apply(x);
 }
 
 occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *image,

@@ -80,7 +80,6 @@ typedef struct {
     occ_code_t *out;
     size_t cap, nh, nv, nn, hwm;
     size_t hit_cur;         /* the walk's cursor over the sorted hits */
-    size_t per_level[OCC_MAX_DEPTH + 1u];
     bool overflow;
     occ_proj_result_t *r;
     occ_proj_frame_t walk[OCC_MAX_DEPTH + 1u]; /* the walk's stack (the context is in scratch) */
@@ -112,8 +111,6 @@ void occi_proj_range(const occ_proj_t *x, uint32_t i0, uint32_t i1, uint32_t j0,
 
 /* Sort and collapse the end points' codes in out[0..nh) (hit bit set). */
 void occi_proj_hits_sort(occ_proj_t *x);
-/* Drop from free_codes[0..nv) (sorted) the codes in hits[0..nh); returns the new count. */
-size_t occi_proj_drop_hits(occ_code_t *free_codes, size_t nv, const occ_code_t *hits, size_t nh);
 
 /* Lanes of the bulk rule: the voxels of a level-2 node. */
 #define OCC_PROJ_BULK 64u
@@ -121,7 +118,7 @@ size_t occi_proj_drop_hits(occ_code_t *free_codes, size_t nv, const occ_code_t *
  * k: bit m of the result is set when the voxel in Morton slot m (below the node) is free. */
 uint64_t occi_proj_bulk(const occ_proj_t *x, const uint32_t k[3], unsigned level);
 
-/* The walk: fills x->out / nv / nn / per_level, or sets x->overflow. */
+/* The walk: fills x->out / nv / nn, or sets x->overflow. */
 void occi_proj_walk(occ_proj_t *x);
 
 #endif

@@ -264,7 +264,6 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
     if (room(x)) {
         x->nn++;
         x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
-        x->per_level[l]++;
     }
 }
 
