@@ -9,6 +9,14 @@
 
 #include "integrate_internal.h"
 
+/* A vectorisable loop kept out of line: inlined into its caller, GCC 12 drops the loop's
+ * restrict qualifiers and leaves it scalar. */
+#if defined(__GNUC__)
+#define OCC_PROJ_LANES __attribute__((noinline))
+#else
+#define OCC_PROJ_LANES
+#endif
+
 /* Pyramid levels: level 0 is the image, each next one halves both sides (ceil) down to 1x1;
  * 65535 pixels per side need 17. */
 #define OCC_PROJ_MAX_LEVELS 18u
@@ -62,6 +70,7 @@ typedef struct {
     float kfrac[3];         /* the camera's position within its voxel, in voxels [0, 1) */
     int32_t kside;          /* 2^depth: keys are below it */
     occ_proj_pixels_t px;
+    bool raw_lanes;         /* rows are plain uint16 arrays (U16, contiguous, aligned) */
     float *d0;              /* level 0: depth per pixel, -INFINITY = no reading */
     float *mn[OCC_PROJ_MAX_LEVELS], *mx[OCC_PROJ_MAX_LEVELS]; /* levels >= 1 */
     uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];

@@ -66,27 +66,43 @@ static void columns(occ_proj_t *x)
     }
 }
 
-/* Row j's depths as floats (0 = no reading) into px.dr. */
+/* Are the rows plain uint16 arrays? (U16, contiguous, 2-byte aligned.) */
+static bool raw_rows(const occ_proj_image_t *const im)
+{
+    return im->format == OCC_PROJ_U16 && im->pixel_stride_bytes == 2u &&
+           ((uintptr_t)im->data & 1u) == 0u && (im->row_stride_bytes & 1u) == 0u;
+}
+
+/* The common image's depths to floats: a loop that vectorises. */
+OCC_PROJ_LANES static void row_u16(const uint32_t w, const uint16_t *restrict raw, const float scale,
+                    float *restrict dr)
+{
+    const uint32_t w4 = w & ~3u; /* a multiple of 4: no scalar epilogue to weigh */
+    for (uint32_t i = 0; i < w4; i++) {
+        dr[i] = (float)raw[i] * scale; /* raw 0: 0, no reading */
+    }
+    for (uint32_t i = w4; i < w; i++) {
+        dr[i] = (float)raw[i] * scale;
+    }
+}
+
+/* Row j's depths for the lane loop as floats into px.dr (0 = no reading). Pad lanes stay 0. */
 static void load_row(const occ_proj_t *x, const uint32_t j)
 {
     const occ_proj_image_t *const im = x->im;
     const unsigned char *const row = (const unsigned char *)im->data + (size_t)j * im->row_stride_bytes;
-    float *const dr = x->px.dr;
     const uint32_t w = im->width;
+    float *const dr = x->px.dr;
+    if (x->raw_lanes) {
+        row_u16(w, (const uint16_t *)(const void *)row, im->depth_scale_m, dr);
+        return;
+    }
     if (im->format == OCC_PROJ_U16) {
         const float scale = im->depth_scale_m;
-        if (im->pixel_stride_bytes == 2u) {
-            for (uint32_t i = 0; i < w; i++) {
-                uint16_t raw;
-                memcpy(&raw, row + 2u * (size_t)i, 2u);
-                dr[i] = (float)raw * scale; /* raw 0: 0, no reading */
-            }
-            return;
-        }
         for (uint32_t i = 0; i < w; i++) {
             uint16_t raw;
             memcpy(&raw, row + (size_t)i * im->pixel_stride_bytes, 2u);
-            dr[i] = (float)raw * scale;
+            dr[i] = (float)raw * scale; /* raw 0: 0, no reading */
         }
         return;
     }
@@ -99,64 +115,85 @@ static void load_row(const occ_proj_t *x, const uint32_t j)
 }
 
 /* A row's inputs for the lane loop: per map axis the row's part of the direction (voxels) and
- * the camera's position in its voxel, the camera's key, and the ranges. */
+ * the camera's position in its voxel, the camera's key, the ranges, and the U16 scale. */
 typedef struct {
-    float bsq1, v[3], f[3], min2, max2, max2h;
+    float bsq1, v[3], f[3], min2, max2, max2h, scale;
     int32_t t[3], side;
 } row_consts_t;
 
-/* Counters of one row: no reading, too close, beyond max range, end point outside the map. */
+/* Sums of one row: pixels with a finite depth, valid ones (not blind), those within max range,
+ * and those marking a voxel (the counters follow by differences). */
 typedef struct {
-    uint32_t none, close, beyond, outside;
+    uint32_t finite, valid, in, marked;
 } row_counts_t;
 
-/* The lane loop over n pixels (a multiple of 4): branch-free, restrict-qualified, so that a
- * host compiler vectorises it (the header's arithmetic, lane for lane). A hit farther than
- * OCC_PROJ_HIT_VOXELS voxels is outside every map: with that bound the offsets always
- * convert to int32. */
-static void classify_lanes(const uint32_t n, const row_consts_t *const c,
-                           const float *restrict dr, const float *restrict asq,
-                           const float *restrict u0, const float *restrict u1,
-                           const float *restrict u2, float *restrict d0row, int32_t *restrict k0,
-                           int32_t *restrict k1, int32_t *restrict k2, row_counts_t *const cnt)
+/* One pixel of the lane loops (the header's arithmetic): its level-0 depth, its end voxel's
+ * key offsets from the camera's voxel (k0 NO_VOXEL where it marks nothing) and its class. A hit
+ * farther than OCC_PROJ_HIT_VOXELS voxels is outside every map: with that bound the offsets
+ * always convert to int32. (The map test is always made: without it GCC 12 sinks the key
+ * arithmetic under the hit test and no longer vectorises the loop.) */
+typedef struct {
+    float d0;
+    int32_t k0, k1, k2;
+    int32_t finite, valid, in, mark;
+} px_t;
+
+static inline px_t classify_px(const float d, const float asq, const float u0, const float u1,
+                               const float u2, const row_consts_t c)
 {
-    const float bsq1 = c->bsq1, min2 = c->min2, max2 = c->max2, max2h = c->max2h;
-    const float v0 = c->v[0], v1 = c->v[1], v2 = c->v[2], f0 = c->f[0], f1 = c->f[1], f2 = c->f[2];
-    const int32_t t0 = c->t[0], t1 = c->t[1], t2 = c->t[2], side = c->side;
-    uint32_t none = 0, close = 0, beyond = 0, outside = 0;
+    px_t o;
+    const float r2 = (d * d) * (asq + c.bsq1);
+    o.finite = (d > 0.0f) & (r2 <= FLT_MAX);
+    o.valid = o.finite & (r2 >= c.min2);
+    o.in = o.valid & (r2 <= c.max2);
+    const int32_t hit = o.valid & (r2 <= c.max2h);
+    o.d0 = o.valid ? d : -INFINITY;
+    const float ds = hit ? d : 0.0f; /* no hit: the camera's own voxel, dropped below */
+    const float e0 = ds * (u0 + c.v[0]) + c.f[0], e1 = ds * (u1 + c.v[1]) + c.f[1],
+                e2 = ds * (u2 + c.v[2]) + c.f[2];
+    int32_t q0 = (int32_t)e0, q1 = (int32_t)e1, q2 = (int32_t)e2;
+    q0 -= (int32_t)(e0 < (float)q0); /* truncation to floor */
+    q1 -= (int32_t)(e1 < (float)q1);
+    q2 -= (int32_t)(e2 < (float)q2);
+    const int32_t s = c.side;
+    o.mark = hit & (q0 + c.t[0] >= 0) & (q0 + c.t[0] < s) & (q1 + c.t[1] >= 0) &
+             (q1 + c.t[1] < s) & (q2 + c.t[2] >= 0) & (q2 + c.t[2] < s);
+    o.k0 = o.mark ? q0 : NO_VOXEL;
+    o.k1 = q1;
+    o.k2 = q2;
+    return o;
+}
+
+/* The lane loop over n pixels (a multiple of 4): branch-free, restrict-qualified, so that a
+ * host compiler vectorises it. */
+OCC_PROJ_LANES static void classify_lanes(const uint32_t n, const row_consts_t *const c, const float *restrict dr,
+                        const float *restrict asq, const float *restrict u0,
+                        const float *restrict u1, const float *restrict u2,
+                        float *restrict d0row, int32_t *restrict k0, int32_t *restrict k1,
+                        int32_t *restrict k2, row_counts_t *const cnt)
+{
+    uint32_t finite = 0, valid = 0, in = 0, marked = 0;
+    const row_consts_t cc = *c; /* a copy the stores cannot alias */
     for (uint32_t i = 0; i < n; i++) {
-        const float d = dr[i];
-        const float r2 = (d * d) * (asq[i] + bsq1);
-        const int has = d > 0.0f, fin = r2 <= FLT_MAX, near = r2 < min2, in = r2 <= max2;
-        const int valid = has & fin & !near, hit = valid & (r2 <= max2h);
-        d0row[i] = valid ? d : -INFINITY;
-        none += (uint32_t)!(has & fin);
-        close += (uint32_t)(has & fin & near);
-        beyond += (uint32_t)(valid & !in);
-        const float ds = hit ? d : 0.0f; /* no hit: the camera's own voxel, dropped below */
-        const float e0 = ds * (u0[i] + v0) + f0, e1 = ds * (u1[i] + v1) + f1,
-                    e2 = ds * (u2[i] + v2) + f2;
-        int32_t q0 = (int32_t)e0, q1 = (int32_t)e1, q2 = (int32_t)e2;
-        q0 -= (int32_t)(e0 < (float)q0); /* truncation to floor */
-        q1 -= (int32_t)(e1 < (float)q1);
-        q2 -= (int32_t)(e2 < (float)q2);
-        const int inside = (q0 + t0 >= 0) & (q0 + t0 < side) & (q1 + t1 >= 0) &
-                           (q1 + t1 < side) & (q2 + t2 >= 0) & (q2 + t2 < side);
-        outside += (uint32_t)(valid & in & !(hit & inside));
-        const int mark = hit & inside;
-        k0[i] = mark ? q0 : NO_VOXEL;
-        k1[i] = mark ? q1 : NO_VOXEL;
-        k2[i] = mark ? q2 : NO_VOXEL;
+        const px_t o = classify_px(dr[i], asq[i], u0[i], u1[i], u2[i], cc);
+        d0row[i] = o.d0;
+        k0[i] = o.k0;
+        k1[i] = o.k1;
+        k2[i] = o.k2;
+        finite += (uint32_t)o.finite;
+        valid += (uint32_t)o.valid;
+        in += (uint32_t)o.in;
+        marked += (uint32_t)o.mark;
     }
-    cnt->none += none;
-    cnt->close += close;
-    cnt->beyond += beyond;
-    cnt->outside += outside;
+    cnt->finite = finite;
+    cnt->valid = valid;
+    cnt->in = in;
+    cnt->marked = marked;
 }
 
 /* Row j: level 0, counters, and per end point its key offsets from the camera's voxel
- * (NO_VOXEL where the pixel marks no hit), over the row padded to a multiple of 4 (the pad
- * lanes read depth 0 and are taken off the counters). */
+ * (NO_VOXEL in k0 where the pixel marks no hit), over the row padded to a multiple of 4 (the
+ * pad lanes read depth 0: no reading, taken off the counters). */
 static void classify_row(occ_proj_t *const x, const uint32_t j, float *const d0row)
 {
     const occ_proj_camera_t *const k = x->cam;
@@ -171,26 +208,28 @@ static void classify_row(occ_proj_t *const x, const uint32_t j, float *const d0r
     c.min2 = x->min2;
     c.max2 = x->max2;
     c.max2h = x->max2_hit;
+    c.scale = x->im->depth_scale_m;
     c.side = x->kside;
-    const uint32_t n = (x->im->width + 3u) & ~3u;
-    row_counts_t cnt = {0u, 0u, 0u, 0u};
-    classify_lanes(n, &c, x->px.dr, x->px.asq, x->px.u[0], x->px.u[1], x->px.u[2], d0row,
-                   x->px.kc[0], x->px.kc[1], x->px.kc[2], &cnt);
+    const uint32_t w = x->im->width, n = (w + 3u) & ~3u;
+    row_counts_t s;
+    const occ_proj_pixels_t *const p = &x->px;
+    classify_lanes(n, &c, p->dr, p->asq, p->u[0], p->u[1], p->u[2], d0row, p->kc[0], p->kc[1],
+                   p->kc[2], &s);
     occ_proj_result_t *const r = x->r;
-    r->pixels_no_reading += cnt.none - (n - x->im->width);
-    r->pixels_too_close += cnt.close;
-    r->pixels_beyond_max += cnt.beyond;
-    r->insert.points_skipped += cnt.outside;
+    r->pixels_no_reading += w - s.finite; /* the pad lanes are not finite */
+    r->pixels_too_close += s.finite - s.valid;
+    r->pixels_beyond_max += s.valid - s.in;
+    r->insert.points_skipped += s.in - s.marked;
 }
 
 /* New-voxel flags over n lanes: a marked pixel whose voxel is not its left or upper
  * neighbour's (c: this row's offsets, from column -1; p: the previous row's). */
-static void flag_lanes(const uint32_t n, const int32_t *restrict c0, const int32_t *restrict c1,
+OCC_PROJ_LANES static void flag_lanes(const uint32_t n, const int32_t *restrict c0, const int32_t *restrict c1,
                        const int32_t *restrict c2, const int32_t *restrict p0,
                        const int32_t *restrict p1, const int32_t *restrict p2,
                        int32_t *restrict nw)
 {
-    for (uint32_t i = 1; i <= n; i++) {
+    for (uint32_t i = 1; i <= (n & ~3u); i++) { /* n is a multiple of 4: say so */
         const int32_t left = (c0[i] == c0[i - 1u]) & (c1[i] == c1[i - 1u]) & (c2[i] == c2[i - 1u]);
         const int32_t up = (c0[i] == p0[i]) & (c1[i] == p1[i]) & (c2[i] == p2[i]);
         nw[i - 1u] = (c0[i] != NO_VOXEL) & (left == 0) & (up == 0);
@@ -308,6 +347,7 @@ bool occi_proj_pixels(occ_proj_t *const x)
     }
     x->px.last_code = 0u; /* none yet (a hit code always has bit 63) */
     columns(x);
+    x->raw_lanes = raw_rows(x->im);
     bool fit = true;
     size_t n = 0;
     for (uint32_t j = 0; j < h; j++) {
