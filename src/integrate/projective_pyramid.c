@@ -34,21 +34,45 @@ size_t occi_proj_pyramid_bytes(const uint32_t w, const uint32_t h)
     return 8u * cells;
 }
 
-/* Level l from level l - 1 (src min / max; at level 1 both are d0). */
+/* Vertical step: per column the min of two rows' minima and the max of their maxima. */
+OCC_PROJ_LANES static void rows_minmax(const uint32_t n, const float *restrict amn,
+                                       const float *restrict bmn, const float *restrict amx,
+                                       const float *restrict bmx, float *restrict tmn,
+                                       float *restrict tmx)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        tmn[i] = lo_of(amn[i], bmn[i]);
+        tmx[i] = hi_of(amx[i], bmx[i]);
+    }
+}
+
+/* Horizontal step: pairs of columns. */
+OCC_PROJ_LANES static void pairs_minmax(const uint32_t n, const float *restrict tmn,
+                                        const float *restrict tmx, float *restrict dmn,
+                                        float *restrict dmx)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        dmn[i] = lo_of(tmn[2u * i], tmn[2u * i + 1u]);
+        dmx[i] = hi_of(tmx[2u * i], tmx[2u * i + 1u]);
+    }
+}
+
+/* Level l + 1 from level l (src min / max; at level 1 both are d0): per destination row the
+ * two source rows' column-wise min / max (tmn / tmx: sw cells, one more when sw is odd, for the
+ * repeated last column), then pairs of columns. */
 static void reduce(const float *smn, const float *smx, const uint32_t sw, const uint32_t sh,
-                   float *dmn, float *dmx, const uint32_t dw, const uint32_t dh)
+                   float *dmn, float *dmx, const uint32_t dw, const uint32_t dh, float *tmn,
+                   float *tmx)
 {
     for (uint32_t j = 0; j < dh; j++) {
         const uint32_t j0 = 2u * j, j1 = j0 + 1u < sh ? j0 + 1u : j0;
-        for (uint32_t i = 0; i < dw; i++) {
-            const uint32_t i0 = 2u * i, i1 = i0 + 1u < sw ? i0 + 1u : i0;
-            const size_t a = (size_t)j0 * sw + i0, b = (size_t)j0 * sw + i1,
-                         c = (size_t)j1 * sw + i0, e = (size_t)j1 * sw + i1;
-            const float m0 = lo_of(lo_of(smn[a], smn[b]), lo_of(smn[c], smn[e]));
-            const float m1 = hi_of(hi_of(smx[a], smx[b]), hi_of(smx[c], smx[e]));
-            dmn[(size_t)j * dw + i] = m0;
-            dmx[(size_t)j * dw + i] = m1;
+        rows_minmax(sw, smn + (size_t)j0 * sw, smn + (size_t)j1 * sw, smx + (size_t)j0 * sw,
+                    smx + (size_t)j1 * sw, tmn, tmx);
+        if ((sw & 1u) != 0u) { /* the last pair repeats the odd column */
+            tmn[sw] = tmn[sw - 1u];
+            tmx[sw] = tmx[sw - 1u];
         }
+        pairs_minmax(dw, tmn, tmx, dmn + (size_t)j * dw, dmx + (size_t)j * dw);
     }
 }
 
@@ -67,7 +91,8 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
         x->mn[l + 1u] = next;
         x->mx[l + 1u] = next + (size_t)dw * dh;
         next += 2u * (size_t)dw * dh;
-        reduce(x->mn[l], x->mx[l], x->lw[l], x->lh[l], x->mn[l + 1u], x->mx[l + 1u], dw, dh);
+        reduce(x->mn[l], x->mx[l], x->lw[l], x->lh[l], x->mn[l + 1u], x->mx[l + 1u], dw, dh,
+               x->px.u[0], x->px.u[1]); /* the pixel pass's rows are free now */
         x->lw[l + 1u] = dw;
         x->lh[l + 1u] = dh;
         l++;
