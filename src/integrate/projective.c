@@ -114,7 +114,7 @@ static occ_err_t apply(occ_proj_t *x)
     occi_frame_t f;
     f.hits = x->out;
     f.nh = x->nh;
-    f.voxels = x->out + x->nh;
+    f.voxels = x->out + x->nh + x->nr;
     f.nv = x->nv;
     f.nodes = sorted_nodes(x);
     f.nn = x->nn;
@@ -183,13 +183,17 @@ static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
     }
     const bool hits_fit = occi_proj_pixels(x);
     occi_proj_build(x, mem);
-    if (hits_fit) {
+    bool fit = hits_fit;
+    if (fit) {
         occi_proj_hits_sort(x);
+        fit = occi_proj_near(x);
+    }
+    if (fit) {
         occi_proj_walk(x);
     }
-    const size_t slots = x->nh + x->nv + x->nn;
+    const size_t slots = x->nh + x->nr + x->nv + x->nn;
     x->r->insert.scratch_used += 8u * (slots > x->hwm ? slots : x->hwm);
-    if (!hits_fit || x->overflow) {
+    if (!fit || x->overflow) {
         return OCC_ERR_SCRATCH;
     }
     count_output(x);
@@ -231,7 +235,7 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
         x->min2 = camera->min_range_m * camera->min_range_m;
         x->far = 1024.0f * camera->max_range_m;
         x->keep = 1.0f - camera->noise_rel;
-        x->m0 = 0.8660254f * map->cfg.resolution_m;
+        x->near_z = (float)OCC_PROJ_NEAR_VOXELS * map->cfg.resolution_m;
         camera_voxel(x, t, kt);
         e = run(x, (unsigned char *)scratch + used, scratch_bytes - used);
         res.insert.scratch_used += used;

@@ -90,7 +90,7 @@ OCC_PROJ_LANES static void front_lanes(const occ_proj_t *const x, const float *r
                                        const uint32_t *restrict pix, const int32_t *restrict in,
                                        uint8_t *restrict free8)
 {
-    const float keep = x->keep, m0 = x->m0;
+    const float keep = x->keep;
     const float *const d0 = x->d0;
     float d[OCC_PROJ_BULK];
     int32_t f[OCC_PROJ_BULK];
@@ -98,7 +98,7 @@ OCC_PROJ_LANES static void front_lanes(const occ_proj_t *const x, const float *r
         d[m] = d0[pix[m]];
     }
     for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
-        f[m] = in[m] & (int32_t)(qc[m] < keep * d[m] - m0);
+        f[m] = in[m] & (int32_t)(qc[m] < keep * d[m]);
     }
     for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
         free8[m] = (uint8_t)f[m];

@@ -63,7 +63,6 @@ typedef struct {
     float max2_hit;         /* max2, at most (OCC_PROJ_HIT_VOXELS res)^2: end points beyond are outside */
     float far;              /* F32 depths beyond this are "no return" (2 max range) */
     float keep;             /* 1 - noise_rel */
-    float m0;               /* margin at depth 0: half the voxel diagonal */
     float dmax;             /* largest depth with a reading (-inf: none) */
     float rf;               /* 1 / resolution (float) */
     int32_t kcam[3];        /* the camera's voxel key */
@@ -89,6 +88,11 @@ typedef struct {
     occ_code_t *out;
     size_t cap, nh, nv, nn, hwm;
     size_t hit_cur;         /* the walk's cursor over the sorted hits */
+    /* The near field's free voxels (projective_near.c): sorted codes after the hits, merged
+     * into the walk's output in code order by its cursor. */
+    const occ_code_t *near;
+    size_t nr, near_cur;
+    float near_z;           /* the near rays' depth: OCC_PROJ_NEAR_VOXELS voxels */
     bool overflow;
     occ_proj_result_t *r;
     occ_proj_frame_t walk[OCC_MAX_DEPTH + 1u]; /* the walk's stack (the context is in scratch) */
@@ -98,7 +102,7 @@ typedef struct {
  * so the pyramid's min and max bound it). */
 static inline float occ_proj_front(const occ_proj_t *x, const float d)
 {
-    return x->keep * d - x->m0;
+    return x->keep * d;
 }
 
 /* Bytes the pyramid levels >= 1 take (min and max) and their layout for a w x h image. */
@@ -110,8 +114,12 @@ void occi_proj_pixels_carve(occ_proj_t *x, unsigned char *mem);
 /* The pixel pass: level 0 (x->d0), the counters, and the end points' codes, filtered, in
  * out[0..nh) (unsorted); false when the output cannot hold them and the sort's temporary. */
 bool occi_proj_pixels(occ_proj_t *x);
-/* The pyramid over level 0 (x->d0, filled): levels >= 1 laid out from `mem` (4-byte aligned,
- * occi_proj_pyramid_bytes bytes); x->dmax. */
+/* Level 0's single-pixel gaps closed for the free test (projective_fill.c), in place, with
+ * occi_proj_fill_bytes(w) bytes of rows at `mem` (4-byte aligned). */
+size_t occi_proj_fill_bytes(uint32_t w);
+void occi_proj_fill(occ_proj_t *x, float *mem);
+/* Level 0's gaps filled, then the pyramid over it: levels >= 1 laid out from `mem` (4-byte
+ * aligned, occi_proj_pyramid_bytes bytes); x->dmax. */
 void occi_proj_build(occ_proj_t *x, float *mem);
 /* Min and max depth over pixels [i0, i1] x [j0, j1] (inside the image, i0 <= i1, j0 <= j1),
  * over-approximated by at most 2 x 2 cells of one level (so mn may be lower, mx higher). */
@@ -120,6 +128,17 @@ void occi_proj_range(const occ_proj_t *x, uint32_t i0, uint32_t i1, uint32_t j0,
 
 /* Sort and collapse the end points' codes in out[0..nh) (hit bit set). */
 void occi_proj_hits_sort(occ_proj_t *x);
+
+/* The near field (projective_near.c): rays from the camera along every step-th pixel
+ * (occi_proj_near_step: min(fx, fy) / 32, at least 1) and the last row and column, to this
+ * many voxels of depth or the front of their surface if nearer. */
+#define OCC_PROJ_NEAR_VOXELS 4u
+uint32_t occi_proj_near_step(const occ_proj_camera_t *k);
+/* Rays of a w x h image's grid. */
+size_t occi_proj_near_rays(uint32_t w, uint32_t h, uint32_t step);
+/* The near rays' voxels, sorted and unique, at out + nh (x->near, x->nr); false when the
+ * output cannot hold them and the sort's temporary. Needs level 0 (x->d0). */
+bool occi_proj_near(occ_proj_t *x);
 
 /* Lanes of the bulk rule: the voxels of a level-2 node. */
 #define OCC_PROJ_BULK 64u

@@ -79,6 +79,9 @@ static void reduce(const float *smn, const float *smx, const uint32_t sw, const 
 void occi_proj_build(occ_proj_t *const x, float *const mem)
 {
     const uint32_t w = x->im->width, h = x->im->height;
+    /* the pixel pass's tables are free now: the gap filling's rows, then the reduction's */
+    OCC_ASSERT(occi_proj_fill_bytes(w) <= occi_proj_pixels_bytes(w));
+    occi_proj_fill(x, x->px.asq);
     x->mn[0] = x->d0;
     x->mx[0] = x->d0;
     x->lw[0] = w;
@@ -92,7 +95,7 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
         x->mx[l + 1u] = next + (size_t)dw * dh;
         next += 2u * (size_t)dw * dh;
         reduce(x->mn[l], x->mx[l], x->lw[l], x->lh[l], x->mn[l + 1u], x->mx[l + 1u], dw, dh,
-               x->px.u[0], x->px.u[1]); /* the pixel pass's rows are free now */
+               x->px.u[0], x->px.u[1]);
         x->lw[l + 1u] = dw;
         x->lh[l + 1u] = dh;
         l++;

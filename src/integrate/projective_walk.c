@@ -240,7 +240,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
 /* Is there an output slot left? (Else the call ends with OCC_ERR_SCRATCH.) */
 static bool room(occ_proj_t *x)
 {
-    if (x->nh + x->nv + x->nn >= x->cap) {
+    if (x->nh + x->nr + x->nv + x->nn >= x->cap) {
         x->overflow = true;
         return false;
     }
@@ -258,12 +258,46 @@ static bool holds_hit(occ_proj_t *x, const occ_code_t code, const unsigned l)
     return x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < end;
 }
 
-/* Record a whole free node at level l >= 1 (from the back of the output). */
+/* The free voxels go after the hits and the near field's voxels. */
+static void emit_voxel(occ_proj_t *x, const occ_code_t code)
+{
+    x->out[x->nh + x->nr + x->nv++] = code;
+}
+
+/* The near field's voxels below `code` to the output (the walk emits in code order, so the
+ * output stays sorted); false when it is full. */
+static bool flush_near(occ_proj_t *x, const occ_code_t code)
+{
+    for (; x->near_cur < x->nr && x->near[x->near_cur] < code; x->near_cur++) {
+        if (!room(x)) {
+            return false;
+        }
+        emit_voxel(x, x->near[x->near_cur]);
+    }
+    return true;
+}
+
+/* Skip the near field's voxels inside the level-l node at `code`; returns their bits (voxel
+ * offsets from code, level <= 2) for a node whose voxels the caller decides. */
+static uint64_t take_near(occ_proj_t *x, const occ_code_t code, const unsigned l)
+{
+    const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
+    uint64_t bits = 0u;
+    for (; x->near_cur < x->nr && x->near[x->near_cur] < end; x->near_cur++) {
+        const occ_code_t off = x->near[x->near_cur] - code;
+        bits |= l <= 2u ? (uint64_t)1 << off : 0u;
+    }
+    return bits;
+}
+
+/* Record a whole free node at level l >= 1 (from the back of the output), after the near
+ * voxels before it; the near voxels inside it are covered by it. */
 static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
-    if (room(x)) {
+    if (flush_near(x, code) && room(x)) {
         x->nn++;
         x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
+        (void)take_near(x, code, l);
     }
 }
 
@@ -274,24 +308,33 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
 static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
                        const unsigned level, const bool may_merge)
 {
-    const uint64_t mask = occi_proj_bulk(x, k, level);
+    if (!flush_near(x, code)) {
+        return;
+    }
+    /* the rule's free voxels, and the near field's (free by its rays) */
+    const uint64_t mask = occi_proj_bulk(x, k, level) | take_near(x, code, level);
     const unsigned n = 1u << (3u * level);
     const uint64_t all = n == 64u ? ~(uint64_t)0 : (((uint64_t)1 << n) - 1u);
+    if (mask == 0u) {
+        return;
+    }
     if (mask == all && may_merge && !holds_hit(x, code, level)) {
         emit_node(x, code, level);
         return;
     }
+    if (x->cap - x->nh - x->nr - x->nv - x->nn < n) { /* room for every voxel, checked once */
+        x->overflow = true;
+        return;
+    }
     for (unsigned c = 0; c < n / 8u; c++) {
-        const unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
+        unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
         const occ_code_t cc = code | ((occ_code_t)c << 3);
         if (byte == 0xFFu && (level == 2u || may_merge) && !holds_hit(x, cc, 1u)) {
             emit_node(x, cc, 1u);
             continue;
         }
-        for (unsigned v = 0; v < 8u; v++) {
-            if (((byte >> v) & 1u) != 0u && room(x)) {
-                x->out[x->nh + x->nv++] = cc | v;
-            }
+        for (; byte != 0u; byte &= byte - 1u) {
+            emit_voxel(x, cc | (occ_code_t)__builtin_ctz(byte));
         }
     }
 }
@@ -307,6 +350,7 @@ void occi_proj_walk(occ_proj_t *const x)
         if (test_node(x, k0, 1u, x->dmax, &f) != NODE_SKIP) {
             visit_bulk(x, k0, 0u, 1u, false); /* the root is no coarse node */
         }
+        (void)flush_near(x, ~(occ_code_t)0);
         return;
     }
     unsigned sp = 1;
@@ -346,5 +390,8 @@ void occi_proj_walk(occ_proj_t *const x)
             st[sp].next = 0u;
             sp++;
         }
+    }
+    if (!x->overflow) {
+        (void)flush_near(x, ~(occ_code_t)0); /* the near voxels after the walk's last output */
     }
 }

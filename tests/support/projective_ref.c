@@ -51,6 +51,31 @@ static float ref_depth(const occ_proj_image_t *im, const occ_proj_camera_t *k, u
     return d;
 }
 
+/* The depth the free test uses (occ_integrate.h): the pixel's reading, else the smallest
+ * reading among its four neighbours (left, right, up, down), else NaN. */
+static float ref_free_depth(const occ_proj_image_t *im, const occ_proj_camera_t *k, uint32_t i,
+                            uint32_t j)
+{
+    ref_ray_t ray;
+    const float d = ref_depth(im, k, i, j, &ray);
+    if (!isnan(d)) {
+        return d;
+    }
+    float best = NAN;
+    const int di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
+    for (unsigned n = 0; n < 4u; n++) {
+        const int64_t ni = (int64_t)i + di[n], nj = (int64_t)j + dj[n];
+        if (ni < 0 || nj < 0 || ni >= (int64_t)im->width || nj >= (int64_t)im->height) {
+            continue;
+        }
+        const float e = ref_depth(im, k, (uint32_t)ni, (uint32_t)nj, &ray);
+        if (!isnan(e) && (isnan(best) || e < best)) {
+            best = e;
+        }
+    }
+    return best;
+}
+
 static int by_code(const void *a, const void *b)
 {
     const occ_code_t x = *(const occ_code_t *)a & ~OCC_CODE_HIT_BIT;
@@ -130,8 +155,7 @@ size_t projref_end_keys(const occ_map_t *map, const occ_proj_image_t *im,
 }
 
 /* The rule for one voxel centre: free? */
-static bool ref_free(const occ_map_t *map, const occ_proj_image_t *im,
-                     const occ_proj_camera_t *k, occ_vec3_t centre)
+static bool ref_free(const occ_proj_image_t *im, const occ_proj_camera_t *k, occ_vec3_t centre)
 {
     const float w[3] = {centre.x - k->t.x, centre.y - k->t.y, centre.z - k->t.z};
     float q[3];
@@ -146,13 +170,54 @@ static bool ref_free(const occ_map_t *map, const occ_proj_image_t *im,
     if (!(u >= 0.0f && u < (float)im->width && v >= 0.0f && v < (float)im->height)) {
         return false;
     }
-    ref_ray_t ray;
-    const float d = ref_depth(im, k, (uint32_t)u, (uint32_t)v, &ray);
-    const float m0 = 0.8660254f * map->cfg.resolution_m;
-    if (isnan(d) || !(q[2] < (1.0f - k->noise_rel) * d - m0)) {
+    const float d = ref_free_depth(im, k, (uint32_t)u, (uint32_t)v);
+    if (isnan(d) || !(q[2] < (1.0f - k->noise_rel) * d)) {
         return false;
     }
     return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= k->max_range_m * k->max_range_m;
+}
+
+/* The near field (occ_integrate.h): rays from the camera along the pixel grid (every step-th
+ * pixel and the last of a row and a column, step = min(fx, fy) / 32 truncated, at least 1) with
+ * a reading, to depth min(front of its surface, 4 voxels); the voxels occ_ray_keys() gives for
+ * each (the camera's first, the end's excluded) are free. Appended to c[n..). */
+static size_t ref_near(const occ_map_t *map, const occ_proj_image_t *im,
+                       const occ_proj_camera_t *k, occ_code_t **c, size_t n, size_t *cap)
+{
+    const float f = k->fx < k->fy ? k->fx : k->fy;
+    const uint32_t step = f / 32.0f >= 1.0f ? (uint32_t)(f / 32.0f) : 1u;
+    const float near = 4.0f * map->cfg.resolution_m;
+    const float keep = 1.0f - k->noise_rel;
+    const float t[3] = {k->t.x, k->t.y, k->t.z};
+    occ_key_t keys[256];
+    for (uint32_t j = 0; j < im->height; j = j + 1u == im->height ? j + 1u : (j + step < im->height ? j + step : im->height - 1u)) {
+        for (uint32_t i = 0; i < im->width; i = i + 1u == im->width ? i + 1u : (i + step < im->width ? i + step : im->width - 1u)) {
+            const float d = ref_free_depth(im, k, i, j);
+            const float front = keep * d;
+            const float z = front < near ? front : near;
+            if (isnan(d) || !(z > 0.0f)) {
+                continue;
+            }
+            float e[3];
+            const float a = ((float)i - k->cx) / k->fx, b = ((float)j - k->cy) / k->fy;
+            for (unsigned ax = 0; ax < 3u; ax++) {
+                e[ax] = (k->r[ax][0] * a + k->r[ax][1] * b + k->r[ax][2]) * z + t[ax];
+            }
+            size_t nk = 0;
+            const occ_vec3_t ev = {e[0], e[1], e[2]};
+            if (occ_ray_keys(map, k->t, ev, keys, 256u, &nk) != OCC_OK) {
+                continue;
+            }
+            for (size_t q = 0; q < nk; q++) {
+                if (n == *cap) {
+                    *cap *= 2u;
+                    *c = realloc(*c, *cap * sizeof **c);
+                }
+                (*c)[n++] = occ_morton_encode(keys[q]);
+            }
+        }
+    }
+    return n;
 }
 
 size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
@@ -178,7 +243,7 @@ size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
     for (key.k[2] = lo[2]; key.k[2] <= hi[2]; key.k[2]++) {
         for (key.k[1] = lo[1]; key.k[1] <= hi[1]; key.k[1]++) {
             for (key.k[0] = lo[0]; key.k[0] <= hi[0]; key.k[0]++) {
-                if (!ref_free(map, im, cam, occ_map_key_center(map, key, 0u))) {
+                if (!ref_free(im, cam, occ_map_key_center(map, key, 0u))) {
                     continue;
                 }
                 if (n == cap) {
@@ -190,6 +255,7 @@ size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
         }
     }
     (void)box;
+    n = ref_near(map, im, cam, &c, n, &cap);
     qsort(c, n, sizeof *c, by_code);
     size_t u = 0, hits = 0;
     for (size_t i = 0; i < n; i++) {
