@@ -163,20 +163,35 @@ static bool next_entry(const occ_map_t *const m, cursor_t *const c, entry_t *con
 /* Blocks one sorted stream's entries can allocate, as if no node existed: the entry that first
  * goes below a node on the union of their paths (its split from the previous entry is above
  * that node) counts the node's child block (a leaf block at level 1, else an inner block), for
- * the levels level + 1 .. split - 1. Whole nodes carry their marker (level); voxels do not. */
-static void stream_need(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
-                        const bool nodes, uint64_t *const inner, uint64_t *const leaf)
+ * the levels level + 1 .. split - 1. Voxels (level 0) here, whole nodes below. */
+static void voxels_need(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
+                        uint64_t *const inner, uint64_t *const leaf)
+{
+    if (n == 0u) {
+        return;
+    }
+    const unsigned top = m->cfg.depth_levels; /* the first entry splits above the root */
+    uint64_t in = top >= 2u ? top - 1u : 0u, lf = 1u;
+    for (size_t i = 1; i < n; i++) {
+        const unsigned s = split_level(codes[i], codes[i - 1u]);
+        OCC_ASSERT((codes[i] & ~OCC_CODE_HIT_BIT) > (codes[i - 1u] & ~OCC_CODE_HIT_BIT));
+        lf += s >= 2u ? 1u : 0u;
+        in += s >= 3u ? s - 2u : 0u;
+    }
+    *inner += in;
+    *leaf += lf;
+}
+
+static void nodes_need(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
+                       uint64_t *const inner)
 {
     occ_code_t prev = 0;
     for (size_t i = 0; i < n; i++) {
-        const unsigned lv = nodes ? node_level(codes[i]) : 0u;
-        const occ_code_t code = codes[i] & ~OCC_CODE_HIT_BIT & ~(((occ_code_t)1 << (3u * lv)) - 1u);
+        const unsigned lv = node_level(codes[i]);
+        const occ_code_t code = codes[i] & ~(((occ_code_t)1 << (3u * lv)) - 1u);
         const unsigned s = i == 0u ? m->cfg.depth_levels + 1u : split_level(code, prev);
         OCC_ASSERT(i == 0u || code > prev); /* sorted, unique */
-        const unsigned top = s - 1u;                  /* the highest node it may split */
-        const unsigned low = lv + 1u > 2u ? lv + 1u : 2u; /* the lowest with an inner block */
-        *leaf += lv == 0u && top >= 1u ? 1u : 0u;
-        *inner += top >= low ? top - low + 1u : 0u;
+        *inner += s >= lv + 2u ? s - lv - 1u : 0u; /* inner blocks at levels lv + 1 .. s - 1 */
         prev = code;
     }
 }
@@ -188,9 +203,9 @@ static void frame_need(const occ_map_t *const m, const occi_frame_t *const f,
 {
     *inner = 0u;
     *leaf = 0u;
-    stream_need(m, f->hits, f->nh, false, inner, leaf);
-    stream_need(m, f->voxels, f->nv, false, inner, leaf);
-    stream_need(m, f->nodes, f->nn, true, inner, leaf);
+    voxels_need(m, f->hits, f->nh, inner, leaf);
+    voxels_need(m, f->voxels, f->nv, inner, leaf);
+    nodes_need(m, f->nodes, f->nn, inner);
 }
 
 /* One voxel entry on the path (apply_batch's step): true when its value changed. */
