@@ -213,11 +213,12 @@ static void test_end_points_never_free(void **state)
                                       2u, 1.0f / 5000.0f};
         const occ_proj_camera_t k = camera_of(&f[i].pose, cam.fx, cam.fy, cam.cx, cam.cy, 0.3f,
                                               5.0f);
-        occ_vec3_t *pts = NULL;
-        const size_t np = projref_end_points(&pim, &k, &pts);
+        occ_key_t *pts = NULL;
+        const size_t np = projref_end_keys(&map_a, &pim, &k, &pts);
         size_t bad = 0;
         for (size_t p = 0; p < np; p++) {
-            bad += occ_map_state_at(&map_a, pts[p]) != OCC_STATE_OCCUPIED ? 1u : 0u;
+            const occ_vec3_t c = occ_map_key_center(&map_a, pts[p], 0u);
+            bad += occ_map_state_at(&map_a, c) != OCC_STATE_OCCUPIED ? 1u : 0u;
         }
         free(pts);
         printf("  frame %zu: %zu end points, %zu not occupied, %zu free voxels, %zu whole nodes\n",
@@ -312,7 +313,12 @@ static void fill_tof(void)
             tof[v][u] = 2.0f;
         }
     }
-    tof[2][5] = NAN;       /* no reading */
+    for (unsigned v = 1; v <= 3u; v++) { /* a 3 x 3 block without readings around zone (5, 2) */
+        for (unsigned u = 4; u <= 6u; u++) {
+            tof[v][u] = NAN;
+        }
+    }
+    tof[5][6] = NAN;       /* an isolated zone without a reading: its neighbours' depth frees */
     tof[6][1] = INFINITY;  /* no return within range */
 }
 
@@ -328,7 +334,7 @@ static void test_tof_8x8(void **state)
         occ_depth_result_t r;
         frame_equals_oracle(&im, &tof_dp, &pose, &r);
         assert_int_equal(r.pixels_sampled, 64);
-        assert_int_equal(r.pixels_no_reading, 1);
+        assert_int_equal(r.pixels_no_reading, 10);
         assert_int_equal(r.pixels_beyond_max, 1);
         /* By hand: straight ahead at 1 m is free, the wall at 2 m occupied, behind it unknown. */
         const occ_vec3_t ahead = {pose.p.x + 1.0f, pose.p.y, pose.p.z};
@@ -338,16 +344,24 @@ static void test_tof_8x8(void **state)
         assert_int_equal(occ_map_state_at(&map_a, ahead), OCC_STATE_FREE);
         assert_int_equal(occ_map_state_at(&map_a, wall), OCC_STATE_OCCUPIED);
         assert_int_equal(occ_map_state_at(&map_a, behind), OCC_STATE_UNKNOWN);
-        /* Zone (5, 2) has no reading: its centre ray at 1 m stays unknown (the zone is 0.1 m
-         * wide there: checked where a voxel is smaller). */
+        /* Zone (5, 2) and its four neighbours have no reading: its centre ray at 1 m stays
+         * unknown; zone (6, 5) has none but its neighbours read 2 m: free at 1 m (the zone is
+         * 0.1 m wide there: checked where a voxel is smaller). */
         const float zx = (5.0f - 3.5f) / 9.656854f, zy = (2.0f - 3.5f) / 9.656854f;
         const occ_vec3_t nz = {pose.p.x + 1.0f, pose.p.y - zx, pose.p.z - zy};
+        const float fx_ = (6.0f - 3.5f) / 9.656854f, fy_ = (5.0f - 3.5f) / 9.656854f;
+        const occ_vec3_t filled = {pose.p.x + 1.0f, pose.p.y - fx_, pose.p.z - fy_};
         if (res[i] < 0.06f) {
             assert_int_equal(occ_map_state_at(&map_a, nz), OCC_STATE_UNKNOWN);
+            assert_int_equal(occ_map_state_at(&map_a, filled), OCC_STATE_FREE);
         }
-        /* Behind the camera: unknown. */
+        /* Behind the camera: unknown. The camera's own voxel: free (the near rays start there,
+         * as OctoMap's rays do); beside the camera, outside the field of view: unknown. */
         const occ_vec3_t back = {pose.p.x - 0.5f, pose.p.y, pose.p.z};
         assert_int_equal(occ_map_state_at(&map_a, back), OCC_STATE_UNKNOWN);
+        assert_int_equal(occ_map_state_at(&map_a, pose.p), OCC_STATE_FREE);
+        const occ_vec3_t side = {pose.p.x, pose.p.y + 0.5f, pose.p.z};
+        assert_int_equal(occ_map_state_at(&map_a, side), OCC_STATE_UNKNOWN);
         assert_int_equal(leak_check(&map_a), 0);
         assert_int_equal(leak_check(&map_b), 0);
     }

@@ -257,67 +257,96 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * The rule, per voxel (exact; the walk only decides whole nodes where every voxel below would
  * get the same answer, so the result equals applying it to every voxel of the map):
  *  - pixel depth d (metres along z): U16 raw * depth_scale_m (raw 0: no reading); F32 as given
- *    (0, NaN, negative, -Inf: no reading; +Inf or > 1024 max_range_m: d = 2 max_range_m). A
- *    pixel (i, j) back-projects to c = ((i - cx) * d / fx, (j - cy) * d / fy, d) (float, left to
- *    right); |c|^2 (float) not finite: no reading; |c| < min_range_m: no reading (blind zone);
+ *    (0, NaN, negative, -Inf: no reading; +Inf or > 1024 max_range_m: d = 2 max_range_m). Pixel
+ *    (i, j) has the ray a_i = (i - cx) / fx, b_j = (j - cy) / fy and the camera-frame point
+ *    c = (a_i d, b_j d, d) with |c|^2 = (d d) (a_i a_i + (b_j b_j + 1)) (float, as written);
+ *    |c|^2 not finite: no reading; |c|^2 < min_range_m^2: no reading (blind zone);
  *  - the voxel's centre C (OctoMap's float centre per axis) goes to the camera frame:
  *    w = C - t, q_k = r[0][k] w_0 + r[1][k] w_1 + r[2][k] w_2 (float, left to right), and its
  *    pixel is i = floor(fx * (q_0 / q_2) + cx + 0.5), j = floor(fy * (q_1 / q_2) + cy + 0.5);
+ *  - the free test's depth of a pixel: its reading d; a pixel with no reading takes the
+ *    smallest reading among its four neighbours (left, right, up, down) that have one, so that a
+ *    single-pixel gap (a speckle of the sensor) is decided by the readings around it as ray
+ *    casting decides it by the neighbouring rays; with none it stays without;
  *  - the voxel is FREE (cfg.miss) iff q_2 > 0, (i, j) is inside the image, that pixel has a
- *    reading with depth d, q_2 < T(d) = (1 - noise_rel) * d - m0 (float) and
+ *    free-test depth d, q_2 < T(d) = (1 - noise_rel) * d (float) and
  *    q_0^2 + q_1^2 + q_2^2 <= max_range_m^2 (float): strictly in front of the surface by the
- *    margin m(d) = m0 + noise_rel * d, m0 = 0.8660254f * cfg.resolution_m (half the voxel diagonal: a pixel's own
- *    end voxel is never free by that pixel), noise_rel the caller's depth noise (fraction of d);
- *  - the voxel is OCCUPIED (cfg.hit) iff it holds the end point p = r c + t (float, left to right)
- *    of some pixel with a reading and |c| <= max_range_m; hits win over FREE (OctoMap's rule);
+ *    margin m(d) = noise_rel * d, the caller's depth noise as a fraction of d
+ *    (occ_insert_params_t.proj_noise_rel). There is no resolution term: a voxel that holds the
+ *    surface holds end points and is OCCUPIED (hits win), and the voxel in front of it is free,
+ *    as ray casting makes it (a half-voxel margin left a shell of unknown voxels in front of
+ *    every surface, which an obstacle feed reports as "no data");
+ *  - near field: it is FREE too when one of the near rays crosses it: from the camera t along
+ *    every step-th pixel of each row and column and the last one (step = min(fx, fy) / 32
+ *    truncated, at least 1: a ray every ~1.8 degrees) that has a free-test depth d, to depth
+ *    z = min(T(d), 4 voxels) (the end e = (r (a_i, b_j, 1)) z + t, float), the voxels
+ *    occ_ray_keys(t, e) gives (the camera's voxel first, the end's excluded; none when e is off
+ *    the map). Within a few voxels of the camera a voxel is large against the frustum, so most
+ *    voxels there have their centre outside the image though the camera's rays cross them;
+ *  - the voxel is OCCUPIED (cfg.hit) iff it is the end voxel of some pixel with a reading and
+ *    |c|^2 <= max_range_m^2: the voxel of the point t + r c, computed from the camera's voxel
+ *    in float so that every pixel costs a few vector operations: per map axis a,
+ *    key_a = kt_a + floor(d (U_a(i) + V_a(j)) + F_a) with U_a(i) = (r[a][0] a_i) rf,
+ *    V_a(j) = (r[a][1] b_j + r[a][2]) rf, rf = (float)(1 / res), kt the camera's key and
+ *    F_a = (float)(t_a / res - floor(t_a / res)) (the map's key arithmetic: double on hosts).
+ *    That is the map key of t + r c up to float rounding relative to the distance (below 1e-6
+ *    of a voxel per voxel of distance); an end point outside the map, or farther than 2^22
+ *    voxels, marks nothing (points_skipped). Hits win over FREE (OctoMap's rule);
  *  - every other voxel is unchanged: behind or within the margin of its pixel's surface, at
- *    "no reading" pixels (never free: unknown stays unknown), outside the image (the border is
- *    the pixel grid: centre rounding to a pixel outside [0, width) x [0, height)), behind the
- *    camera, beyond max range. At a depth discontinuity each voxel follows its own centre's
+ *    pixels without a free-test depth (never free: unknown stays unknown), outside the image
+ *    (the border is the pixel grid: centre rounding to a pixel outside [0, width) x [0, height))
+ *    and not crossed by a near ray, behind the camera, beyond max range. At a depth discontinuity each voxel follows its own centre's
  *    pixel: a voxel whose centre projects onto the far side is free even if a near pixel's end
  *    point is next to it (unless it holds that end point: then it is hit).
  *  A pixel beyond max range (|c| > max_range_m) marks no hit and frees up to max range.
- * Differences to ray casting (OctoMap insertPointCloud): voxels are decided by their centres,
- * not by the rays crossing them: a voxel crossed by a ray but whose centre's pixel reads nearer
- * (grazing surfaces, discontinuities), and the voxels around the camera whose centres lie
- * behind it or outside the image, stay unchanged; a voxel no ray crosses whose centre is in
- * front of its pixel's surface is free.
+ * Differences to ray casting (OctoMap insertPointCloud): beyond the near field voxels are
+ * decided by their centres, not by the rays crossing them: a voxel crossed by a ray but whose
+ * centre's pixel reads nearer (grazing surfaces, discontinuities) or has no reading (gaps wider
+ * than a pixel), and the frustum's boundary voxels whose centres lie outside the image, stay
+ * unchanged; a voxel no ray crosses whose centre is in front of its pixel's surface is free.
+ * Measured against OctoMap in `make bench` (bench/projective.cpp) and in the loop demo.
  *
- * Writes: whole free nodes through the coarse applier (every voxel below gets cfg.miss once),
- * voxels through occ_map_observe_codes: each voxel is updated at most once per call. The pool
- * check covers both before anything is written (a bound as if no node on the paths existed, so
- * it may refuse with OCC_ERR_NOMEM when a tight pool would have sufficed); any error: the map
- * is unchanged.
+ * Writes: hits, free voxels and whole free nodes (every voxel below gets cfg.miss once) in one
+ * pass over the tree in Morton order; each voxel is updated at most once per call. The pool
+ * check comes first (a bound as if no node on the paths existed, so it may refuse with
+ * OCC_ERR_NOMEM when a tight pool would have sufficed); any error: the map is unchanged.
  *
  * Scratch (caller's, any alignment): a fixed part (OCC_PROJ_FIXED_BYTES: alignment, an 8 KiB
- * repeat filter for end points, the radix sort's histograms, the call's context and the
- * walk's per-level constants and stack (4 KiB, kept off the stack)), 4 bytes per pixel (the depths), 8 bytes per pyramid cell
- * (min and max, levels 1.. of halved sides: at most OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells) and the output, in 8-byte slots: the end
- * points' codes after the repeat filter (twice while they are sorted), then one per voxel
- * update and two per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it for n_out
- * slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers the TUM frames in
- * `make bench` (measured at most 0.47 slots per pixel: the pioneer frames at 0.05 m, every pixel
- * a hit; bench/projective.cpp prints what they used) and an 8x8 ToF array at 0.05 m to 3 m
- * (tests/test_projective.c). For 640 x 480 the whole formula is 11.3 bytes per
- * pixel. A frame that needs more slots is refused with OCC_ERR_SCRATCH (map unchanged): pass
- * more. out->insert.scratch_used says what a call used.
+ * repeat filter for end points, the radix sort's histograms, the call's context, the walk's
+ * per-level constants and stack and the 64-voxel rule's lane arrays (6 KiB, kept off the
+ * stack)), 4 bytes per pixel (the
+ * depths), 8 bytes per pyramid cell (min and max, levels 1.. of halved sides: at most
+ * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells), 48 bytes per image column (the pixel
+ * pass's per-column tables and row buffers, OCC_PROJ_COLUMN_BYTES) and the output, in 8-byte
+ * slots: the end points' codes after the repeat filter (twice while they are sorted), the near
+ * rays' voxels (twice while sorted; ~5,000 for a 640 x 480 Kinect frame), then one per voxel
+ * update and one per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it
+ * for n_out slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers the TUM frames in
+ * `make bench` (bench/projective.cpp prints what they used) and an 8x8 ToF array at 0.05 m to
+ * 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 11.4 bytes per pixel, of
+ * which a frame of the pioneer sequence used at most 10.2. A frame that needs more slots is
+ * refused with OCC_ERR_SCRATCH (map unchanged): pass more. out->insert.scratch_used says what
+ * a call used.
  *
- * Work, bounded per call: O(pixels) for the pyramid; the walk tests a node in O(1) (8 corner
- * projections, at most 4 pyramid cells) and descends only where its answer is mixed, so it
- * visits at most 8 D + 8 (undecided nodes) nodes: in the worst case (a noisy surface filling
- * the frustum) every voxel of the frustum within max range; each undecided level-1 node also
- * scans the pixels of its footprint for end points. Typical: proportional to the surface's
- * voxels, not pixels x ray length. Stack: O(D), no recursion. */
+ * Work, bounded per call: O(pixels) for the pixel pass (depths, end points), the gap filling
+ * and the pyramid; the near rays (about (32 w / f) (32 h / f) rays of at most 4 sqrt(3) + 3
+ * voxels each); the walk tests a node in O(1) (8 corner projections, at most 4 pyramid cells)
+ * and descends only where its answer is mixed, down to level 2, whose 64 voxels it decides at
+ * once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a noisy surface filling the
+ * frustum) every voxel of the frustum within max range. Typical: proportional to the surface's
+ * voxels, not pixels x ray length. Then one pass over the tree. Stack: O(D), no recursion. */
 #define OCC_PROJ_CELLS(w, h) \
     ((size_t)(w) * (size_t)(h) / 3u + (size_t)(w) + (size_t)(h) + 20u)
 #define OCC_PROJ_LEVELS_BYTES 2048u /* the walk's per-level constants (kept off the stack) */
 #define OCC_PROJ_CTX_BYTES 2048u    /* the call's context and walk stack (kept off the stack) */
+#define OCC_PROJ_BULK_BYTES 2048u   /* the 64-voxel rule's lane arrays (kept off the stack) */
 #define OCC_PROJ_FIXED_BYTES                                                               \
     (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u + \
-     OCC_PROJ_LEVELS_BYTES + OCC_PROJ_CTX_BYTES)
-#define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                               \
-    (OCC_PROJ_FIXED_BYTES + 8u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
-     8u * (size_t)(n_out))
+     OCC_PROJ_LEVELS_BYTES + OCC_PROJ_CTX_BYTES + OCC_PROJ_BULK_BYTES)
+#define OCC_PROJ_COLUMN_BYTES(w) (48u * (size_t)(w) + 256u)
+#define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                                 \
+    (OCC_PROJ_FIXED_BYTES + 48u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
+     OCC_PROJ_COLUMN_BYTES(w) + 8u * (size_t)(n_out))
 #define OCC_PROJ_OUT_DEFAULT(w, h) ((size_t)(w) * (size_t)(h) / 2u + 16384u)
 
 typedef enum {
@@ -346,7 +375,7 @@ typedef struct {
     occ_vec3_t t;
     float min_range_m;          /* finite >= 0 */
     float max_range_m;          /* finite > min_range_m */
-    float noise_rel;            /* [0, 0.5]: margin m(d) = 0.866 res + noise_rel * d */
+    float noise_rel;            /* [0, 0.5]: margin in front of a surface m(d) = noise_rel * d */
 } occ_proj_camera_t;
 
 typedef struct {
@@ -376,9 +405,11 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
  *   occ_map_insert_cloud, occ_map_insert_rays: stack <= 1,472 / 1,536 B; work: n_points rays x <= 3
  *       (ceil(max_ray / res) + 2) + 2 voxels, then one path per distinct voxel
- *   occ_map_insert_projective: stack <= 832 / 832 B (its context, tables and walk stack are
- *       in the scratch); work: O(pixels) for the pyramid and end points, the walk as stated above
- *       (at most every voxel of the frustum within max range), then the tree update
+ *   occ_map_insert_projective: stack <= 1,152 / 1,152 B (its context, tables, walk stack and
+ *       lane arrays are in the scratch; the deepest chain is the tree pass updating a whole
+ *       node's subtree); work: O(pixels) for the pixel pass, gap filling and pyramid, the near
+ *       rays, the walk as stated above (at most every voxel of the frustum within max range),
+ *       then one pass over the tree
  *   occ_ray_keys: stack <= 384 / 512 B; work: <= occ_ray_max_keys() keys, no map access
  *   occ_insert_scratch_bytes_scan: stack <= 256 / 320 B; work: O(n_points) (FAST_DISCRETE: + its
  *       coarse box)

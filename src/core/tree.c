@@ -8,6 +8,7 @@
  */
 #include "shared_internal.h"
 #include "tree_internal.h"
+#include "tree_path.h"
 
 /* ---- node helpers --------------------------------------------------------------------------- */
 
@@ -217,69 +218,6 @@ occ_err_t occ_map_read(const occ_map_t *const map, const occ_vec3_t p, const uns
 }
 
 /* ---- batch updates ---------------------------------------------------------------------------- */
-
-/* The path of the current code: node[l] for l in [low, D]; node[D] is the root. */
-typedef struct {
-    occ_nodep_t node[OCC_MAX_DEPTH + 1];
-    bool dirty[OCC_MAX_DEPTH + 2];
-    unsigned low;
-    /* count_blocks: a copy of the root, where its read-only path starts (the map stays const) */
-    uint32_t root_child;
-    occ_value_t root_value;
-    uint8_t root_flags;
-} path_t;
-
-/* Lowest level whose node contains both codes. */
-static unsigned split_level(const occ_code_t a, const occ_code_t b)
-{
-    occ_code_t x = (a ^ b) & ~OCC_CODE_HIT_BIT;
-    if (x == 0u) {
-        return 1u;
-    }
-#if defined(__GNUC__)
-    const unsigned h = 63u - (unsigned)__builtin_clzll((unsigned long long)x);
-#else
-    unsigned h = 0;
-    while (x > 1u) {
-        x >>= 1;
-        h++;
-    }
-#endif
-    return h / 3u + 1u;
-}
-
-/* Descend from node[start] along `code` while nodes have inner children; stops at level 1 or at
- * a uniform node. Returns the voxel's value and sets *stop: 0 when it lies in a leaf block,
- * else the level of the uniform node holding it. */
-static occ_value_t descend(const occ_map_t *const m, path_t *const p, const occ_code_t code,
-                           unsigned start, unsigned *const stop)
-{
-    unsigned l = start;
-    while (l > 1u && *p->node[l].child != OCC_NONE) {
-        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
-        l--;
-    }
-    p->low = l;
-    if (*p->node[l].child != OCC_NONE) { /* l == 1 with a leaf block */
-        *stop = 0u;
-        return occ_leaf_at(m, *p->node[1].child)->value[occ_code_slot(code, 1u)];
-    }
-    *stop = l;
-    return *p->node[l].value;
-}
-
-/* Refresh dirty nodes from p->low up to level `top` (inclusive), marking parents dirty. */
-static void refresh_up_to(occ_map_t *const m, path_t *const p, const unsigned top)
-{
-    for (unsigned l = p->low; l <= top; l++) {
-        if (p->dirty[l]) {
-            p->dirty[l] = false;
-            if (occi_tree_refresh(m, p->node[l], l)) {
-                p->dirty[l + 1u] = true;
-            }
-        }
-    }
-}
 
 typedef enum { DELTA_TAGGED, DELTA_FIXED } delta_mode_t;
 

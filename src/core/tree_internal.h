@@ -306,4 +306,29 @@ bool occi_tree_refresh(occ_map_t *m, occ_nodep_t node, unsigned level);
  * call chains, make cross). */
 bool occi_map_config_ok(const occ_map_config_t *cfg);
 
+/* Add `delta` to every voxel below the node at `level` >= 1 (tree_frame.c): a uniform node in
+ * O(1), else its subtree, refreshed bottom-up (values, flags, pruning). Allocates nothing. */
+void occi_tree_apply_subtree(occ_map_t *m, occ_nodep_t node, unsigned level, occ_delta_t delta);
+
+/* One frame's updates, each stream sorted by code: voxel hits (hit bit set, unique), voxel
+ * updates by voxel_delta (unique; a code that is also a hit is a hit), and whole nodes, each
+ * the code of its first voxel with the marker bit 3 level - 1 set (level >= 1), every voxel
+ * below getting node_delta once. No entry may lie inside a whole node. */
+typedef struct {
+    const occ_code_t *hits, *voxels, *nodes;
+    size_t nh, nv, nn;
+    occ_delta_t voxel_delta, node_delta;
+} occi_frame_t;
+
+/* Counters of occi_tree_apply_frame: voxel values changed, voxel updates dropped because the
+ * voxel is a hit. */
+typedef struct {
+    size_t changed, dropped;
+} occi_frame_out_t;
+
+/* Apply a frame in one pass (tree_frame.c): first a bound of the blocks it can allocate (as if
+ * no node existed) against the pools: OCC_ERR_NOMEM (oom_count bumped, nothing written), else
+ * every update, refreshing and pruning as it goes. O(entries x depth). */
+occ_err_t occi_tree_apply_frame(occ_map_t *m, const occi_frame_t *f, occi_frame_out_t *out);
+
 #endif /* OCC_TREE_INTERNAL_H_INCLUDED */

@@ -37,70 +37,10 @@ void occi_coarse_need(const occ_code_t *const codes, const size_t n, const unsig
     *leaf = lf;
 }
 
-/* Apply to a node's value (a uniform node). */
-static void apply_uniform(occ_map_t *const m, const occ_nodep_t node, const occ_value_t delta)
-{
-    *node.value = occ_value_apply_delta(m, *node.value, delta);
-    *node.flags = occ_value_flags(m, *node.value);
-    occ_touch_node(m, node);
-}
-
 /* A node by where it lives: slot `slot` of inner block `block`, or the root (block OCC_NONE). */
 static occ_nodep_t node_at(occ_map_t *const m, const uint32_t block, const unsigned slot)
 {
     return block == OCC_NONE ? occ_root(m) : occ_inner_node(m, block, slot);
-}
-
-/* Every voxel below the node (level >= 1) gets delta; values and flags refreshed bottom-up. */
-static void apply_subtree(occ_map_t *const m, const uint32_t block, const unsigned slot,
-                          const unsigned level, const occ_value_t delta)
-{
-    OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
-    const occ_nodep_t top = node_at(m, block, slot);
-    if (*top.child == OCC_NONE) {
-        apply_uniform(m, top, delta);
-        return;
-    }
-    struct {
-        uint32_t block; /* where the node lives */
-        uint8_t slot, level, next;
-    } stack[OCC_MAX_DEPTH + 1u];
-    unsigned sp = 1;
-    stack[0].block = block;
-    stack[0].slot = (uint8_t)slot;
-    stack[0].level = (uint8_t)level;
-    stack[0].next = 0;
-    while (sp > 0u) {
-        const unsigned t = sp - 1u;
-        const occ_nodep_t nd = node_at(m, stack[t].block, stack[t].slot);
-        if (stack[t].level == 1u) {
-            occ_leaf_block_t *const b = occ_leaf_at(m, *nd.child);
-            for (unsigned i = 0; i < 8u; i++) {
-                b->value[i] = occ_value_apply_delta(m, b->value[i], delta);
-            }
-            occi_shared_touch(m, b, sizeof *b);
-            (void)occi_tree_refresh(m, nd, 1u);
-            sp--;
-            continue;
-        }
-        if (stack[t].next == 8u) {
-            (void)occi_tree_refresh(m, nd, stack[t].level);
-            sp--;
-            continue;
-        }
-        const unsigned s = stack[t].next++;
-        const occ_nodep_t c = occ_inner_node(m, *nd.child, s);
-        if (*c.child == OCC_NONE) {
-            apply_uniform(m, c, delta);
-        } else {
-            OCC_ASSERT(sp <= OCC_MAX_DEPTH);
-            stack[sp].block = *nd.child;
-            stack[sp].slot = (uint8_t)s;
-            stack[sp].level = (uint8_t)(stack[t].level - 1u);
-            stack[sp].next = 0;
-            sp++;
-        }
-    }
 }
 
 /* Refresh the path's nodes at levels from..to (bottom-up). */
@@ -141,7 +81,8 @@ size_t occi_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, cons
             }
             blk[l - 1u] = *nd.child;
         }
-        apply_subtree(m, blk[level], occ_code_slot(c, level + 1u), level, delta);
+        occi_tree_apply_subtree(m, node_at(m, blk[level], occ_code_slot(c, level + 1u)), level,
+                                delta);
         prev = c;
     }
     if (n > 0u) {

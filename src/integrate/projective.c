@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* projective.c - occ_map_insert_projective(): check the call, lay out the scratch, build the
  * pyramid, walk, then the all-or-nothing pool check and the writes (whole free nodes through
- * the coarse applier, voxels through the batch applier). */
+ * the core's frame pass: hits, free voxels and whole nodes merged in one walk of the tree). */
 #include <math.h>
 #include <string.h>
 
 #include "projective_internal.h"
-#include "coarse_internal.h"
+#include "../core/tree_internal.h"
 
 /* The header's fixed term names the filter's 8 KiB. */
 typedef char proj_filter_matches_header[OCC_PROJ_FILTER_N * 8u == 8192u ? 1 : -1];
@@ -54,6 +54,9 @@ static bool camera_ok(const occ_proj_camera_t *k)
     return isfinite(t.x) && isfinite(t.y) && isfinite(t.z) && rotation_ok(k->r);
 }
 
+/* The bulk rule's lane arrays too (OCC_PROJ_BULK_BYTES), 8-byte aligned after the tables. */
+typedef char occ_proj_bulk_fit[sizeof(occ_proj_bulk_t) <= OCC_PROJ_BULK_BYTES && OCC_PROJ_LEVELS_BYTES % 8u == 0u ? 1 : -1];
+
 /* The per-level tables live in the scratch's fixed part (OCC_PROJ_FIXED_BYTES counts
  * OCC_PROJ_LEVELS_BYTES for them): a C99 static assertion that they fit. */
 typedef char occ_proj_levels_fit[sizeof(occ_proj_levels_t) <= OCC_PROJ_LEVELS_BYTES ? 1 : -1];
@@ -61,19 +64,23 @@ typedef char occ_proj_levels_fit[sizeof(occ_proj_levels_t) <= OCC_PROJ_LEVELS_BY
 typedef char occ_proj_ctx_fit[sizeof(occ_proj_t) <= OCC_PROJ_CTX_BYTES && OCC_PROJ_CTX_BYTES % 8u == 0u ? 1 : -1];
 
 /* Carve the scratch: the filter and the sort's histograms (8-byte aligned), the depths and
- * the pyramid (floats), then the output (8-byte codes). false when it cannot hold all that and
- * one output slot. */
+ * the pyramid (floats), the pixel pass's tables (16-byte aligned), then the output (8-byte
+ * codes). false when it cannot hold all that and one output slot. */
 static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
 {
     if (scratch == NULL) {
         return false;
     }
     const uintptr_t a = (uintptr_t)scratch;
-    const size_t skip = (size_t)((8u - (a & 7u)) & 7u);
-    const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u + OCC_PROJ_LEVELS_BYTES;
+    const size_t skip = (size_t)((16u - (a & 15u)) & 15u);
+    const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u + OCC_PROJ_LEVELS_BYTES +
+                         OCC_PROJ_BULK_BYTES;
     const size_t px = (size_t)x->im->width * x->im->height;
-    const size_t floats = 4u * px + occi_proj_pyramid_bytes(x->im->width, x->im->height);
-    const size_t head = skip + fixed + ((floats + 7u) & ~(size_t)7u);
+    /* level 0 plus 4 floats: the row loop writes up to 3 past a row (the next row's, later
+     * rewritten; past the last row: this pad) */
+    const size_t floats = 4u * px + 16u + occi_proj_pyramid_bytes(x->im->width, x->im->height);
+    const size_t tables = skip + ((fixed + floats + 15u) & ~(size_t)15u);
+    const size_t head = tables + occi_proj_pixels_bytes(x->im->width);
     if (bytes < head + 8u) {
         return false;
     }
@@ -81,79 +88,54 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     x->filter = (occ_code_t *)(void *)base;
     x->hist = (uint32_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u);
     x->lv = (occ_proj_levels_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u);
-    *mem = (float *)(void *)(base + fixed);
+    x->bulk = (occ_proj_bulk_t *)(void *)((unsigned char *)x->lv + OCC_PROJ_LEVELS_BYTES);
+    x->d0 = (float *)(void *)(base + fixed);
+    *mem = x->d0 + px + 4u;
+    occi_proj_pixels_carve(x, (unsigned char *)scratch + tables);
     x->out = (occ_code_t *)(void *)((unsigned char *)scratch + head);
     x->cap = (bytes - head) / 8u;
     x->r->insert.scratch_used = head;
     return true;
 }
 
-/* Group the whole free nodes by level into the free gap between the two output ends (each
- * group stays in walk order: sorted; group l from x->start[l]). Returns the group array, or
- * NULL when the gap is short. Out of line: its fill counters stay off the stack of apply's
- * tree update (make cross). */
-OCC_NOINLINE static occ_code_t *group_nodes(occ_proj_t *x)
+/* The whole free nodes came from the back of the output in walk order: reversed in place they
+ * are sorted by code. */
+static const occ_code_t *sorted_nodes(occ_proj_t *x)
 {
-    size_t *const start = x->start;
-    if (x->cap - x->nh - x->nv - x->nn < x->nn) {
-        return NULL;
+    occ_code_t *const n = x->out + x->cap - x->nn;
+    for (size_t i = 0, j = x->nn; i + 1u < j; i++, j--) {
+        const occ_code_t t = n[i];
+        n[i] = n[j - 1u];
+        n[j - 1u] = t;
     }
-    occ_code_t *const g = x->out + x->nh + x->nv;
-    start[0] = 0;
-    for (unsigned l = 0; l <= OCC_MAX_DEPTH; l++) {
-        start[l + 1u] = start[l] + x->per_level[l];
-    }
-    size_t fill[OCC_MAX_DEPTH + 1u];
-    memcpy(fill, start, sizeof fill);
-    for (size_t n = 1; n <= x->nn; n++) {
-        const occ_code_t e = x->out[x->cap - n];
-        const unsigned l = ((unsigned)__builtin_ctzll(e) + 1u) / 3u; /* the marker bit */
-        g[fill[l]++] = e & ~(((occ_code_t)1 << (3u * l)) - 1u);
-    }
-    return g;
+    return n;
 }
 
-/* The pool check for every write of the call (bounds as if no node existed), then the writes. */
-static occ_err_t apply(occ_proj_t *x, const occ_code_t *g)
+/* The writes: hits, free voxels and whole free nodes in one pass over the tree (its pool check
+ * first: a bound as if no node on the paths existed), one version of a shared map. */
+static occ_err_t apply(occ_proj_t *x)
 {
-    const size_t *const start = x->start;
     occ_map_t *const m = x->map;
-    const unsigned depth = m->cfg.depth_levels;
-    uint64_t inner = 0, leaf = 0, i, f;
-    for (unsigned l = 1; l < depth; l++) {
-        occi_coarse_need(g + start[l], x->per_level[l], l, depth, &i, &f);
-        inner += i;
-        leaf += f;
-    }
-    occ_code_t *const fv = x->out + x->nh;
-    occi_coarse_need(fv, x->nv, 0u, depth, &i, &f);
-    inner += i;
-    leaf += f;
-    occi_coarse_need(x->out, x->nh, 0u, depth, &i, &f);
-    inner += i;
-    leaf += f;
-    if (inner > OCC_NONE || leaf > OCC_NONE ||
-        !occi_pool_can_supply(m, (uint32_t)inner, (uint32_t)leaf)) {
-        m->oom_count++;
-        return OCC_ERR_NOMEM;
-    }
-    const occ_value_t miss = occ_value_from_logodds(m->cfg.miss);
-    /* A shared map publishes the frame's coarse and voxel updates as one version. */
+    occi_frame_t f;
+    f.hits = x->out;
+    f.nh = x->nh;
+    f.voxels = x->out + x->nh + x->nr;
+    f.nv = x->nv;
+    f.nodes = sorted_nodes(x);
+    f.nn = x->nn;
+    f.voxel_delta = occi_delta_from_logodds(m->cfg.miss);
+    f.node_delta = f.voxel_delta;
     const bool shared = m->priv.shared != NULL && occ_map_write_begin(m) == OCC_OK;
-    for (unsigned l = depth - 1u; l >= 1u; l--) {
-        x->r->insert.coarse_updated +=
-            occi_coarse_apply(m, g + start[l], x->per_level[l], l, miss);
-    }
-    size_t changed = 0, changed_hits = 0;
-    occ_err_t e = occ_map_observe_codes(m, fv, x->nv, &changed);
-    if (e == OCC_OK) {
-        e = occ_map_observe_codes(m, x->out, x->nh, &changed_hits);
-    }
-    OCC_ASSERT(e == OCC_OK); /* the check above covers both */
+    occi_frame_out_t fo;
+    const occ_err_t e = occi_tree_apply_frame(m, &f, &fo);
     if (shared) {
         (void)occ_map_write_end(m);
     }
-    x->r->insert.voxels_changed = changed + changed_hits;
+    occ_insert_result_t *const r = &x->r->insert;
+    r->voxels_free = x->nv - fo.dropped;
+    r->voxels_updated = r->voxels_free + x->nh;
+    r->voxels_changed = fo.changed;
+    r->coarse_updated = e == OCC_OK ? x->nn : 0u;
     return e;
 }
 
@@ -161,9 +143,7 @@ static occ_err_t apply(occ_proj_t *x, const occ_code_t *g)
 static void count_output(occ_proj_t *x)
 {
     occ_insert_result_t *const r = &x->r->insert;
-    r->voxels_free = x->nv;
     r->voxels_occupied = x->nh;
-    r->voxels_updated = x->nv + x->nh;
     r->voxel_visits = x->r->nodes_tested;
     r->rays_clipped = x->r->pixels_beyond_max;
     r->points_integrated = x->r->pixels - x->r->pixels_no_reading - x->r->pixels_too_close -
@@ -187,6 +167,18 @@ static occ_proj_t *context_in(void *scratch, const size_t bytes, size_t *used)
     return x;
 }
 
+/* The camera's voxel, its position in it (voxels) and the key side, for the end points. */
+static void camera_voxel(occ_proj_t *x, const float t[3], const uint32_t kt[3])
+{
+    x->rf = (float)x->g.rf;
+    x->kside = (int32_t)((uint32_t)1 << x->g.depth);
+    for (unsigned a = 0; a < 3u; a++) {
+        x->kcam[a] = (int32_t)kt[a];
+        const occ_rr_t s = (occ_rr_t)t[a] * x->g.rf - ((occ_rr_t)kt[a] - x->g.tmv_r);
+        x->kfrac[a] = (float)s;
+    }
+}
+
 /* Pyramid, end points, walk, then the writes, in the scratch after the context. */
 static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
 {
@@ -194,36 +186,38 @@ static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
     if (!carve(x, rest, rest_bytes, &mem)) {
         return OCC_ERR_SCRATCH;
     }
+    const bool hits_fit = occi_proj_pixels(x);
     occi_proj_build(x, mem);
-    const bool hits_fit = occi_proj_hits(x);
-    if (hits_fit) {
+    bool fit = hits_fit;
+    if (fit) {
+        occi_proj_hits_sort(x);
+        fit = occi_proj_near(x);
+    }
+    if (fit) {
         occi_proj_walk(x);
     }
-    const occ_code_t *const g = !hits_fit || x->overflow ? NULL : group_nodes(x);
-    const size_t slots = x->nh + x->nv + 2u * x->nn;
+    const size_t slots = x->nh + x->nr + x->nv + x->nn;
     x->r->insert.scratch_used += 8u * (slots > x->hwm ? slots : x->hwm);
-    if (g == NULL) {
+    if (!fit || x->overflow) {
         return OCC_ERR_SCRATCH;
     }
-    x->nv = occi_proj_drop_hits(x->out + x->nh, x->nv, x->out, x->nh);
     count_output(x);
-    return apply(x, g);
+    return apply(x);
 }
 
-/* The camera's voxel is in the map (occ_map_insert_projective refuses it otherwise, before it
- * needs any scratch). Out of line: its ray geometry is not needed again until the context
+/* The camera's voxel, or false off the map (occ_map_insert_projective refuses it then, before
+ * it needs any scratch). Out of line: its ray geometry is not needed again until the context
  * holds its own copy. */
 OCC_NOINLINE static bool camera_in_map(const occ_map_t *map, const occ_proj_camera_t *camera,
-                                       occ_raygeo_t *g)
+                                       occ_raygeo_t *g, uint32_t kt[3])
 {
     occi_raygeo_init(g, map);
     const float t[3] = {camera->t.x, camera->t.y, camera->t.z};
-    uint32_t kt[3];
     return occi_raygeo_key(g, t, kt);
 }
 
-/* The counters and the context live in the scratch (x->res, x->start): off the stack of the
- * tree update, the deepest chain of every integration (make cross). */
+/* The counters and the context live in the scratch (x->res): off the stack of the tree update,
+ * the deepest chain of every integration (make cross). */
 occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *image,
                                     const occ_proj_camera_t *camera, void *scratch,
                                     const size_t scratch_bytes, occ_proj_result_t *out)
@@ -235,7 +229,8 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
         return OCC_ERR_ARG;
     }
     occ_raygeo_t g;
-    if (!camera_in_map(map, camera, &g)) {
+    uint32_t kt[3];
+    if (!camera_in_map(map, camera, &g, kt)) {
         return OCC_ERR_RANGE;
     }
     const size_t pixels = (size_t)image->width * image->height;
@@ -254,10 +249,14 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
     x->res.pixels = pixels;
     x->g = g;
     x->max2 = camera->max_range_m * camera->max_range_m;
+    const float hit_m = OCC_PROJ_HIT_VOXELS * map->cfg.resolution_m;
+    x->max2_hit = x->max2 < hit_m * hit_m ? x->max2 : hit_m * hit_m;
     x->min2 = camera->min_range_m * camera->min_range_m;
     x->far = 1024.0f * camera->max_range_m;
     x->keep = 1.0f - camera->noise_rel;
-    x->m0 = 0.8660254f * map->cfg.resolution_m;
+    x->near_z = (float)OCC_PROJ_NEAR_VOXELS * map->cfg.resolution_m;
+    const float t[3] = {camera->t.x, camera->t.y, camera->t.z};
+    camera_voxel(x, t, kt);
     const occ_err_t e = run(x, (unsigned char *)scratch + used, scratch_bytes - used);
     x->res.insert.scratch_used += used;
     if (out != NULL) {

@@ -9,11 +9,31 @@
 
 #include "integrate_internal.h"
 
+/* A vectorisable loop kept out of line: inlined into its caller, GCC 12 drops the loop's
+ * restrict qualifiers and leaves it scalar. */
+#define OCC_PROJ_LANES OCC_NOINLINE
+
 /* Pyramid levels: level 0 is the image, each next one halves both sides (ceil) down to 1x1;
  * 65535 pixels per side need 17. */
 #define OCC_PROJ_MAX_LEVELS 18u
 /* Entries of the end points' repeat filter (direct mapped, 8 bytes each). */
 #define OCC_PROJ_FILTER_N 1024u
+/* An end point farther than this from the camera (in voxels: 2^22) is outside every map (keys
+ * have at most 21 bits, and one axis differs by more than 2^22 / sqrt(3) > 2^21); below it the
+ * key offsets from the camera's voxel convert to int32 without overflow. */
+#define OCC_PROJ_HIT_VOXELS 4194304.0f
+
+/* The pixel pass's per-column tables and row buffers (projective_pixels.c), in the scratch. */
+typedef struct {
+    float *asq;        /* a_i^2, a_i = (i - cx) / fx */
+    float *u[3];       /* r[a][0] a_i rf: the direction's column part per map axis, in voxels */
+    float *dr;         /* the row's depths (0: no reading) */
+    int32_t *kc[3];    /* this row's end-point key offsets from the camera's voxel (index -1 ok) */
+    int32_t *kp[3];    /* the previous row's */
+    int32_t *nw;       /* this row's "new voxel" flags (0 / 1), padded to a multiple of 4 */
+    occ_code_t last_code; /* the last emitted end point's code (0: none) and key */
+    uint32_t last_key[3];
+} occ_proj_pixels_t;
 
 /* One level of the walk's explicit stack: a node being opened and its next child slot. */
 typedef struct {
@@ -22,6 +42,18 @@ typedef struct {
     float cap;
     uint8_t level, next;
 } occ_proj_frame_t;
+
+/* Lanes of the bulk rule: the voxels of a level-2 node. */
+#define OCC_PROJ_BULK 64u
+/* The bulk rule's lane arrays (projective_bulk.c), in the scratch: 1.8 KB were too much for a
+ * firmware task's stack (make cross). */
+typedef struct {
+    float q[3][OCC_PROJ_BULK];  /* camera-frame centres */
+    float d[OCC_PROJ_BULK];     /* their pixels' depths */
+    uint32_t pix[OCC_PROJ_BULK];
+    int32_t in[OCC_PROJ_BULK], f[OCC_PROJ_BULK];
+    uint8_t free8[OCC_PROJ_BULK];
+} occ_proj_bulk_t;
 
 /* Per node level, the walk's constants (see occ_proj_t). */
 typedef struct {
@@ -36,13 +68,16 @@ typedef struct {
     const occ_proj_image_t *im;
     const occ_proj_camera_t *cam;
     float max2, min2;       /* squared ranges */
+    float max2_hit;         /* max2, at most (OCC_PROJ_HIT_VOXELS res)^2: end points beyond are outside */
     float far;              /* F32 depths beyond this are "no return" (2 max range) */
     float keep;             /* 1 - noise_rel */
-    float m0;               /* margin at depth 0: half the voxel diagonal */
-    float dmin, dmax;       /* smallest / largest depth with a reading (dmin > dmax: none) */
-    /* A depth d with near2 < d d < far2 back-projects (any pixel) to a squared range within
-     * [min2, max2] whatever the rounding: the exact range test can be skipped (the same answer). */
-    float near2, far2;
+    float dmax;             /* largest depth with a reading (-inf: none) */
+    float rf;               /* 1 / resolution (float) */
+    int32_t kcam[3];        /* the camera's voxel key */
+    float kfrac[3];         /* the camera's position within its voxel, in voxels [0, 1) */
+    int32_t kside;          /* 2^depth: keys are below it */
+    occ_proj_pixels_t px;
+    bool raw_lanes;         /* rows are plain uint16 arrays (U16, contiguous, aligned) */
     float *d0;              /* level 0: depth per pixel, -INFINITY = no reading */
     float *mn[OCC_PROJ_MAX_LEVELS], *mx[OCC_PROJ_MAX_LEVELS]; /* levels >= 1 */
     uint32_t lw[OCC_PROJ_MAX_LEVELS], lh[OCC_PROJ_MAX_LEVELS];
@@ -51,6 +86,7 @@ typedef struct {
     /* Per node level, the walk's constants (the same products test_node used to form per node):
      * the edge vectors s r[a] (camera frame) and the side planes' positive parts s pr[p][a]. */
     occ_proj_levels_t *lv;  /* in the caller's scratch (1.9 KB: off the stack for firmware) */
+    occ_proj_bulk_t *bulk;  /* in the caller's scratch too */
     float tabs;             /* |t.x| + |t.y| + |t.z| */
     float wf, hf;           /* image width and height as floats (exact) */
     float peps0;            /* 1e-5 (fx + fy + |cx| + |cy| + w + h) */
@@ -61,8 +97,11 @@ typedef struct {
     occ_code_t *out;
     size_t cap, nh, nv, nn, hwm;
     size_t hit_cur;         /* the walk's cursor over the sorted hits */
-    size_t per_level[OCC_MAX_DEPTH + 1u];
-    size_t start[OCC_MAX_DEPTH + 2u]; /* the free nodes grouped by level: group l from start[l] */
+    /* The near field's free voxels (projective_near.c): sorted codes after the hits, merged
+     * into the walk's output in code order by its cursor. */
+    const occ_code_t *near;
+    size_t nr, near_cur;
+    float near_z;           /* the near rays' depth: OCC_PROJ_NEAR_VOXELS voxels */
     bool overflow;
     occ_proj_result_t *r;   /* = &res */
     occ_proj_result_t res;  /* the call's counters, copied out at the end */
@@ -73,35 +112,49 @@ typedef struct {
  * so the pyramid's min and max bound it). */
 static inline float occ_proj_front(const occ_proj_t *x, const float d)
 {
-    return x->keep * d - x->m0;
-}
-
-/* Camera-frame back-projection of pixel (i, j) at depth d (the header's arithmetic). */
-static inline void occ_proj_back(const occ_proj_camera_t *k, const uint32_t i, const uint32_t j,
-                                 const float d, float c[3])
-{
-    c[0] = ((float)i - k->cx) * d / k->fx;
-    c[1] = ((float)j - k->cy) * d / k->fy;
-    c[2] = d;
+    return x->keep * d;
 }
 
 /* Bytes the pyramid levels >= 1 take (min and max) and their layout for a w x h image. */
 size_t occi_proj_pyramid_bytes(uint32_t w, uint32_t h);
-/* Level 0 from the image (counters in x->r), then the pyramid; d0 and the level arrays are
- * laid out from `mem` (4-byte aligned, w h + 2 cells floats). */
+/* Bytes of the pixel pass's tables and row buffers for an image `w` pixels wide. */
+size_t occi_proj_pixels_bytes(uint32_t w);
+/* Lay them out from `mem` (16-byte aligned, occi_proj_pixels_bytes(w) bytes). */
+void occi_proj_pixels_carve(occ_proj_t *x, unsigned char *mem);
+/* The pixel pass: level 0 (x->d0), the counters, and the end points' codes, filtered, in
+ * out[0..nh) (unsorted); false when the output cannot hold them and the sort's temporary. */
+bool occi_proj_pixels(occ_proj_t *x);
+/* Level 0's single-pixel gaps closed for the free test (projective_fill.c), in place, with
+ * occi_proj_fill_bytes(w) bytes of rows at `mem` (4-byte aligned). */
+size_t occi_proj_fill_bytes(uint32_t w);
+void occi_proj_fill(occ_proj_t *x, float *mem);
+/* Level 0's gaps filled, then the pyramid over it: levels >= 1 laid out from `mem` (4-byte
+ * aligned, occi_proj_pyramid_bytes bytes); x->dmax. */
 void occi_proj_build(occ_proj_t *x, float *mem);
 /* Min and max depth over pixels [i0, i1] x [j0, j1] (inside the image, i0 <= i1, j0 <= j1),
  * over-approximated by at most 2 x 2 cells of one level (so mn may be lower, mx higher). */
 void occi_proj_range(const occ_proj_t *x, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1,
                      float *mn, float *mx);
 
-/* The end points' codes into out[0..nh) (sorted, unique, hit bit set); false when the output
- * cannot hold them and the sort's temporary. */
-bool occi_proj_hits(occ_proj_t *x);
-/* Drop from free_codes[0..nv) (sorted) the codes in hits[0..nh); returns the new count. */
-size_t occi_proj_drop_hits(occ_code_t *free_codes, size_t nv, const occ_code_t *hits, size_t nh);
+/* Sort and collapse the end points' codes in out[0..nh) (hit bit set). */
+void occi_proj_hits_sort(occ_proj_t *x);
 
-/* The walk: fills x->out / nv / nn / per_level, or sets x->overflow. */
+/* The near field (projective_near.c): rays from the camera along every step-th pixel
+ * (occi_proj_near_step: min(fx, fy) / 32, at least 1) and the last row and column, to this
+ * many voxels of depth or the front of their surface if nearer. */
+#define OCC_PROJ_NEAR_VOXELS 4u
+uint32_t occi_proj_near_step(const occ_proj_camera_t *k);
+/* Rays of a w x h image's grid. */
+size_t occi_proj_near_rays(uint32_t w, uint32_t h, uint32_t step);
+/* The near rays' voxels, sorted and unique, at out + nh (x->near, x->nr); false when the
+ * output cannot hold them and the sort's temporary. Needs level 0 (x->d0). */
+bool occi_proj_near(occ_proj_t *x);
+
+/* The per-voxel rule for every voxel of the node at `level` (1 or 2) whose first voxel has key
+ * k: bit m of the result is set when the voxel in Morton slot m (below the node) is free. */
+uint64_t occi_proj_bulk(const occ_proj_t *x, const uint32_t k[3], unsigned level);
+
+/* The walk: fills x->out / nv / nn, or sets x->overflow. */
 void occi_proj_walk(occ_proj_t *x);
 
 #endif

@@ -34,111 +34,59 @@ size_t occi_proj_pyramid_bytes(const uint32_t w, const uint32_t h)
     return 8u * cells;
 }
 
-/* Depth of pixel (i, j) in metres, NaN for "no reading" (classified by the caller). */
-static float raw_depth(const occ_proj_t *x, const uint32_t i, const uint32_t j)
+/* Vertical step: per column the min of two rows' minima and the max of their maxima. */
+OCC_PROJ_LANES static void rows_minmax(const uint32_t n, const float *restrict amn,
+                                       const float *restrict bmn, const float *restrict amx,
+                                       const float *restrict bmx, float *restrict tmn,
+                                       float *restrict tmx)
 {
-    const occ_proj_image_t *const im = x->im;
-    const unsigned char *const p = (const unsigned char *)im->data +
-                                   (size_t)j * im->row_stride_bytes +
-                                   (size_t)i * im->pixel_stride_bytes;
-    if (im->format == OCC_PROJ_U16) {
-        uint16_t raw;
-        memcpy(&raw, p, sizeof raw);
-        return raw == 0u ? NAN : (float)raw * im->depth_scale_m;
-    }
-    float d;
-    memcpy(&d, p, sizeof d);
-    if (d > x->far) {
-        d = 2.0f * x->cam->max_range_m; /* +Inf: "no return within range" */
-    }
-    return d;
-}
-
-/* near2, far2: |c|^2 <= d^2 (1 + (A / fx)^2 + (B / fy)^2) with A, B the largest pixel offsets
- * from the principal point, and |c|^2 >= d^2 (c[2] = d); a 1 % margin covers every rounding
- * (relative 1e-6 here). Non-finite bounds only make the tests fail: the exact path then. */
-static void sure_range(occ_proj_t *x)
-{
-    const occ_proj_camera_t *const k = x->cam;
-    const float a0 = fabsf(k->cx), a1 = fabsf((float)(x->im->width - 1u) - k->cx);
-    const float b0 = fabsf(k->cy), b1 = fabsf((float)(x->im->height - 1u) - k->cy);
-    const float a = hi_of(a0, a1) / k->fx, b = hi_of(b0, b1) / k->fy;
-    const float kk = (1.0f + a * a + b * b) * 1.01f;
-    x->far2 = 0.99f * (x->max2 / kk);
-    x->near2 = 1.01f * x->min2;
-}
-
-/* Level 0: the depth of every pixel with a usable reading, -inf otherwise; counters. */
-static void fill_level0(occ_proj_t *x)
-{
-    const uint32_t w = x->im->width, h = x->im->height;
-    occ_proj_result_t *const r = x->r;
-    x->dmin = INFINITY;
-    x->dmax = -INFINITY;
-    for (uint32_t j = 0; j < h; j++) {
-        for (uint32_t i = 0; i < w; i++) {
-            const float d = raw_depth(x, i, j);
-            float *const slot = &x->d0[(size_t)j * w + i];
-            *slot = -INFINITY;
-            if (!(d > 0.0f)) {
-                r->pixels_no_reading++;
-                continue;
-            }
-            const float dd = d * d;
-            if (dd > x->near2 && dd < x->far2) {
-                *slot = d; /* within range for sure: no back-projection */
-                x->dmin = d < x->dmin ? d : x->dmin;
-                x->dmax = d > x->dmax ? d : x->dmax;
-                continue;
-            }
-            float c[3];
-            occ_proj_back(x->cam, i, j, d, c);
-            const float r2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-            if (!isfinite(r2)) {
-                r->pixels_no_reading++;
-                continue;
-            }
-            if (r2 < x->min2) {
-                r->pixels_too_close++;
-                continue;
-            }
-            r->pixels_beyond_max += r2 > x->max2 ? 1u : 0u;
-            *slot = d;
-            x->dmin = d < x->dmin ? d : x->dmin;
-            x->dmax = d > x->dmax ? d : x->dmax;
-        }
+    for (uint32_t i = 0; i < n; i++) {
+        tmn[i] = lo_of(amn[i], bmn[i]);
+        tmx[i] = hi_of(amx[i], bmx[i]);
     }
 }
 
-/* Level l from level l - 1 (src min / max; at level 1 both are d0). */
+/* Horizontal step: pairs of columns. */
+OCC_PROJ_LANES static void pairs_minmax(const uint32_t n, const float *restrict tmn,
+                                        const float *restrict tmx, float *restrict dmn,
+                                        float *restrict dmx)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        dmn[i] = lo_of(tmn[2u * i], tmn[2u * i + 1u]);
+        dmx[i] = hi_of(tmx[2u * i], tmx[2u * i + 1u]);
+    }
+}
+
+/* Level l + 1 from level l (src min / max; at level 1 both are d0): per destination row the
+ * two source rows' column-wise min / max (tmn / tmx: sw cells, one more when sw is odd, for the
+ * repeated last column), then pairs of columns. */
 static void reduce(const float *smn, const float *smx, const uint32_t sw, const uint32_t sh,
-                   float *dmn, float *dmx, const uint32_t dw, const uint32_t dh)
+                   float *dmn, float *dmx, const uint32_t dw, const uint32_t dh, float *tmn,
+                   float *tmx)
 {
     for (uint32_t j = 0; j < dh; j++) {
         const uint32_t j0 = 2u * j, j1 = j0 + 1u < sh ? j0 + 1u : j0;
-        for (uint32_t i = 0; i < dw; i++) {
-            const uint32_t i0 = 2u * i, i1 = i0 + 1u < sw ? i0 + 1u : i0;
-            const size_t a = (size_t)j0 * sw + i0, b = (size_t)j0 * sw + i1,
-                         c = (size_t)j1 * sw + i0, e = (size_t)j1 * sw + i1;
-            const float m0 = lo_of(lo_of(smn[a], smn[b]), lo_of(smn[c], smn[e]));
-            const float m1 = hi_of(hi_of(smx[a], smx[b]), hi_of(smx[c], smx[e]));
-            dmn[(size_t)j * dw + i] = m0;
-            dmx[(size_t)j * dw + i] = m1;
+        rows_minmax(sw, smn + (size_t)j0 * sw, smn + (size_t)j1 * sw, smx + (size_t)j0 * sw,
+                    smx + (size_t)j1 * sw, tmn, tmx);
+        if ((sw & 1u) != 0u) { /* the last pair repeats the odd column */
+            tmn[sw] = tmn[sw - 1u];
+            tmx[sw] = tmx[sw - 1u];
         }
+        pairs_minmax(dw, tmn, tmx, dmn + (size_t)j * dw, dmx + (size_t)j * dw);
     }
 }
 
 void occi_proj_build(occ_proj_t *const x, float *const mem)
 {
     const uint32_t w = x->im->width, h = x->im->height;
-    x->d0 = mem;
-    sure_range(x);
-    fill_level0(x);
+    /* the pixel pass's tables are free now: the gap filling's rows, then the reduction's */
+    OCC_ASSERT(occi_proj_fill_bytes(w) <= occi_proj_pixels_bytes(w));
+    occi_proj_fill(x, x->px.asq);
     x->mn[0] = x->d0;
     x->mx[0] = x->d0;
     x->lw[0] = w;
     x->lh[0] = h;
-    float *next = mem + (size_t)w * h;
+    float *next = mem;
     unsigned l = 0;
     while (x->lw[l] > 1u || x->lh[l] > 1u) {
         OCC_ASSERT(l + 1u < OCC_PROJ_MAX_LEVELS);
@@ -146,12 +94,14 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
         x->mn[l + 1u] = next;
         x->mx[l + 1u] = next + (size_t)dw * dh;
         next += 2u * (size_t)dw * dh;
-        reduce(x->mn[l], x->mx[l], x->lw[l], x->lh[l], x->mn[l + 1u], x->mx[l + 1u], dw, dh);
+        reduce(x->mn[l], x->mx[l], x->lw[l], x->lh[l], x->mn[l + 1u], x->mx[l + 1u], dw, dh,
+               x->px.u[0], x->px.u[1]);
         x->lw[l + 1u] = dw;
         x->lh[l + 1u] = dh;
         l++;
     }
     x->levels = l + 1u;
+    x->dmax = x->mx[l][0]; /* -inf: no reading at all */
 }
 
 void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_t i1,

@@ -237,31 +237,10 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
     return NODE_MIXED;
 }
 
-/* The per-voxel rule (occ_integrate.h) for the voxel whose centre is q in the camera frame
- * (q = R^T w, w its centre minus the camera position, map frame: OctoMap's float centre - t). */
-static bool voxel_free(const occ_proj_t *x, const float q[3], const float zcap)
-{
-    const occ_proj_camera_t *const cam = x->cam;
-    if (!(q[2] > 0.0f) || !(q[2] < zcap)) {
-        return false; /* behind the camera, or not in front of any depth it can project to */
-    }
-    const float u = cam->fx * (q[0] / q[2]) + cam->cx + 0.5f;
-    const float v = cam->fy * (q[1] / q[2]) + cam->cy + 0.5f;
-    if (!(u >= 0.0f && u < x->wf && v >= 0.0f && v < x->hf)) {
-        return false;
-    }
-    /* u, v >= 0: truncation is floor */
-    const float d = x->d0[(size_t)v * x->im->width + (size_t)u];
-    if (!(d > 0.0f) || !(q[2] < occ_proj_front(x, d))) {
-        return false;
-    }
-    return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] <= x->max2;
-}
-
 /* Is there an output slot left? (Else the call ends with OCC_ERR_SCRATCH.) */
 static bool room(occ_proj_t *x)
 {
-    if (x->nh + x->nv + x->nn >= x->cap) {
+    if (x->nh + x->nr + x->nv + x->nn >= x->cap) {
         x->overflow = true;
         return false;
     }
@@ -279,57 +258,83 @@ static bool holds_hit(occ_proj_t *x, const occ_code_t code, const unsigned l)
     return x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < end;
 }
 
-/* Record a whole free node at level l >= 1 (from the back of the output). */
+/* The free voxels go after the hits and the near field's voxels. */
+static void emit_voxel(occ_proj_t *x, const occ_code_t code)
+{
+    x->out[x->nh + x->nr + x->nv++] = code;
+}
+
+/* The near field's voxels below `code` to the output (the walk emits in code order, so the
+ * output stays sorted); false when it is full. */
+static bool flush_near(occ_proj_t *x, const occ_code_t code)
+{
+    for (; x->near_cur < x->nr && x->near[x->near_cur] < code; x->near_cur++) {
+        if (!room(x)) {
+            return false;
+        }
+        emit_voxel(x, x->near[x->near_cur]);
+    }
+    return true;
+}
+
+/* Skip the near field's voxels inside the level-l node at `code`; returns their bits (voxel
+ * offsets from code, level <= 2) for a node whose voxels the caller decides. */
+static uint64_t take_near(occ_proj_t *x, const occ_code_t code, const unsigned l)
+{
+    const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
+    uint64_t bits = 0u;
+    for (; x->near_cur < x->nr && x->near[x->near_cur] < end; x->near_cur++) {
+        const occ_code_t off = x->near[x->near_cur] - code;
+        bits |= l <= 2u ? (uint64_t)1 << off : 0u;
+    }
+    return bits;
+}
+
+/* Record a whole free node at level l >= 1 (from the back of the output), after the near
+ * voxels before it; the near voxels inside it are covered by it. */
 static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
-    if (room(x)) {
+    if (flush_near(x, code) && room(x)) {
         x->nn++;
         x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
-        x->per_level[l]++;
+        (void)take_near(x, code, l);
     }
 }
 
-/* The 8 voxels of a MIXED level-1 node, free or not by the rule (hits are occi_proj_hits');
- * all 8 free: one whole level-1 node (the same updates, fewer slots). cap: foot_t's. */
-static void visit_voxels(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
-                         const bool may_merge, const float cap)
+/* The voxels of a MIXED node at level 1 or 2, by the rule (occi_proj_bulk; hits are
+ * occi_proj_pixels'). Whole free nodes where every voxel below is free and holds no end point
+ * (the same updates, fewer slots): the node itself (level 2; level 1 when may_merge) or its
+ * level-1 children; the other free voxels one by one. */
+static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
+                       const unsigned level, const bool may_merge)
 {
-    const float zcap = occ_proj_front(x, cap); /* front() is monotone in the depth */
-    const occ_proj_camera_t *const cam = x->cam;
-    const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
-    float wc[3][2]; /* per axis the two voxel centres' offsets from the camera */
-    for (unsigned a = 0; a < 3u; a++) {
-        wc[a][0] = occi_raygeo_center(&x->g, k[a]) - t[a];
-        wc[a][1] = occi_raygeo_center(&x->g, k[a] | 1u) - t[a];
-    }
-    /* q[b] = r[0][b] w[0] + r[1][b] w[1] + r[2][b] w[2] (to_cam's sum order), from the
-     * per-axis products and the shared partial sums of the first two */
-    float pr[3][2][3], p01[4][3];
-    for (unsigned a = 0; a < 3u; a++) {
-        for (unsigned c = 0; c < 2u; c++) {
-            for (unsigned b = 0; b < 3u; b++) {
-                pr[a][c][b] = cam->r[a][b] * wc[a][c];
-            }
-        }
-    }
-    for (unsigned s = 0; s < 4u; s++) {
-        for (unsigned b = 0; b < 3u; b++) {
-            p01[s][b] = pr[0][s & 1u][b] + pr[1][s >> 1][b];
-        }
-    }
-    unsigned mask = 0;
-    for (unsigned s = 0; s < 8u; s++) {
-        const float *const a01 = p01[s & 3u], *const a2 = pr[2][s >> 2];
-        const float q[3] = {a01[0] + a2[0], a01[1] + a2[1], a01[2] + a2[2]};
-        mask |= voxel_free(x, q, zcap) ? 1u << s : 0u;
-    }
-    if (mask == 0xFFu && may_merge && !holds_hit(x, code, 1u)) {
-        emit_node(x, code, 1u);
+    if (!flush_near(x, code)) {
         return;
     }
-    for (unsigned s = 0; s < 8u; s++) {
-        if (((mask >> s) & 1u) != 0u && room(x)) {
-            x->out[x->nh + x->nv++] = code | s;
+    /* the rule's free voxels, and the near field's (free by its rays) */
+    const uint64_t mask = occi_proj_bulk(x, k, level) | take_near(x, code, level);
+    const unsigned n = 1u << (3u * level);
+    const uint64_t all = n == 64u ? ~(uint64_t)0 : (((uint64_t)1 << n) - 1u);
+    if (mask == 0u) {
+        return;
+    }
+    if (mask == all && may_merge && !holds_hit(x, code, level)) {
+        emit_node(x, code, level);
+        return;
+    }
+    if (x->cap - x->nh - x->nr - x->nv - x->nn < n) { /* room for every voxel, checked once */
+        x->overflow = true;
+        return;
+    }
+    for (unsigned c = 0; c < n / 8u; c++) {
+        unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
+        const occ_code_t cc = code | ((occ_code_t)c << 3);
+        if (byte == 0xFFu && (level == 2u || may_merge) && !holds_hit(x, cc, 1u)) {
+            emit_node(x, cc, 1u);
+            continue;
+        }
+        for (; byte != 0u; byte &= byte - 1u) {
+            emit_voxel(x, cc | (occ_code_t)__builtin_ctz(byte));
         }
     }
 }
@@ -343,8 +348,9 @@ void occi_proj_walk(occ_proj_t *const x)
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
         if (test_node(x, k0, 1u, x->dmax, &f) != NODE_SKIP) {
-            visit_voxels(x, k0, 0u, false, f.cap); /* the root is no coarse node */
+            visit_bulk(x, k0, 0u, 1u, false); /* the root is no coarse node */
         }
+        (void)flush_near(x, ~(occ_code_t)0);
         return;
     }
     unsigned sp = 1;
@@ -371,8 +377,8 @@ void occi_proj_walk(occ_proj_t *const x)
         }
         if (cls == NODE_FREE) {
             emit_node(x, code, l);
-        } else if (cls == NODE_MIXED && l == 1u) {
-            visit_voxels(x, k, code, true, f.cap);
+        } else if (cls == NODE_MIXED && l <= 2u) {
+            visit_bulk(x, k, code, l, true);
         } else if (cls == NODE_MIXED) {
             OCC_ASSERT(sp <= OCC_MAX_DEPTH);
             st[sp].k[0] = k[0];
@@ -384,5 +390,8 @@ void occi_proj_walk(occ_proj_t *const x)
             st[sp].next = 0u;
             sp++;
         }
+    }
+    if (!x->overflow) {
+        (void)flush_near(x, ~(occ_code_t)0); /* the near voxels after the walk's last output */
     }
 }

@@ -55,7 +55,8 @@ size_t occ_depth_scratch_bytes(const occ_map_t *map, const uint32_t width, const
     const size_t n = OCC_DEPTH_PIXELS(width, height, pixel_step);
     if (insert->method == OCC_INSERT_PROJECTIVE) {
         const size_t w = (width + pixel_step - 1u) / pixel_step, h = n / w;
-        if (n > (SIZE_MAX - OCC_PROJ_FIXED_BYTES - 8u * (w + h + 20u + 16384u) - 8u) / 24u) {
+        if (n > (SIZE_MAX - OCC_PROJ_FIXED_BYTES - OCC_PROJ_COLUMN_BYTES(w) -
+                 8u * (w + h + 20u + 16384u) - 48u) / 24u) {
             return SIZE_MAX; /* a 32-bit size_t: no scratch that big */
         }
         return OCC_PROJ_SCRATCH_BYTES(w, h, OCC_PROJ_OUT_DEFAULT(w, h));

@@ -12,9 +12,16 @@
 size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
                      const occ_proj_camera_t *cam, occ_code_t **codes, size_t *n_hits);
 
-/* The end points of the frame's pixels with a reading within [min, max] range (map frame, the
- * header's arithmetic) in a malloc'd array. Returns the count. */
+/* The end points of the frame's pixels with a reading within [min, max] range, as points in
+ * the map frame (t + d r (a, b, 1): for OctoMap's insertPointCloud, not the rule's voxels) in a
+ * malloc'd array. Returns the count. */
 size_t projref_end_points(const occ_proj_image_t *im, const occ_proj_camera_t *cam,
                           occ_vec3_t **pts);
+
+/* The rule's end-point voxels (occ_integrate.h: per axis the camera's key plus the floor of
+ * d (U_a + V_a) + F_a, in float), one per pixel with a hit inside the map, in a malloc'd array.
+ * Returns the count. */
+size_t projref_end_keys(const occ_map_t *map, const occ_proj_image_t *im,
+                        const occ_proj_camera_t *cam, occ_key_t **keys);
 
 #endif

@@ -1,0 +1,77 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/*
+ * tree_path.h - the path of a batch update through the tree (src/core only): sorted codes share
+ * the path above their split level, nodes below it are finished and refreshed (maybe pruned)
+ * before the next code descends. tree.c (voxel batches) and tree_frame.c (a frame's voxels and
+ * whole nodes) walk it.
+ */
+#ifndef OCC_TREE_PATH_H_INCLUDED
+#define OCC_TREE_PATH_H_INCLUDED
+
+#include "tree_internal.h"
+
+/* The path of the current code: node[l] for l in [low, D]; node[D] is the root. */
+typedef struct {
+    occ_nodep_t node[OCC_MAX_DEPTH + 1];
+    bool dirty[OCC_MAX_DEPTH + 2];
+    unsigned low;
+    /* tree.c's count_blocks: a copy of the root, where its read-only path starts (the map stays
+     * const) */
+    uint32_t root_child;
+    occ_value_t root_value;
+    uint8_t root_flags;
+} path_t;
+
+/* Lowest level whose node contains both codes. */
+static inline unsigned split_level(const occ_code_t a, const occ_code_t b)
+{
+    occ_code_t x = (a ^ b) & ~OCC_CODE_HIT_BIT;
+    if (x == 0u) {
+        return 1u;
+    }
+#if defined(__GNUC__)
+    const unsigned h = 63u - (unsigned)__builtin_clzll((unsigned long long)x);
+#else
+    unsigned h = 0;
+    while (x > 1u) {
+        x >>= 1;
+        h++;
+    }
+#endif
+    return h / 3u + 1u;
+}
+
+/* Descend from node[start] along `code` while nodes have inner children; stops at level 1 or at
+ * a uniform node. Returns the voxel's value and sets *stop: 0 when it lies in a leaf block,
+ * else the level of the uniform node holding it. */
+static inline occ_value_t descend(const occ_map_t *const m, path_t *const p, const occ_code_t code,
+                           unsigned start, unsigned *const stop)
+{
+    unsigned l = start;
+    while (l > 1u && *p->node[l].child != OCC_NONE) {
+        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
+        l--;
+    }
+    p->low = l;
+    if (*p->node[l].child != OCC_NONE) { /* l == 1 with a leaf block */
+        *stop = 0u;
+        return occ_leaf_at(m, *p->node[1].child)->value[occ_code_slot(code, 1u)];
+    }
+    *stop = l;
+    return *p->node[l].value;
+}
+
+/* Refresh dirty nodes from p->low up to level `top` (inclusive), marking parents dirty. */
+static inline void refresh_up_to(occ_map_t *const m, path_t *const p, const unsigned top)
+{
+    for (unsigned l = p->low; l <= top; l++) {
+        if (p->dirty[l]) {
+            p->dirty[l] = false;
+            if (occi_tree_refresh(m, p->node[l], l)) {
+                p->dirty[l + 1u] = true;
+            }
+        }
+    }
+}
+
+#endif

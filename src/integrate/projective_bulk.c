@@ -1,0 +1,138 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/* projective_bulk.c - the per-voxel rule over every voxel of a small node (level 1 or 2: 8 or
+ * 64 voxels) at once, where the walk stops testing nodes. Lanes are the voxels in Morton
+ * order; the loops are branch-free over whole arrays so that a host compiler vectorises them,
+ * and the arithmetic is the header's rule lane for lane (q_b = r[0][b] w_0 + r[1][b] w_1 +
+ * r[2][b] w_2, left to right). The answer is a bit mask in Morton order. */
+#include <string.h>
+
+#include "projective_internal.h"
+
+/* Per axis a and camera-frame component b, r[a][b] (centre - t) of the voxels at key offsets
+ * 0..3 from k (the rule's products, summed per lane by centres()). A level-1 node (offsets 0,
+ * 1) repeats them at 2, 3: its 8 voxels are then the first 8 lanes. */
+static void axis_products(const occ_proj_t *const x, const uint32_t k[3], const unsigned level,
+                          float p[3][3][4])
+{
+    const occ_proj_camera_t *const cam = x->cam;
+    const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
+    for (unsigned a = 0; a < 3u; a++) {
+        for (unsigned o = 0; o < 4u; o++) {
+            const uint32_t off = level == 2u ? o : (o & 1u);
+            const float w = occi_raygeo_center(&x->g, k[a] + off) - t[a];
+            for (unsigned b = 0; b < 3u; b++) {
+                p[a][b][o] = cam->r[a][b] * w;
+            }
+        }
+    }
+}
+
+/* Camera-frame centres q[b][m] = (p[0][b][x] + p[1][b][y]) + p[2][b][z] of the voxels in
+ * Morton lanes m (x = bits 0 and 3 of m, y = 1 and 4, z = 2 and 5). Four consecutive lanes
+ * share z and the high bits while (x0, y0) runs (0,0) (1,0) (0,1) (1,1): per high x (y) bit a
+ * row of four x (y) products, their sums shared by the four z. */
+static void centres(const float p[3][3][4], float q[3][OCC_PROJ_BULK])
+{
+    for (unsigned b = 0; b < 3u; b++) {
+        float xr[2][4], yr[2][4], xy[2][2][4]; /* [x1][lane], [y1][lane], [y1][x1][lane] */
+        for (unsigned h = 0; h < 2u; h++) {
+            xr[h][0] = xr[h][2] = p[0][b][2u * h];
+            xr[h][1] = xr[h][3] = p[0][b][2u * h + 1u];
+            yr[h][0] = yr[h][1] = p[1][b][2u * h];
+            yr[h][2] = yr[h][3] = p[1][b][2u * h + 1u];
+        }
+        for (unsigned y1 = 0; y1 < 2u; y1++) {
+            for (unsigned x1 = 0; x1 < 2u; x1++) {
+                for (unsigned l = 0; l < 4u; l++) {
+                    xy[y1][x1][l] = xr[x1][l] + yr[y1][l];
+                }
+            }
+        }
+        float *out = q[b];
+        for (unsigned g = 0; g < OCC_PROJ_BULK / 4u; g++, out += 4) {
+            /* group g = z0 | x1 << 1 | y1 << 2 | z1 << 3 */
+            const float *const s = xy[(g >> 2) & 1u][(g >> 1) & 1u];
+            const float z = p[2][b][(g & 1u) | ((g >> 2) & 2u)];
+            for (unsigned l = 0; l < 4u; l++) {
+                out[l] = s[l] + z;
+            }
+        }
+    }
+}
+
+/* Every lane's camera-frame centre -> in front of the camera, inside the image, within max
+ * range (`in`, 0 / 1) and its pixel's index (0 where not). */
+OCC_PROJ_LANES static void project_lanes(const occ_proj_t *const x, const float *restrict qa,
+                                         const float *restrict qb, const float *restrict qc,
+                                         uint32_t *restrict pix, int32_t *restrict in)
+{
+    const occ_proj_camera_t *const k = x->cam;
+    const float fx = k->fx, fy = k->fy, cx = k->cx, cy = k->cy;
+    const float wf = x->wf, hf = x->hf, max2 = x->max2;
+    const uint32_t w = x->im->width;
+    for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
+        const float u = fx * (qa[m] / qc[m]) + cx + 0.5f;
+        const float v = fy * (qb[m] / qc[m]) + cy + 0.5f;
+        const float r2 = qa[m] * qa[m] + qb[m] * qb[m] + qc[m] * qc[m];
+        const int32_t ok = (qc[m] > 0.0f) & (u >= 0.0f) & (u < wf) & (v >= 0.0f) & (v < hf) &
+                           (r2 <= max2);
+        /* u, v in [0, 65535] where ok: truncation is floor; the index fits 32 bits */
+        const uint32_t col = (uint32_t)(int32_t)(ok ? u : 0.0f);
+        const uint32_t row = (uint32_t)(int32_t)(ok ? v : 0.0f);
+        pix[m] = row * w + col;
+        in[m] = ok;
+    }
+}
+
+/* Free where inside and in front of the pixel's surface by the margin (no reading: -inf),
+ * as one byte (0 / 1) per lane. d and f: the lanes' depths and answers (workspace). */
+OCC_PROJ_LANES static void front_lanes(const occ_proj_t *const x, const float *restrict qc,
+                                       const uint32_t *restrict pix, const int32_t *restrict in,
+                                       float *restrict d, int32_t *restrict f,
+                                       uint8_t *restrict free8)
+{
+    const float keep = x->keep;
+    const float *const d0 = x->d0;
+    for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
+        d[m] = d0[pix[m]];
+    }
+    for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
+        f[m] = in[m] & (int32_t)(qc[m] < keep * d[m]);
+    }
+    for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
+        free8[m] = (uint8_t)f[m];
+    }
+}
+
+/* Eight 0 / 1 bytes to the bits of one byte (bit i: byte i). */
+static unsigned pack8(const uint8_t *const b)
+{
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    uint64_t v;
+    memcpy(&v, b, 8u);
+    return (unsigned)((v * 0x0102040810204080ull) >> 56); /* each byte to its bit, no carries */
+#else
+    unsigned r = 0;
+    for (unsigned i = 0; i < 8u; i++) {
+        r |= (unsigned)b[i] << i;
+    }
+    return r;
+#endif
+}
+
+uint64_t occi_proj_bulk(const occ_proj_t *const x, const uint32_t k[3], const unsigned level)
+{
+    OCC_ASSERT(level == 1u || level == 2u);
+    float p[3][3][4];
+    axis_products(x, k, level, p);
+    occ_proj_bulk_t *const b = x->bulk; /* the lanes' arrays: in the scratch, off the stack */
+    centres((const float(*)[3][4])p, b->q);
+    project_lanes(x, b->q[0], b->q[1], b->q[2], b->pix, b->in);
+    front_lanes(x, b->q[2], b->pix, b->in, b->d, b->f, b->free8);
+    uint64_t mask = 0u;
+    const unsigned groups = level == 2u ? 8u : 1u;
+    for (unsigned c = 0; c < groups; c++) {
+        mask |= (uint64_t)pack8(b->free8 + 8u * c) << (8u * c);
+    }
+    return mask;
+}
