@@ -5,6 +5,8 @@
  * of the tree is descended, written and refreshed once (the projective integrator's output).
  * All-or-nothing: a bound of the blocks the pass can allocate is checked first.
  */
+#include <string.h>
+
 #include "tree_path.h"
 
 /* ---- a whole node's subtree ------------------------------------------------------------------ */
@@ -273,10 +275,8 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
     }
     m->write_gen++; /* handles on the old tree are stale */
     path_t p;
+    memset(&p, 0, sizeof p); /* the path is read only from node[low] up; cppcheck cannot tell */
     const unsigned depth = m->cfg.depth_levels;
-    for (unsigned l = 0; l <= depth + 1u; l++) {
-        p.dirty[l] = false;
-    }
     p.node[depth] = occ_root(m);
     p.low = depth;
     cursor_t c;

@@ -199,6 +199,7 @@ static void classify_row(occ_proj_t *const x, const uint32_t j, float *const d0r
     const occ_proj_camera_t *const k = x->cam;
     const float b = ((float)j - k->cy) / k->fy;
     row_consts_t c;
+    memset(&c, 0, sizeof c); /* gcc -fanalyzer cannot follow the loop below */
     c.bsq1 = b * b + 1.0f;
     for (unsigned a = 0; a < 3u; a++) {
         c.v[a] = (k->r[a][1] * b + k->r[a][2]) * x->rf;
