@@ -100,8 +100,10 @@ ASAN_CFLAGS := $(WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 $(OCC_TEST_ASSERTS)
 
 # The projective integrator's lane loops (src/integrate/projective_*.c) are written to be
 # vectorised; GCC 12's -O2 cost model ("very cheap") keeps every loop scalar that needs a scalar
-# epilogue or a float select, so the host release builds of those files use the -O3 model.
-PROJ_VEC_CFLAGS := -fvect-cost-model=dynamic
+# epilogue or a float select, so the host release builds of those files use the -O3 model; and
+# with trapping math GCC will not if-convert a select whose condition is a float compare (the
+# library never reads the floating-point exception flags: the results are the same).
+PROJ_VEC_CFLAGS := -fvect-cost-model=dynamic -fno-trapping-math
 $(BUILD)/rel/./src/integrate/projective%.o $(BUILD)/pic/./src/integrate/projective%.o: \
     REL_CFLAGS += $(PROJ_VEC_CFLAGS)
 $(BUILD)/rel/%.o: %.c

@@ -486,6 +486,46 @@ static void test_full_pool(void **state)
     assert_true(fitted);
 }
 
+/* The header's scratch formula covers the call's fixed parts for every small image shape at
+ * every alignment of the scratch: an image without readings needs no output slot, so what the
+ * call uses then is its fixed part, which must not exceed OCC_PROJ_SCRATCH_BYTES(w, h, 0), and
+ * OCC_PROJ_SCRATCH_BYTES(w, h, 1) bytes of a malloc'd block (ASan catches a write past them)
+ * must do. A frame with readings in OCC_PROJ_OUT_DEFAULT slots works too. */
+static void test_scratch_formula_every_shape(void **state)
+{
+    (void)state;
+    init_maps(0.1f, (size_t)8 << 20);
+    float none[3 * 33], some[3 * 33];
+    for (size_t i = 0; i < 3u * 33u; i++) {
+        none[i] = NAN;
+        some[i] = (i % 7u) == 3u ? NAN : 1.0f + 0.05f * (float)(i % 5u); /* a few holes */
+    }
+    const occ_pose_t pose = tof_pose();
+    for (uint32_t w = 1; w <= 33u; w++) {
+        for (uint32_t h = 1; h <= 3u; h++) {
+            const occ_proj_camera_t k = camera_of(&pose, 8.0f, 8.0f, 0.5f * (float)w,
+                                                  0.5f * (float)h, 0.05f, 3.0f);
+            const occ_proj_image_t empty = {none, OCC_PROJ_F32, w, h, 33u * 4u, 4u, 1.0f};
+            const occ_proj_image_t frame = {some, OCC_PROJ_F32, w, h, 33u * 4u, 4u, 1.0f};
+            const size_t fixed = OCC_PROJ_SCRATCH_BYTES(w, h, 0);
+            const size_t full = OCC_PROJ_SCRATCH_BYTES(w, h, OCC_PROJ_OUT_DEFAULT(w, h));
+            for (size_t off = 0; off < 16u; off += 3u) {
+                unsigned char *const block = malloc(off + full);
+                occ_proj_result_t r;
+                assert_int_equal(occ_map_insert_projective(&map_a, &empty, &k, block + off,
+                                                           fixed + 8u, &r),
+                                 OCC_OK);
+                assert_true(r.insert.scratch_used <= fixed);
+                assert_int_equal(occ_map_insert_projective(&map_a, &frame, &k, block + off, full,
+                                                           &r),
+                                 OCC_OK);
+                free(block);
+            }
+        }
+    }
+    assert_int_equal(occ_map_check(&map_a), OCC_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -495,6 +535,7 @@ int main(void)
         cmocka_unit_test(test_pioneer_equals_oracle),
         cmocka_unit_test(test_end_points_never_free),
         cmocka_unit_test(test_pioneer_vs_octomap),
+        cmocka_unit_test(test_scratch_formula_every_shape),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

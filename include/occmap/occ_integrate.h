@@ -316,7 +316,7 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * per-level constants and stack and the 64-voxel rule's lane arrays (6 KiB, kept off the
  * stack)), 4 bytes per pixel (the
  * depths), 8 bytes per pyramid cell (min and max, levels 1.. of halved sides: at most
- * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells), 48 bytes per image column (the pixel
+ * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells), 52 bytes per image column (the pixel
  * pass's per-column tables and row buffers, OCC_PROJ_COLUMN_BYTES) and the output, in 8-byte
  * slots: the end points' codes after the repeat filter (twice while they are sorted), the near
  * rays' voxels (twice while sorted; ~5,000 for a 640 x 480 Kinect frame), then one per voxel
@@ -343,7 +343,7 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
 #define OCC_PROJ_FIXED_BYTES                                                               \
     (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u + \
      OCC_PROJ_LEVELS_BYTES + OCC_PROJ_CTX_BYTES + OCC_PROJ_BULK_BYTES)
-#define OCC_PROJ_COLUMN_BYTES(w) (48u * (size_t)(w) + 256u)
+#define OCC_PROJ_COLUMN_BYTES(w) (52u * (size_t)(w) + 256u)
 #define OCC_PROJ_SCRATCH_BYTES(w, h, n_out)                                                 \
     (OCC_PROJ_FIXED_BYTES + 48u + 4u * (size_t)(w) * (size_t)(h) + 8u * OCC_PROJ_CELLS(w, h) + \
      OCC_PROJ_COLUMN_BYTES(w) + 8u * (size_t)(n_out))

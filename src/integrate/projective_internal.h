@@ -28,6 +28,7 @@ typedef struct {
     float *asq;        /* a_i^2, a_i = (i - cx) / fx */
     float *u[3];       /* r[a][0] a_i rf: the direction's column part per map axis, in voxels */
     float *dr;         /* the row's depths (0: no reading) */
+    float *ds;         /* the row's hit depths (0: the pixel marks nothing) */
     int32_t *kc[3];    /* this row's end-point key offsets from the camera's voxel (index -1 ok) */
     int32_t *kp[3];    /* the previous row's */
     int32_t *nw;       /* this row's "new voxel" flags (0 / 1), padded to a multiple of 4 */

@@ -21,8 +21,8 @@ static size_t cells16(const size_t n)
 
 size_t occi_proj_pixels_bytes(const uint32_t w)
 {
-    /* asq, u[3], dr, nw: w cells padded to 4; kc[3], kp[3]: column -1 and w padded to 4 */
-    return 6u * cells16(w) + 6u * cells16((size_t)w + 4u);
+    /* asq, u[3], dr, ds, nw: w cells padded to 4; kc[3], kp[3]: column -1 and w padded to 4 */
+    return 7u * cells16(w) + 6u * cells16((size_t)w + 4u);
 }
 
 void occi_proj_pixels_carve(occ_proj_t *const x, unsigned char *mem)
@@ -35,6 +35,8 @@ void occi_proj_pixels_carve(occ_proj_t *const x, unsigned char *mem)
         mem += cells16(w);
     }
     x->px.dr = (float *)(void *)mem;
+    mem += cells16(w);
+    x->px.ds = (float *)(void *)mem;
     mem += cells16(w);
     for (unsigned a = 0; a < 3u; a++) {
         x->px.kc[a] = (int32_t *)(void *)mem;
@@ -127,67 +129,61 @@ typedef struct {
     uint32_t finite, valid, in, marked;
 } row_counts_t;
 
-/* One pixel of the lane loops (the header's arithmetic): its level-0 depth, its end voxel's
- * key offsets from the camera's voxel (k0 NO_VOXEL where it marks nothing) and its class. A hit
- * farther than OCC_PROJ_HIT_VOXELS voxels is outside every map: with that bound the offsets
- * always convert to int32. (The map test is always made: without it GCC 12 sinks the key
- * arithmetic under the hit test and no longer vectorises the loop.) */
-typedef struct {
-    float d0;
-    int32_t k0, k1, k2;
-    int32_t finite, valid, in, mark;
-} px_t;
-
-static inline px_t classify_px(const float d, const float asq, const float u0, const float u1,
-                               const float u2, const row_consts_t c)
+/* The lane loops over n pixels (a multiple of 4): branch-free, restrict-qualified, so that a
+ * host compiler vectorises them; two loops, because one would hold more values than SSE2 has
+ * registers (the header's arithmetic, lane for lane). First the depths: level 0, the class
+ * counts, and in ds the depth of a hit (0 where the pixel marks nothing). */
+OCC_PROJ_LANES static void depth_lanes(const uint32_t n, const row_consts_t *const c,
+                                       const float *restrict dr, const float *restrict asq,
+                                       float *restrict d0row, float *restrict ds,
+                                       row_counts_t *const cnt)
 {
-    px_t o;
-    const float r2 = (d * d) * (asq + c.bsq1);
-    o.finite = (d > 0.0f) & (r2 <= FLT_MAX);
-    o.valid = o.finite & (r2 >= c.min2);
-    o.in = o.valid & (r2 <= c.max2);
-    const int32_t hit = o.valid & (r2 <= c.max2h);
-    o.d0 = o.valid ? d : -INFINITY;
-    const float ds = hit ? d : 0.0f; /* no hit: the camera's own voxel, dropped below */
-    const float e0 = ds * (u0 + c.v[0]) + c.f[0], e1 = ds * (u1 + c.v[1]) + c.f[1],
-                e2 = ds * (u2 + c.v[2]) + c.f[2];
-    int32_t q0 = (int32_t)e0, q1 = (int32_t)e1, q2 = (int32_t)e2;
-    q0 -= (int32_t)(e0 < (float)q0); /* truncation to floor */
-    q1 -= (int32_t)(e1 < (float)q1);
-    q2 -= (int32_t)(e2 < (float)q2);
-    const int32_t s = c.side;
-    o.mark = hit & (q0 + c.t[0] >= 0) & (q0 + c.t[0] < s) & (q1 + c.t[1] >= 0) &
-             (q1 + c.t[1] < s) & (q2 + c.t[2] >= 0) & (q2 + c.t[2] < s);
-    o.k0 = o.mark ? q0 : NO_VOXEL;
-    o.k1 = q1;
-    o.k2 = q2;
-    return o;
-}
-
-/* The lane loop over n pixels (a multiple of 4): branch-free, restrict-qualified, so that a
- * host compiler vectorises it. */
-OCC_PROJ_LANES static void classify_lanes(const uint32_t n, const row_consts_t *const c, const float *restrict dr,
-                        const float *restrict asq, const float *restrict u0,
-                        const float *restrict u1, const float *restrict u2,
-                        float *restrict d0row, int32_t *restrict k0, int32_t *restrict k1,
-                        int32_t *restrict k2, row_counts_t *const cnt)
-{
-    uint32_t finite = 0, valid = 0, in = 0, marked = 0;
-    const row_consts_t cc = *c; /* a copy the stores cannot alias */
+    uint32_t finite = 0, valid_n = 0, in_n = 0;
+    const float bsq1 = c->bsq1, min2 = c->min2, max2 = c->max2, max2h = c->max2h;
     for (uint32_t i = 0; i < n; i++) {
-        const px_t o = classify_px(dr[i], asq[i], u0[i], u1[i], u2[i], cc);
-        d0row[i] = o.d0;
-        k0[i] = o.k0;
-        k1[i] = o.k1;
-        k2[i] = o.k2;
-        finite += (uint32_t)o.finite;
-        valid += (uint32_t)o.valid;
-        in += (uint32_t)o.in;
-        marked += (uint32_t)o.mark;
+        const float d = dr[i];
+        const float r2 = (d * d) * (asq[i] + bsq1);
+        const int32_t fin = (d > 0.0f) & (r2 <= FLT_MAX);
+        const int32_t valid = fin & (r2 >= min2);
+        const int32_t in = valid & (r2 <= max2);
+        const int32_t hit = valid & (r2 <= max2h);
+        d0row[i] = valid ? d : -INFINITY;
+        ds[i] = hit ? d : 0.0f;
+        finite += (uint32_t)fin;
+        valid_n += (uint32_t)valid;
+        in_n += (uint32_t)in;
     }
     cnt->finite = finite;
-    cnt->valid = valid;
-    cnt->in = in;
+    cnt->valid = valid_n;
+    cnt->in = in_n;
+}
+
+/* Then the end voxels: per hit its key offsets from the camera's voxel (k0 NO_VOXEL where the
+ * pixel marks nothing: no hit, or off the map). A hit farther than OCC_PROJ_HIT_VOXELS voxels is
+ * outside every map: with that bound the offsets always convert to int32. */
+OCC_PROJ_LANES static void key_lanes(const uint32_t n, const row_consts_t *const c,
+                                     const float *restrict ds, const float *restrict u0,
+                                     const float *restrict u1, const float *restrict u2,
+                                     int32_t *restrict k0, int32_t *restrict k1,
+                                     int32_t *restrict k2, row_counts_t *const cnt)
+{
+    uint32_t marked = 0;
+    const float v0 = c->v[0], v1 = c->v[1], v2 = c->v[2], f0 = c->f[0], f1 = c->f[1], f2 = c->f[2];
+    const int32_t t0 = c->t[0], t1 = c->t[1], t2 = c->t[2], side = c->side;
+    for (uint32_t i = 0; i < n; i++) {
+        const float e0 = ds[i] * (u0[i] + v0) + f0, e1 = ds[i] * (u1[i] + v1) + f1,
+                    e2 = ds[i] * (u2[i] + v2) + f2;
+        int32_t q0 = (int32_t)e0, q1 = (int32_t)e1, q2 = (int32_t)e2;
+        q0 -= (int32_t)(e0 < (float)q0); /* truncation to floor */
+        q1 -= (int32_t)(e1 < (float)q1);
+        q2 -= (int32_t)(e2 < (float)q2);
+        const int32_t mark = (ds[i] > 0.0f) & (q0 + t0 >= 0) & (q0 + t0 < side) &
+                             (q1 + t1 >= 0) & (q1 + t1 < side) & (q2 + t2 >= 0) & (q2 + t2 < side);
+        marked += (uint32_t)mark;
+        k0[i] = mark ? q0 : NO_VOXEL;
+        k1[i] = q1;
+        k2[i] = q2;
+    }
     cnt->marked = marked;
 }
 
@@ -214,8 +210,8 @@ static void classify_row(occ_proj_t *const x, const uint32_t j, float *const d0r
     const uint32_t w = x->im->width, n = (w + 3u) & ~3u;
     row_counts_t s;
     const occ_proj_pixels_t *const p = &x->px;
-    classify_lanes(n, &c, p->dr, p->asq, p->u[0], p->u[1], p->u[2], d0row, p->kc[0], p->kc[1],
-                   p->kc[2], &s);
+    depth_lanes(n, &c, p->dr, p->asq, d0row, p->ds, &s);
+    key_lanes(n, &c, p->ds, p->u[0], p->u[1], p->u[2], p->kc[0], p->kc[1], p->kc[2], &s);
     occ_proj_result_t *const r = x->r;
     r->pixels_no_reading += w - s.finite; /* the pad lanes are not finite */
     r->pixels_too_close += s.finite - s.valid;
