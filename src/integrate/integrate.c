@@ -20,6 +20,15 @@ typedef char fixed_term_matches_header[OCC_INSERT_SCRATCH_FIXED_BYTES == 7u + FI
 /* Scratch beyond this is not used: the sort counts codes in 32 bits (32 GiB on a 64-bit host). */
 #define SCRATCH_MAX ((size_t)UINT32_MAX < SIZE_MAX / 8u ? (size_t)UINT32_MAX * 8u : SIZE_MAX)
 
+#ifdef OCC_TESTING
+occi_insert_probe_t occi_insert_probe;
+#define PROBE(field) (occi_insert_probe.field++)
+#define PROBE_RESET() memset(&occi_insert_probe, 0, sizeof occi_insert_probe)
+#else
+#define PROBE(field) ((void)0)
+#define PROBE_RESET() ((void)0)
+#endif
+
 occ_insert_params_t occ_insert_params_default(void)
 {
     occ_insert_params_t p;
@@ -513,6 +522,7 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
         }
     }
     size_t changed = 0;
+    PROBE(pieces);
     occ_err_t e = occ_map_observe_codes(map, codes, m, &changed);
     if (e == OCC_ERR_NOMEM && params->auto_evict != NULL) {
         size_t applied = 0;
@@ -572,6 +582,7 @@ OCC_NOINLINE static occ_err_t set_apply(occ_ictx_t *const x)
     while ((m = occi_vset_read(x->bs, &cur, x->a, x->n, x->b, x->b_cap)) > 0u) {
         occ_ictx_note(x, 0, m);
         size_t ch = 0;
+        PROBE(pieces);
         const occ_err_t e = occ_map_observe_codes(x->map, x->b, m, &ch);
         if (e != OCC_OK) {
             return e; /* cannot happen: pass 1 checked the pools for these pieces */
@@ -806,6 +817,7 @@ static int chunk_run(occ_ictx_t *const x, const occ_insert_params_t *const param
                      const occ_vec3_t *const points, const size_t n_points,
                      const carve_t *const c, const occ_code_t lo)
 {
+    PROBE(traces);
     memset(x->filt, 0xFF, FILTER_N * 8u);
     x->n = 0;
     x->win_lo = lo;
@@ -871,6 +883,7 @@ static occ_err_t chunk_apply(occ_ictx_t *const x, const occ_insert_params_t *con
         for (size_t i = 0; i < m; i++) {
             r->voxels_occupied += (size_t)(codes[i] >> 63);
         }
+        PROBE(pieces);
         const occ_err_t e = occ_map_observe_codes(x->map, codes, m, &ch);
         if (e != OCC_OK) {
             return e;
@@ -925,6 +938,7 @@ static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const para
             layout_sorted(x, c);
         }
         x->chunked = !set && chunkable(params);
+        PROBE(traces);
         rc = run_method(x, params, points, n_points, c->ends);
         if (!set || (rc == 0 && !vs->overflow && (chunkable(params) || set_fits_once(x)))) {
             break;
@@ -945,6 +959,7 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
     /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_insert_result_t *const r = out != NULL ? out : &local;
     memset(r, 0, sizeof *r);
+    PROBE_RESET();
     occ_err_t e = check_args(map, origin, points, n_points, params, scratch, scratch_bytes);
     occ_ictx_t x;
     if (e != OCC_OK || (e = ictx_begin(&x, map, origin, params, r)) != OCC_OK) {

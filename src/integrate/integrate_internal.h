@@ -252,6 +252,16 @@ static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
     x->a[x->n++] = c;
 }
 
+#ifdef OCC_TESTING
+/* Test builds only: how the last occ_map_insert_rays() call ran - traversals of the whole scan
+ * (run_method / a window's pass) and batches applied with occ_map_observe_codes(). */
+typedef struct {
+    unsigned traces;
+    unsigned pieces;
+} occi_insert_probe_t;
+extern occi_insert_probe_t occi_insert_probe;
+#endif
+
 /* FAST_DISCRETE's ray (fastdiscrete.c): coarse marching, then fine DDA near the end. */
 void occi_fast_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
 
