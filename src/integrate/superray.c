@@ -332,7 +332,7 @@ static bool run_voxel(occ_ictx_t *const x, const occ_vec3_t *const points,
     return true;
 }
 
-/* The dense path's free scratch, carved: end cells and point indices (sorted as pairs, with
+/* The voxel set path's room at x->b, carved: end cells and point indices (sorted as pairs, with
  * room for the sort's second copy), then the per-bundle workspace. */
 typedef struct {
     uint64_t *keys, *tkeys; /* end cell per point, and the sort's second buffer */
