@@ -186,44 +186,66 @@ static void check_below_min(occ_map_t *m, const it_cloud_t *c, const occ_insert_
     assert_int_equal(m->oom_count, oom0);
 }
 
+/* The scan (every `every`-th point) at `res` with `method`: the one-shot map in ref with its
+ * result r0, OctoMap's tree for the same scan (ref checked equal to it), m initialised empty. */
+typedef struct {
+    it_cloud_t c;
+    occ_map_t ref, m;
+    occ_insert_params_t p;
+    occ_insert_result_t r0;
+    void *oracle;
+} fixture_t;
+
+static bool fixture_begin(fixture_t *f, const occ_insert_method_t method, const float res,
+                          const size_t every)
+{
+    if (!it_load_scan(&f->c, every)) {
+        return false;
+    }
+    it_init_map(&f->ref, arena_a, ARENA_BYTES, res);
+    it_init_map(&f->m, arena_b, ARENA_BYTES, res);
+    f->p = occ_insert_params_default();
+    f->p.method = method;
+    assert_int_equal(occ_map_insert_cloud(&f->ref, &f->c.origin, f->c.p, f->c.n, &f->p, scratch,
+                                          SCRATCH_BYTES, &f->r0),
+                     OCC_OK);
+    assert_way(WAY_ONE_SHOT);
+    f->oracle = oracle_ins_new((double)res);
+    const float o[3] = {f->c.origin.x, f->c.origin.y, f->c.origin.z};
+    oracle_ins_cloud(f->oracle, (const float *)(const void *)f->c.p, f->c.n, o, -1.0,
+                     method == OCC_INSERT_DISCRETE);
+    assert_int_equal(it_diff_oracle(&f->ref, f->oracle, 0.002f), 0);
+    return true;
+}
+
+static void fixture_end(fixture_t *f)
+{
+    oracle_ins_delete(f->oracle);
+    free(f->c.p);
+}
+
 static void check_method(const occ_insert_method_t method, const float res, const size_t every,
                          const bool at_min)
 {
-    it_cloud_t c;
-    if (!it_load_scan(&c, every)) {
+    static fixture_t f;
+    if (!fixture_begin(&f, method, res, every)) {
         skip();
     }
-    occ_map_t ref, m;
-    it_init_map(&ref, arena_a, ARENA_BYTES, res);
-    it_init_map(&m, arena_b, ARENA_BYTES, res);
-    occ_insert_params_t p = occ_insert_params_default();
-    p.method = method;
-    occ_insert_result_t r0;
-    assert_int_equal(occ_map_insert_cloud(&ref, &c.origin, c.p, c.n, &p, scratch, SCRATCH_BYTES,
-                                          &r0),
-                     OCC_OK);
-    assert_way(WAY_ONE_SHOT);
-    void *t = oracle_ins_new((double)res);
-    const float o[3] = {c.origin.x, c.origin.y, c.origin.z};
-    oracle_ins_cloud(t, (const float *)(const void *)c.p, c.n, o, -1.0,
-                     method == OCC_INSERT_DISCRETE);
-    assert_int_equal(it_diff_oracle(&ref, t, 0.002f), 0);
     const bool discrete = method == OCC_INSERT_DISCRETE;
-    const size_t lo = min_scratch(&m, &c, &p);
-    const size_t sm = set_min(&c, ray_chunks(&m, &c, discrete), discrete);
+    const size_t lo = min_scratch(&f.m, &f.c, &f.p);
+    const size_t sm = set_min(&f.c, ray_chunks(&f.m, &f.c, discrete), discrete);
     /* The windows' minimum, the set's exact threshold and 8 bytes under it (one chunk short:
      * the set runs full, the scan goes to windows), the set with little and with much room. */
     const size_case_t cases[] = {{lo, WAY_WINDOWS},         {lo + 4096u, WAY_WINDOWS},
                                  {sm - 8u, WAY_WINDOWS},    {sm, WAY_PIECES},
-                                 {sm + 65536u, WAY_PIECES}, {r0.scratch_used / 3u, WAY_ANY}};
+                                 {sm + 65536u, WAY_PIECES}, {f.r0.scratch_used / 3u, WAY_ANY}};
     for (size_t i = at_min ? 0u : 2u; i < (at_min ? 2u : 6u); i++) {
         size_case_t sc = cases[i];
         sc.bytes = sc.bytes > lo ? sc.bytes : lo;
-        check_size(&m, &ref, t, &c, &p, &r0, sc);
+        check_size(&f.m, &f.ref, f.oracle, &f.c, &f.p, &f.r0, sc);
     }
-    check_below_min(&m, &c, &p, lo);
-    oracle_ins_delete(t);
-    free(c.p);
+    check_below_min(&f.m, &f.c, &f.p, lo);
+    fixture_end(&f);
 }
 
 static void test_simple_chunks(void **state)
@@ -255,28 +277,14 @@ static void test_discrete_min(void **state)
  * here (DISCRETE in pieces above at 0.1 m; make bench-scratch compares both at 0.05 m). */
 static void check_8mib(const occ_insert_method_t method)
 {
-    it_cloud_t c;
-    if (!it_load_scan(&c, 1u)) {
+    static fixture_t f;
+    if (!fixture_begin(&f, method, 0.05f, 1u)) {
         skip();
     }
-    occ_map_t ref, m;
-    it_init_map(&ref, arena_a, ARENA_BYTES, 0.05f);
-    it_init_map(&m, arena_b, ARENA_BYTES, 0.05f);
-    occ_insert_params_t p = occ_insert_params_default();
-    p.method = method;
-    occ_insert_result_t r0;
-    assert_int_equal(occ_map_insert_cloud(&ref, &c.origin, c.p, c.n, &p, scratch, SCRATCH_BYTES,
-                                          &r0),
-                     OCC_OK);
-    assert_true(r0.scratch_used > ((size_t)8 << 20));
-    void *t = oracle_ins_new(0.05);
-    const float o[3] = {c.origin.x, c.origin.y, c.origin.z};
-    oracle_ins_cloud(t, (const float *)(const void *)c.p, c.n, o, -1.0,
-                     method == OCC_INSERT_DISCRETE);
+    assert_true(f.r0.scratch_used > ((size_t)8 << 20));
     const size_case_t sc = {(size_t)8 << 20, WAY_PIECES};
-    check_size(&m, &ref, t, &c, &p, &r0, sc);
-    oracle_ins_delete(t);
-    free(c.p);
+    check_size(&f.m, &f.ref, f.oracle, &f.c, &f.p, &f.r0, sc);
+    fixture_end(&f);
 }
 
 static void test_simple_8mib(void **state)
