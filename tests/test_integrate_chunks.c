@@ -123,19 +123,31 @@ static size_t set_min(const it_cloud_t *c, const size_t chunks, const bool discr
            chunks * OCC_VSET_CHUNK_BYTES;
 }
 
-typedef enum { WAY_ONE_SHOT, WAY_PIECES, WAY_WINDOWS, WAY_ANY } way_t;
+typedef enum {
+    WAY_ONE_SHOT,
+    WAY_SORTED_ONE_SHOT,
+    WAY_PIECES,
+    WAY_SET,
+    WAY_WINDOWS,
+    WAY_ANY
+} way_t;
 
-/* How the last insert ran: one trace and one batch, one trace and several batches, or more
- * traces (windows, or a set that ran full first). */
+/* How the last insert ran: one trace into the voxel set and one batch, one trace as sorted
+ * codes and one batch, one trace into the set and several batches (or any number), or more
+ * traces as sorted codes (windows, after a set that ran full or without one). */
 static void assert_way(const way_t way)
 {
     const occi_insert_probe_t p = occi_insert_probe;
     if (way == WAY_ONE_SHOT) {
-        assert_true(p.traces == 1u && p.pieces == 1u);
+        assert_true(p.traces == 1u && p.set_traces == 1u && p.pieces == 1u);
+    } else if (way == WAY_SORTED_ONE_SHOT) {
+        assert_true(p.traces == 1u && p.set_traces == 0u && p.pieces == 1u);
     } else if (way == WAY_PIECES) {
-        assert_true(p.traces == 1u && p.pieces > 1u);
+        assert_true(p.traces == 1u && p.set_traces == 1u && p.pieces > 1u);
+    } else if (way == WAY_SET) {
+        assert_true(p.traces == 1u && p.set_traces == 1u && p.pieces >= 1u);
     } else if (way == WAY_WINDOWS) {
-        assert_true(p.traces > 1u);
+        assert_true(p.traces > 1u && p.set_traces <= 1u);
     }
 }
 
@@ -154,9 +166,10 @@ static void check_size(occ_map_t *m, const occ_map_t *ref, void *oracle, const i
     occ_map_clear(m);
     assert_int_equal(occ_map_insert_cloud(m, &c->origin, c->p, c->n, p, scratch, sc.bytes, &r),
                      OCC_OK);
-    printf("  method %d scratch %zu (one-shot used %zu): %zu voxels, %u traces, %u batches\n",
-           (int)p->method, sc.bytes, r0->scratch_used, r.voxels_updated,
-           occi_insert_probe.traces, occi_insert_probe.pieces);
+    printf("  method %d scratch %zu (one-shot used %zu): %zu voxels, %u traces (%u into the set), "
+           "%u batches\n",
+           (int)p->method, sc.bytes, r0->scratch_used, r.voxels_updated, occi_insert_probe.traces,
+           occi_insert_probe.set_traces, occi_insert_probe.pieces);
     assert_way(sc.way);
     assert_true(r.scratch_used <= sc.bytes);
     assert_int_equal(r.voxels_updated, r0->voxels_updated);
@@ -287,6 +300,31 @@ static void check_8mib(const occ_insert_method_t method)
     fixture_end(&f);
 }
 
+/* The sorted path when it surely runs as one batch (16 bytes per code of the rays' bound after
+ * the fixed term) and the set is not sure to fit (the chunks of its box do not): no trace is
+ * risked on a set that could run full. 8 bytes less, the set is tried (and fits). 1/160 of
+ * scan.dat at 0.05 m. */
+static void test_sorted_when_one_batch(void **state)
+{
+    (void)state;
+    static fixture_t f;
+    if (!fixture_begin(&f, OCC_INSERT_SIMPLE, 0.05f, EVERY_MIN)) {
+        skip();
+    }
+    /* occ_insert_scratch_bytes_scan(): the fixed term, 8 per point, 16 per code */
+    const size_t one = occ_insert_scratch_bytes_scan(&f.m, &f.c.origin, f.c.p, f.c.n, &f.p) -
+                       8u * f.c.n;
+    const size_t sm = set_min(&f.c, ray_chunks(&f.m, &f.c, false), false);
+    printf("  sorted codes in one batch from %zu, the set's threshold %zu\n", one, sm);
+    assert_true(sm + 65536u < one);
+    const size_case_t cases[] = {{one, WAY_SORTED_ONE_SHOT}, {one - 8u, WAY_SET},
+                                 {sm + 65536u, WAY_PIECES}};
+    for (size_t i = 0; i < 3u; i++) {
+        check_size(&f.m, &f.ref, f.oracle, &f.c, &f.p, &f.r0, cases[i]);
+    }
+    fixture_end(&f);
+}
+
 static void test_simple_8mib(void **state)
 {
     (void)state;
@@ -341,7 +379,7 @@ static void test_pool_full_unchanged(void **state)
     free(c.p);
 }
 
-/* ---- the voxel set alone: random voxels and hits ---------------------------------------------- */
+/* ---- the voxel set alone: random voxels and hits -------------------------------------------- */
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static uint32_t rnd(const uint32_t n)
 {
@@ -517,6 +555,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_discrete_chunks, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_simple_min, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_discrete_min, it_timer_setup, it_timer_teardown),
+        cmocka_unit_test_setup_teardown(test_sorted_when_one_batch, it_timer_setup,
+                                        it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_simple_8mib, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_pool_full_unchanged, it_timer_setup,
                                         it_timer_teardown),

@@ -19,16 +19,19 @@
  *
  * The voxel set (SIMPLE, DISCRETE, SUPER_RAYS and FAST_DISCRETE's voxel rays): one bit per voxel
  * in 32^3-voxel chunks (4 KiB, aligned to keys), taken from the scratch when a ray first enters
- * one, so it grows with the chunks the scan crosses, not with its voxel visits. After the one
- * traversal of the scan it is read back in Morton order, merged with the end voxels (hit wins),
- * into the room the chunks left: in one batch when it fits there, else in pieces of that room
- * (SIMPLE and DISCRETE). All or nothing still holds for pieces: before any write, the blocks
- * each piece's update can allocate as if none of its nodes existed (so the pruning of one piece
- * cannot starve the next) are counted on the set and summed, and checked against the pools
- * (evicting for the sum first with auto_evict; what was evicted then stays evicted); when they
- * do not fit: OCC_ERR_NOMEM, map unchanged - a conservative check: it may refuse where one
- * batch with more scratch would succeed. The map equals the one-batch result voxel for voxel.
- * One traversal needs (n = n_points, C = the 32^3-voxel chunks the rays cross, at most those of
+ * one, so it grows with the chunks the scan crosses, not with its voxel visits. It is used when
+ * it surely fits (room for every chunk of the scan's bounding box) or when the sorted codes
+ * would not fit one batch (16 bytes per code of the rays' bound after the fixed term); else the
+ * sorted codes run as one batch, and no traversal is risked on a set that could run full.
+ * After the one traversal of the scan the set is read back in Morton order, merged with the end
+ * voxels (hit wins), into the room the chunks left: in one batch when it fits there, else in
+ * pieces of that room (SIMPLE and DISCRETE). All or nothing still holds for pieces: before any
+ * write, the blocks each piece's update can allocate as if none of its nodes existed (so the
+ * pruning of one piece cannot starve the next) are counted on the set and summed, and checked
+ * against the pools (evicting for the sum first with auto_evict; what was evicted then stays
+ * evicted); when they do not fit: OCC_ERR_NOMEM, map unchanged - a conservative check: it may
+ * refuse where one batch with more scratch would succeed. The map equals the one-batch result
+ * voxel for voxel. One traversal needs (n = n_points, C = the 32^3-voxel chunks the rays cross, at most those of
  * the scan's bounding box):
  *   OCC_INSERT_SCRATCH_FIXED_BYTES + (DISCRETE) 8 n + 8 (n + 1)
  *     + max(8 (n + 1), 8192, SUPER_RAYS: its tables, 24 n + 278,600 on a 64-bit host) + 4,160 C

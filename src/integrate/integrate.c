@@ -339,9 +339,11 @@ static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const para
 
 /* The box around the origin and every (clipped) end point, padded by 2 voxels for the DDA's
  * rounding, into box_lo/box_hi; returns its 32^3-voxel chunks (saturated): no scan touches
- * more chunks of the voxel set. */
-static size_t box_chunks(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n)
+ * more chunks of the voxel set. *codes: the codes the rays can emit on the sorted path. */
+static size_t box_chunks(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                         size_t *const codes)
 {
+    *codes = 0;
     uint32_t lo[3] = {x->ko[0], x->ko[1], x->ko[2]}, hi[3] = {x->ko[0], x->ko[1], x->ko[2]};
     for (size_t i = 0; i < n; i++) {
         if (!occ_finite3(points[i])) {
@@ -357,6 +359,7 @@ static size_t box_chunks(occ_ictx_t *const x, const occ_vec3_t *const points, co
         if (!occi_raygeo_key(&x->g, q, k)) {
             continue;
         }
+        *codes = occ_sat_add(*codes, occi_dda_bound(x->ko, k) + 1u);
         for (unsigned a = 0; a < 3u; a++) {
             lo[a] = k[a] < lo[a] ? k[a] : lo[a];
             hi[a] = k[a] > hi[a] ? k[a] : hi[a];
@@ -774,6 +777,20 @@ static bool layout_set(occ_ictx_t *const x, const carve_t *const c, occ_vset_t *
     return true;
 }
 
+/* Build the voxel set when it surely fits (room for every chunk of the scan's box), or when the
+ * sorted codes would not fit one batch (they would need windows: a set that runs full costs one
+ * more trace, windows at least four). Else the sorted path, which then surely runs as one
+ * batch: no trace is ever lost to a set that runs full where one batch was possible. */
+static bool prefer_set(const carve_t *const c, const occ_insert_params_t *const params,
+                       const size_t n_points, const size_t chunks, const size_t codes)
+{
+    const size_t hits_cap = occ_sat_add(n_points, 1u);
+    const size_t low =
+        occ_sat_mul(occ_sat_add(hits_cap, set_work(params, n_points, hits_cap)), 8u);
+    const bool sure = low < c->rest_bytes && (c->rest_bytes - low) / OCC_VSET_CHUNK_BYTES >= chunks;
+    return sure || occ_sat_mul(codes, 16u) > c->rest_bytes;
+}
+
 /* After a scan into the set by SUPER_RAYS or FAST_DISCRETE (not applied in pieces): do its
  * voxels, the hits and FAST_DISCRETE's coarse codes fit the room between b and the chunks? */
 static bool set_fits_once(const occ_ictx_t *const x)
@@ -913,17 +930,18 @@ static occ_err_t run_chunks(occ_ictx_t *const x, const occ_insert_params_t *cons
     return chunk_apply(x, params, points, n_points, c);
 }
 
-/* Trace the scan: into the voxel set when it fits the scratch, else as sorted codes (in windows
- * for SIMPLE and DISCRETE). A set that runs full (or a ray leaving the map) means one more
- * pass on the sorted path; so does a set too big to apply in one piece by SUPER_RAYS or
- * FAST_DISCRETE. Returns run_method's code; x->bs says which path holds the result. */
+/* Trace the scan: into the voxel set (max_chunks > 0: prefer_set()) when it fits the scratch,
+ * else as sorted codes (in windows for SIMPLE and DISCRETE). A set that runs full (or a ray
+ * leaving the map) means one more pass on the sorted path; so does a set too big to apply in
+ * one piece by SUPER_RAYS or FAST_DISCRETE. Returns run_method's code; x->bs says which path
+ * holds the result. */
 static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const params,
                       const occ_vec3_t *const points, const size_t n_points, const carve_t *c,
                       occ_vset_t *const vs, const size_t max_chunks, const size_t cbricks)
 {
     const size_t hits_cap = occ_sat_add(n_points, 1u);
     /* FAST_DISCRETE with n = 0 casts no voxel rays: only hits, no voxel set needed. */
-    bool set = !(x->cbs != NULL && x->cn == 0u);
+    bool set = max_chunks > 0u && !(x->cbs != NULL && x->cn == 0u);
     int rc = 0;
     for (unsigned attempt = 0; attempt < 2u; attempt++) {
         if (x->cbs != NULL) {
@@ -939,6 +957,9 @@ static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const para
         }
         x->chunked = !set && chunkable(params);
         PROBE(traces);
+        if (set) {
+            PROBE(set_traces);
+        }
         rc = run_method(x, params, points, n_points, c->ends);
         if (!set || (rc == 0 && !vs->overflow && (chunkable(params) || set_fits_once(x)))) {
             break;
@@ -975,13 +996,16 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
     occ_bitset_t cbs;
     memset(&vs, 0, sizeof vs);
     memset(&cbs, 0, sizeof cbs);
-    const size_t chunks = box_chunks(&x, points, n_points);
+    size_t codes;
+    const size_t chunks = box_chunks(&x, points, n_points, &codes);
     size_t cbricks = 0;
     if (params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u &&
         (cbricks = setup_coarse(&x, params, &cbs, &c)) == 0u) {
         return OCC_ERR_SCRATCH;
     }
-    const int rc = trace_scan(&x, params, points, n_points, &c, &vs, chunks, cbricks);
+    const int rc = trace_scan(&x, params, points, n_points, &c, &vs,
+                              prefer_set(&c, params, n_points, chunks, codes) ? chunks : 0u,
+                              cbricks);
     occ_ictx_note(&x, x.n, 0);
     /* A shared map publishes the scan's evictions, coarse and voxel updates as one version. */
     const bool shared = map->priv.shared != NULL && occ_map_write_begin(map) == OCC_OK;

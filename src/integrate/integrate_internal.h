@@ -254,9 +254,11 @@ static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
 
 #ifdef OCC_TESTING
 /* Test builds only: how the last occ_map_insert_rays() call ran - traversals of the whole scan
- * (run_method / a window's pass) and batches applied with occ_map_observe_codes(). */
+ * (run_method / a window's pass), those into the voxel set, and batches applied with
+ * occ_map_observe_codes(). */
 typedef struct {
     unsigned traces;
+    unsigned set_traces;
     unsigned pieces;
 } occi_insert_probe_t;
 extern occi_insert_probe_t occi_insert_probe;
