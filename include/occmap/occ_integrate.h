@@ -38,7 +38,7 @@
  * (tests/test_integrate_chunks.c checks it to the byte).
  * scan.dat at 0.05 m (88,206 points; 14.2 M voxel visits, 3.9 M voxels, C = 605): 4,239,415 B
  * for SIMPLE (the one batch wants ~34 MB); in 8 MiB it runs in 7 pieces with the same
- * instructions as one batch (callgrind: 1,612 M against 1,613 M; 1,779 M before the set) and
+ * instructions as one batch (callgrind: 1,616 M against 1,617 M; 1,779 M before the set) and
  * 0.99x its CPU time (SIMPLE 0.988x, spread 0.93..1.13; DISCRETE 0.992x, 0.94..1.20: make
  * bench-scratch, 9 interleaved repetitions; README, Performance).
  * Bounded scratch below that (SIMPLE and DISCRETE, issue 22): when the set runs full, the scan is
