@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * integrate.c - occ_map_insert_cloud(): OctoMap's per-scan semantics (each voxel updated once,
- * hit wins over free) with the sets kept as Morton codes in the caller's scratch: rays emit
- * codes through a small exact filter, one radix sort + collapse, one occ_map_observe_codes().
+ * hit wins over free) with the sets in the caller's scratch: rays mark the voxel set (vset.c),
+ * read back in Morton order into one occ_map_observe_codes() batch or several; or they emit
+ * Morton codes through a small exact filter, one radix sort + collapse, one batch (or windows).
  */
 #include <math.h>
 #include <string.h>
@@ -568,13 +569,6 @@ OCC_NOINLINE static bool set_prepare(occ_ictx_t *const x)
     return true;
 }
 
-/* Pass 1: the blocks each piece's update can allocate as if none of its nodes existed (so that
- * pruning by one piece cannot make the next one fail), summed: counted on the set's bricks. */
-static void set_need(occ_ictx_t *const x, uint64_t *const ni, uint64_t *const nl)
-{
-    occi_vset_need(x->bs, x->a, x->n, x->b_cap, x->map->cfg.depth_levels, ni, nl);
-}
-
 /* Pass 2: read and apply each piece (the same pieces as pass 1), counting. */
 OCC_NOINLINE static occ_err_t set_apply(occ_ictx_t *const x)
 {
@@ -598,14 +592,16 @@ OCC_NOINLINE static occ_err_t set_apply(occ_ictx_t *const x)
     return OCC_OK;
 }
 
-/* The set in pieces: pass 1, the pool check (evicting for it first in automatic mode), pass 2.
- * The map is written only after the check. SIMPLE and DISCRETE only (trace_scan). */
+/* The set in pieces: pass 1 - the blocks each piece's update can allocate as if none of its
+ * nodes existed (so that pruning by one piece cannot make the next one fail), summed, counted
+ * on the set's bricks -, the pool check (evicting for it first in automatic mode), pass 2. The
+ * map is written only after the check. SIMPLE and DISCRETE only (trace_scan). */
 OCC_NOINLINE static occ_err_t set_pieces(occ_ictx_t *const x,
                                          const occ_insert_params_t *const params,
                                          const occ_vec3_t *const origin)
 {
     uint64_t ni, nl;
-    set_need(x, &ni, &nl);
+    occi_vset_need(x->bs, x->a, x->n, x->b_cap, x->map->cfg.depth_levels, &ni, &nl);
     if (!coarse_fits(x->map, origin, params, ni, nl)) {
         x->map->oom_count++;
         return OCC_ERR_NOMEM;

@@ -4,7 +4,7 @@
  * in 32^3-voxel chunks taken from the caller's scratch on first touch and found through a hash
  * directory. Its size follows the chunks a scan touches (scan.dat at 0.05 m: 605 chunks,
  * 2.4 MiB, for 14.2 M visits of 3.9 M voxels), and it is read back in Morton order in pieces
- * of any size, so the scan's codes never have to be held all at once.
+ * of whole bricks (any room from 64 codes), so the scan's codes never have to be held at once.
  */
 #include <string.h>
 
