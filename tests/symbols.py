@@ -49,12 +49,24 @@ _LEX = re.compile(r"""
 
 
 def strip_preprocessor(text):
-    """Blank every preprocessor line (with its backslash continuations)."""
-    out, cont = [], False
+    """Blank every preprocessor line (with its backslash continuations), and the code under
+    `#ifdef OCC_TESTING` up to its #else / #endif: test builds only, never in the library the
+    check reads (the release build)."""
+    out, cont, depth, skip_at = [], False, 0, None
     for line in text.split("\n"):
         directive = cont or line.lstrip().startswith("#")
         cont = directive and line.endswith("\\")
-        out.append("" if directive else line)
+        word = line.lstrip()[1:].split() if directive and line.lstrip().startswith("#") else []
+        if word[:1] in (["if"], ["ifdef"], ["ifndef"]):
+            depth += 1
+            if skip_at is None and word[:2] == ["ifdef", "OCC_TESTING"]:
+                skip_at = depth
+        elif word[:1] in (["else"], ["elif"]) and skip_at == depth:
+            skip_at = None
+        elif word[:1] == ["endif"]:
+            skip_at = None if skip_at == depth else skip_at
+            depth -= 1
+        out.append("" if directive or skip_at is not None else line)
     return "\n".join(out)
 
 

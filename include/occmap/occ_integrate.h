@@ -10,30 +10,51 @@
  * when OCC_RAY_DOUBLE=1) on the map's decimal resolution (occmap.h), so the keys are bit-for-bit
  * OctoMap's for the octomap::OcTree(0.1) a user writes for cfg.resolution_m = 0.1f.
  *
- * Memory: no heap. The per-scan key sets live in the caller's scratch buffer. They are sorted
- * Morton codes (radix sort), de-duplicated and applied with one occ_map_observe_codes() call,
- * which touches the tree in Morton order. If the scratch cannot hold them the call returns
+ * Memory: no heap. The per-scan key sets live in the caller's scratch buffer: the voxels the
+ * rays cross as a voxel set (below), or as sorted Morton codes (radix sort) when the set does
+ * not fit; either way they are de-duplicated and applied with occ_map_observe_codes(), which
+ * touches the tree in Morton order. If the scratch cannot hold them the call returns
  * OCC_ERR_SCRATCH; if the pools cannot hold the result, OCC_ERR_NOMEM; either way the map is
  * exactly as before (automatic eviction aside, see auto_evict).
  *
- * Bounded scratch (SIMPLE and DISCRETE, issue 22): when the scan's sorted codes do not fit, the
- * scan runs in Morton-range windows instead of failing. The first pass keeps the lowest codes
- * that fit and narrows its window to them (codes above are dropped by every later ray); each
- * further pass traces the whole scan again for the next window. Windows are disjoint key
- * ranges, so each voxel is updated once and hits win exactly as in one batch: the map equals
- * the one-shot result voxel for voxel. All or nothing still holds: a first round of passes adds
- * up, per window, the blocks its update can allocate as if none of its nodes existed (so the
- * pruning of one window cannot starve the next), checks the sum against the pools (evicting for
- * it first with auto_evict; what was evicted then stays evicted) and returns OCC_ERR_NOMEM with
- * the map unchanged when it does not fit - a conservative check: it may refuse where the
- * one-shot call with enough scratch would succeed. Only then a second round traces and applies
- * each window. Cost: 2 x windows traversals of the scan (windows ~ unique voxels / (scratch /
- * 32)); scan.dat at 0.05 m in 8 MB: ~33x the time of the one-shot call (bench/scratch.cpp).
+ * The voxel set (SIMPLE, DISCRETE, SUPER_RAYS and FAST_DISCRETE's voxel rays): one bit per voxel
+ * in 32^3-voxel chunks (4 KiB, aligned to keys), taken from the scratch when a ray first enters
+ * one, so it grows with the chunks the scan crosses, not with its voxel visits. It is used when
+ * it surely fits (room for every chunk of the scan's bounding box) or when the sorted codes
+ * would not fit one batch (16 bytes per code of the rays' bound after the fixed term); else the
+ * sorted codes run as one batch, and no traversal is risked on a set that could run full.
+ * After the one traversal of the scan the set is read back in Morton order, merged with the end
+ * voxels (hit wins), into the room the chunks left: in one batch when it fits there, else in
+ * pieces of that room (SIMPLE and DISCRETE). All or nothing still holds for pieces: before any
+ * write, the blocks each piece's update can allocate as if none of its nodes existed (so the
+ * pruning of one piece cannot starve the next) are counted on the set and summed, and checked
+ * against the pools (evicting for the sum first with auto_evict; what was evicted then stays
+ * evicted); when they do not fit: OCC_ERR_NOMEM, map unchanged - a conservative check: it may
+ * refuse where one batch with more scratch would succeed. The map equals the one-batch result
+ * voxel for voxel. One traversal needs (n = n_points, C = the 32^3-voxel chunks the rays cross, at most those of
+ * the scan's bounding box):
+ *   OCC_INSERT_SCRATCH_FIXED_BYTES + (DISCRETE) 8 n + 8 (n + 1)
+ *     + max(8 (n + 1), 8192, SUPER_RAYS: its tables, 24 n + 278,600 on a 64-bit host) + 4,160 C
+ * (tests/test_integrate_chunks.c checks it to the byte).
+ * scan.dat at 0.05 m (88,206 points; 14.2 M voxel visits, 3.9 M voxels, C = 605): 4,239,415 B
+ * for SIMPLE (the one batch wants ~34 MB); in 8 MiB it runs in 7 pieces with the same
+ * instructions as one batch (callgrind: 1,616 M against 1,617 M; 1,779 M before the set) and
+ * 0.99x its CPU time (SIMPLE 0.988x, spread 0.93..1.13; DISCRETE 0.992x, 0.94..1.20: make
+ * bench-scratch, 9 interleaved repetitions; README, Performance).
+ * Bounded scratch below that (SIMPLE and DISCRETE, issue 22): when the set runs full, the scan is
+ * traced again as sorted codes in Morton-range windows instead of failing. The first pass keeps
+ * the lowest codes that fit and narrows its window to them (codes above are dropped by every
+ * later ray); each further pass traces the whole scan again for the next window. Windows are
+ * disjoint key ranges, so each voxel is updated once and hits win exactly as in one batch; the
+ * pools are checked first for the sum over the windows, as for pieces. Cost: 2 x windows
+ * traversals of the scan (windows ~ unique voxels / (scratch / 32)); scan.dat at 0.05 m in
+ * 4 MiB (45 KB short of the set): ~10 s, 80-100x one batch.
  * Minimum scratch: the fixed term, plus (DISCRETE) 8 bytes per point, plus 16 bytes per code
  * for c = max(longest ray's keys + 2, DISCRETE: n_points) codes, where a ray's keys are
  * |dk|_1 + 4 (occ_insert_scratch_bytes_scan() of that one point is 8 + 16 (keys + 1)); below
- * it OCC_ERR_SCRATCH, map unchanged. SUPER_RAYS and FAST_DISCRETE are not chunked: short
- * scratch is OCC_ERR_SCRATCH as before.
+ * it OCC_ERR_SCRATCH, map unchanged. SUPER_RAYS and FAST_DISCRETE take the set only when it
+ * fits one batch (else they trace again as sorted codes) and are not windowed: short scratch
+ * is OCC_ERR_SCRATCH as before.
  *
  * Work: O(sum over rays of the voxels each ray crosses) for traversal, bounded per ray by
  * 3 * (max_range / resolution + 2) + 2 voxels (the whole map's edge with unlimited range), plus
@@ -116,8 +137,8 @@ typedef enum {
      * paper's mapping lines) share one traversal. Same map as SIMPLE, voxel for voxel: rays
      * within 1e-9 (relative) of a decision or ending within 1e-4 voxel of a face are cast
      * singly, and so are end voxels with fewer than super_k points and bundles split into more
-     * than a third as many super rays as rays. Needs the dense per-scan set (the scan's box
-     * fits the scratch), else it runs as SIMPLE; memory and scratch as SIMPLE.
+     * than a third as many super rays as rays. Needs the voxel set and its tables in the
+     * scratch (see the top), else each ray is cast alone, as SIMPLE; memory as SIMPLE.
      * When to use it: SIMPLE's exact map from a dense depth camera at coarse voxels, where
      * several points end in one voxel. Measured (`make bench-insert`, bench/insert.cpp: 10 TUM
      * fr2 pioneer frames 640x480, 5 interleaved rounds, CPU ms per frame, medians; ratio = median
@@ -180,8 +201,9 @@ typedef struct {
                                * size that would suffice: use the bounds below for that. */
 } occ_insert_result_t;
 
-/* Scratch bytes that make occ_map_insert_cloud() run in one pass (the fast path; less is chunked
- * for SIMPLE and DISCRETE, see the top of this header), for up to
+/* Scratch bytes that make occ_map_insert_cloud() run in one batch whatever the scan (less is
+ * enough when the scan's voxel set fits; less still runs SIMPLE and DISCRETE in windows, see
+ * the top of this header), for up to
  * `n_points` points whose rays are at most `max_ray_m` long (pass max(max_range, farthest point
  * distance); <= 0 or non-finite means "the whole map": a huge number). Formula:
  *   OCC_INSERT_SCRATCH_BYTES(n_points, ceil(max_ray_m / res) + 2)
@@ -403,7 +425,7 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_map_insert_cloud, occ_map_insert_rays: stack <= 1,472 / 1,536 B; work: n_points rays x <= 3
+ *   occ_map_insert_cloud, occ_map_insert_rays: stack <= 1,408 / 1,472 B; work: n_points rays x <= 3
  *       (ceil(max_ray / res) + 2) + 2 voxels, then one path per distinct voxel
  *   occ_map_insert_projective: stack <= 1,152 / 1,152 B (its context, tables, walk stack and
  *       lane arrays are in the scratch; the deepest chain is the tree pass updating a whole

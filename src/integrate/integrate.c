@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * integrate.c - occ_map_insert_cloud(): OctoMap's per-scan semantics (each voxel updated once,
- * hit wins over free) with the sets kept as Morton codes in the caller's scratch: rays emit
- * codes through a small exact filter, one radix sort + collapse, one occ_map_observe_codes().
+ * hit wins over free) with the sets in the caller's scratch: rays mark the voxel set (vset.c),
+ * read back in Morton order into one occ_map_observe_codes() batch or several; or they emit
+ * Morton codes through a small exact filter, one radix sort + collapse, one batch (or windows).
  */
 #include <math.h>
 #include <string.h>
@@ -19,6 +20,15 @@
 typedef char fixed_term_matches_header[OCC_INSERT_SCRATCH_FIXED_BYTES == 7u + FIXED_RT ? 1 : -1];
 /* Scratch beyond this is not used: the sort counts codes in 32 bits (32 GiB on a 64-bit host). */
 #define SCRATCH_MAX ((size_t)UINT32_MAX < SIZE_MAX / 8u ? (size_t)UINT32_MAX * 8u : SIZE_MAX)
+
+#ifdef OCC_TESTING
+occi_insert_probe_t occi_insert_probe;
+#define PROBE(field) (occi_insert_probe.field++)
+#define PROBE_RESET() memset(&occi_insert_probe, 0, sizeof occi_insert_probe)
+#else
+#define PROBE(field) ((void)0)
+#define PROBE_RESET() ((void)0)
+#endif
 
 occ_insert_params_t occ_insert_params_default(void)
 {
@@ -328,11 +338,13 @@ static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const para
     }
 }
 
-/* Bricks of the box around the origin and every (clipped) end point, padded by 2 voxels for
- * the DDA's rounding; fills bs->b0/nb. 0 when the box is too large to consider. */
-static size_t box_bricks(occ_ictx_t *const x, const occ_vec3_t *const points,
-                         const size_t n, occ_bitset_t *const bs)
+/* The box around the origin and every (clipped) end point, padded by 2 voxels for the DDA's
+ * rounding, into box_lo/box_hi; returns its 32^3-voxel chunks (saturated): no scan touches
+ * more chunks of the voxel set. *codes: the codes the rays can emit on the sorted path. */
+static size_t box_chunks(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                         size_t *const codes)
 {
+    *codes = 0;
     uint32_t lo[3] = {x->ko[0], x->ko[1], x->ko[2]}, hi[3] = {x->ko[0], x->ko[1], x->ko[2]};
     for (size_t i = 0; i < n; i++) {
         if (!occ_finite3(points[i])) {
@@ -348,28 +360,20 @@ static size_t box_bricks(occ_ictx_t *const x, const occ_vec3_t *const points,
         if (!occi_raygeo_key(&x->g, q, k)) {
             continue;
         }
+        *codes = occ_sat_add(*codes, occi_dda_bound(x->ko, k) + 1u);
         for (unsigned a = 0; a < 3u; a++) {
             lo[a] = k[a] < lo[a] ? k[a] : lo[a];
             hi[a] = k[a] > hi[a] ? k[a] : hi[a];
         }
     }
-    size_t bricks = 1;
+    size_t chunks = 1;
     const uint32_t kmax = ((uint32_t)1 << x->g.depth) - 1u;
     for (unsigned a = 0; a < 3u; a++) {
-        lo[a] = lo[a] >= 2u ? lo[a] - 2u : 0u;
-        hi[a] = hi[a] + 2u <= kmax ? hi[a] + 2u : kmax;
-        x->box_lo[a] = lo[a];
-        x->box_hi[a] = hi[a];
-        bs->b0[a] = (lo[a] >> 2) & ~7u;
-        bs->nb[a] = (((hi[a] >> 2) - bs->b0[a]) | 7u) + 1u;
-        bricks = occ_sat_mul(bricks, bs->nb[a]);
+        x->box_lo[a] = lo[a] >= 2u ? lo[a] - 2u : 0u;
+        x->box_hi[a] = hi[a] + 2u <= kmax ? hi[a] + 2u : kmax;
+        chunks = occ_sat_mul(chunks, (size_t)((x->box_hi[a] >> 5) - (x->box_lo[a] >> 5)) + 1u);
     }
-    if (bricks > SIZE_MAX / 64u) {
-        return 0;
-    }
-    bs->stride_y = bs->nb[0] >> 3;
-    bs->stride_z = (size_t)(bs->nb[0] >> 3) * (bs->nb[1] >> 3);
-    return bricks;
+    return chunks;
 }
 
 /* Can the pools supply what the coarse pass and the voxel batch need (bounds as if no node
@@ -481,31 +485,18 @@ static uint8_t *align8(void *const p)
 
 /* The scan's sorted, collapsed codes; FAST_DISCRETE's coarse pass (d > 0); then one coherent
  * batch update in Morton order (all or nothing, except in automatic mode). Out of line: inlined,
- * its locals stayed in occ_map_insert_rays' frame under the ray traversal too (make cross). */
+ * its locals stayed in occ_map_insert_rays' frame under the ray traversal too (make cross).
+ * With the voxel set, set_prepare() showed that its codes fit x->b in one piece. */
 OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
                                                  const occ_insert_params_t *const params,
-                                                 const occ_vec3_t *const origin, const bool dense,
-                                                 occ_bitset_t *const bs, occ_bitset_t *const cbs)
+                                                 const occ_vec3_t *const origin,
+                                                 occ_bitset_t *const cbs)
 {
     occ_insert_result_t *const r = x->r;
     occ_code_t *codes, *spare; /* spare: free scratch after the fine codes, for the coarse ones */
     size_t m, spare_cap;
-    if (dense) {
-        if (x->b_cap < x->n || x->b_cap < bs->n_touched) {
-            return OCC_ERR_SCRATCH;
-        }
-        occ_ictx_note(x, 0, x->n > bs->n_touched ? x->n : bs->n_touched);
-        occ_code_t *const hs = occi_keyset_sort(x->a, x->b, x->n, x->hist);
-        const size_t nh = occi_keyset_unique(hs, x->n);
-        if (hs != x->a) {
-            memcpy(x->a, hs, nh * sizeof *hs);
-        }
-        m = occi_bitset_extract(bs, x->a, nh, x->b, x->b_cap, x->b, x->hist);
-        if (m == SIZE_MAX) {
-            occ_ictx_note(x, 0, x->b_cap);
-            return OCC_ERR_SCRATCH;
-        }
-        occ_ictx_note(x, 0, m);
+    if (x->bs != NULL) { /* set_prepare() read the set into x->b */
+        m = x->n;
         codes = x->b;
         spare = x->b + m;
         spare_cap = x->b_cap - m;
@@ -535,6 +526,7 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
         }
     }
     size_t changed = 0;
+    PROBE(pieces);
     occ_err_t e = occ_map_observe_codes(map, codes, m, &changed);
     if (e == OCC_ERR_NOMEM && params->auto_evict != NULL) {
         size_t applied = 0;
@@ -551,17 +543,84 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
     return OCC_OK;
 }
 
+/* ---- the voxel set read back in pieces (bounded scratch without retracing) -----------------
+ * After the scan: the hits sorted and collapsed, the set's chunk list sorted, and x->b_cap
+ * widened to all the room between b and the set's chunks. When the set and the hits fit there
+ * in one piece, they are read into x->b (x->n codes, as the sorted path leaves them for
+ * collapse_and_apply) and true is returned; else x->a holds the x->n hits and set_pieces()
+ * applies the set in pieces. Out of line: its cursor stays off the tree update's stack. */
+OCC_NOINLINE static bool set_prepare(occ_ictx_t *const x)
+{
+    occ_ictx_note(x, 0, x->n);
+    occ_code_t *const hs = occi_keyset_sort(x->a, x->b, x->n, x->hist);
+    x->n = occi_keyset_unique(hs, x->n);
+    if (hs != x->a) {
+        memcpy(x->a, hs, x->n * sizeof *hs);
+    }
+    occi_vset_sort(x->bs, x->hist);
+    x->b_cap = (size_t)(occi_vset_low(x->bs) - (uint8_t *)(void *)x->b) / 8u;
+    if (x->n > x->b_cap || occi_vset_count(x->bs) > x->b_cap - x->n) {
+        return false;
+    }
+    occ_vset_cursor_t cur;
+    memset(&cur, 0, sizeof cur);
+    x->n = occi_vset_read(x->bs, &cur, x->a, x->n, x->b, x->b_cap);
+    occ_ictx_note(x, 0, x->n);
+    return true;
+}
+
+/* Pass 2: read and apply each piece (the same pieces as pass 1), counting. */
+OCC_NOINLINE static occ_err_t set_apply(occ_ictx_t *const x)
+{
+    occ_insert_result_t *const r = x->r;
+    occ_vset_cursor_t cur;
+    memset(&cur, 0, sizeof cur);
+    size_t m;
+    while ((m = occi_vset_read(x->bs, &cur, x->a, x->n, x->b, x->b_cap)) > 0u) {
+        occ_ictx_note(x, 0, m);
+        size_t ch = 0;
+        PROBE(pieces);
+        const occ_err_t e = occ_map_observe_codes(x->map, x->b, m, &ch);
+        if (e != OCC_OK) {
+            return e; /* cannot happen: pass 1 checked the pools for these pieces */
+        }
+        r->voxels_updated += m;
+        r->voxels_changed += ch;
+    }
+    r->voxels_occupied = x->n; /* every hit was read once, as a hit */
+    r->voxels_free = r->voxels_updated - r->voxels_occupied;
+    return OCC_OK;
+}
+
+/* The set in pieces: pass 1 - the blocks each piece's update can allocate as if none of its
+ * nodes existed (so that pruning by one piece cannot make the next one fail), summed, counted
+ * on the set's bricks -, the pool check (evicting for it first in automatic mode), pass 2. The
+ * map is written only after the check. SIMPLE and DISCRETE only (trace_scan). */
+OCC_NOINLINE static occ_err_t set_pieces(occ_ictx_t *const x,
+                                         const occ_insert_params_t *const params,
+                                         const occ_vec3_t *const origin)
+{
+    uint64_t ni, nl;
+    occi_vset_need(x->bs, x->a, x->n, x->b_cap, x->map->cfg.depth_levels, &ni, &nl);
+    if (!coarse_fits(x->map, origin, params, ni, nl)) {
+        x->map->oom_count++;
+        return OCC_ERR_NOMEM;
+    }
+    return set_apply(x);
+}
+
 /* out->scratch_used: the bytes of scratch the call wrote - the histograms, the filter (sorted
- * path), the end voxels, the dense and coarse sets (words and touched lists) and the high-water
- * marks of the two code arrays. Memory the call reserved but never wrote is not counted. */
+ * path), the end voxels, the voxel set (chunks, directory), the coarse set (words and touched
+ * list) and the high-water marks of the two code arrays. Memory the call reserved but never
+ * wrote is not counted. */
 static size_t touched_bytes(const occ_ictx_t *const x, const occ_insert_params_t *const params,
-                            const size_t dense_bricks, const size_t cbricks)
+                            const size_t cbricks)
 {
     size_t b = OCC_KS_HIST_WORDS * 4u;
     if (x->bs == NULL) {
         b += FILTER_N * 8u;
     } else {
-        b += 8u * (dense_bricks + x->bs->n_touched);
+        b += occi_vset_bytes(x->bs);
     }
     if (params->method == OCC_INSERT_DISCRETE || params->method == OCC_INSERT_FAST_DISCRETE) {
         b += 8u * x->n_ends;
@@ -666,32 +725,75 @@ static size_t setup_coarse(occ_ictx_t *const x, const occ_insert_params_t *const
     return cbricks;
 }
 
-/* Lay out one pass: the dense set and the hits after it, or the sorted path's code arrays. */
-static void layout_pass(occ_ictx_t *const x, const carve_t *const c, const bool dense,
-                        occ_bitset_t *const bs, const size_t bricks, const size_t hits_cap)
+/* Lay out one pass on the sorted path: the two code arrays. */
+static void layout_sorted(occ_ictx_t *const x, const carve_t *const c)
 {
     x->n = 0;
     x->a_hwm = 0;
     x->b_hwm = 0;
-    if (dense) {
-        bs->words = (uint64_t *)(void *)c->rest;
-        bs->touched = bs->words + bricks;
-        bs->n_touched = 0;
-        bs->n_set = 0;
-        bs->overflow = false;
-        memset(bs->words, 0, bricks * 8u);
-        x->bs = bs;
-        x->a = bs->touched + bricks;
-        x->cap = hits_cap;
-        x->b = x->a + hits_cap;
-        x->b_cap = (size_t)((c->rest + c->rest_bytes) - (uint8_t *)(void *)x->b) / 8u;
-    } else {
-        memset(x->filt, 0xFF, FILTER_N * 8u); /* bit 63 set: never a code */
-        x->bs = NULL;
-        x->cap = c->rest_bytes / 16u;
-        x->a = (occ_code_t *)(void *)c->rest;
-        x->b = x->a + x->cap;
+    memset(x->filt, 0xFF, FILTER_N * 8u); /* bit 63 set: never a code */
+    x->bs = NULL;
+    x->cap = c->rest_bytes / 16u;
+    x->a = (occ_code_t *)(void *)c->rest;
+    x->b = x->a + x->cap;
+}
+
+/* Codes of room at x->b while the set is built (the hits' sort, the super rays' tables); after
+ * the scan it also takes the room the set's chunks left, and the set is read into it. */
+#define SET_MIN_WORK 1024u
+static size_t set_work(const occ_insert_params_t *const params, const size_t n_points,
+                       const size_t hits_cap)
+{
+    size_t w = hits_cap > SET_MIN_WORK ? hits_cap : SET_MIN_WORK;
+    if (params->method == OCC_INSERT_SUPER_RAYS) {
+        const size_t sr = occi_superray_need(n_points) / 8u + 1u;
+        w = sr > w ? sr : w;
     }
+    return w;
+}
+
+/* Lay out one pass with the voxel set: the hits at a, the work room at b, the set above (its
+ * chunks come down from the top). False when not one chunk fits. */
+static bool layout_set(occ_ictx_t *const x, const carve_t *const c, occ_vset_t *const vs,
+                       const size_t hits_cap, const size_t work, const size_t max_chunks)
+{
+    x->n = 0;
+    x->a_hwm = 0;
+    x->b_hwm = 0;
+    const size_t low = occ_sat_mul(occ_sat_add(hits_cap, work), 8u);
+    if (low >= c->rest_bytes ||
+        !occi_vset_init(vs, c->rest + low, c->rest_bytes - low, max_chunks, x->g.depth)) {
+        return false;
+    }
+    x->bs = vs;
+    x->a = (occ_code_t *)(void *)c->rest;
+    x->cap = hits_cap;
+    x->b = x->a + hits_cap;
+    x->b_cap = work;
+    return true;
+}
+
+/* Build the voxel set when it surely fits (room for every chunk of the scan's box), or when the
+ * sorted codes would not fit one batch (they would need windows: a set that runs full costs one
+ * more trace, windows at least four). Else the sorted path, which then surely runs as one
+ * batch: no trace is ever lost to a set that runs full where one batch was possible. */
+static bool prefer_set(const carve_t *const c, const occ_insert_params_t *const params,
+                       const size_t n_points, const size_t chunks, const size_t codes)
+{
+    const size_t hits_cap = occ_sat_add(n_points, 1u);
+    const size_t low =
+        occ_sat_mul(occ_sat_add(hits_cap, set_work(params, n_points, hits_cap)), 8u);
+    const bool sure = low < c->rest_bytes && (c->rest_bytes - low) / OCC_VSET_CHUNK_BYTES >= chunks;
+    return sure || occ_sat_mul(codes, 16u) > c->rest_bytes;
+}
+
+/* After a scan into the set by SUPER_RAYS or FAST_DISCRETE (not applied in pieces): do its
+ * voxels, the hits and FAST_DISCRETE's coarse codes fit the room between b and the chunks? */
+static bool set_fits_once(const occ_ictx_t *const x)
+{
+    const size_t room = (size_t)(occi_vset_low(x->bs) - (uint8_t *)(void *)x->b) / 8u;
+    const size_t coarse = x->cbs != NULL ? x->cbs->n_set : 0u;
+    return occ_sat_add(occ_sat_add(occi_vset_count(x->bs), x->n), coarse) <= room;
 }
 
 /* ---- bounded scratch: the scan in Morton-range windows ---------------------------------------
@@ -728,6 +830,7 @@ static int chunk_run(occ_ictx_t *const x, const occ_insert_params_t *const param
                      const occ_vec3_t *const points, const size_t n_points,
                      const carve_t *const c, const occ_code_t lo)
 {
+    PROBE(traces);
     memset(x->filt, 0xFF, FILTER_N * 8u);
     x->n = 0;
     x->win_lo = lo;
@@ -793,6 +896,7 @@ static occ_err_t chunk_apply(occ_ictx_t *const x, const occ_insert_params_t *con
         for (size_t i = 0; i < m; i++) {
             r->voxels_occupied += (size_t)(codes[i] >> 63);
         }
+        PROBE(pieces);
         const occ_err_t e = occ_map_observe_codes(x->map, codes, m, &ch);
         if (e != OCC_OK) {
             return e;
@@ -822,19 +926,18 @@ static occ_err_t run_chunks(occ_ictx_t *const x, const occ_insert_params_t *cons
     return chunk_apply(x, params, points, n_points, c);
 }
 
-/* Trace the scan: in the dense set when the box fits the scratch, else as sorted codes (also
- * when a visit fell outside the box, which the padding should rule out). Returns run_method's
- * code; *dense says which path holds the result. */
+/* Trace the scan: into the voxel set (max_chunks > 0: prefer_set()) when it fits the scratch,
+ * else as sorted codes (in windows for SIMPLE and DISCRETE). A set that runs full (or a ray
+ * leaving the map) means one more pass on the sorted path; so does a set too big to apply in
+ * one piece by SUPER_RAYS or FAST_DISCRETE. Returns run_method's code; x->bs says which path
+ * holds the result. */
 static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const params,
                       const occ_vec3_t *const points, const size_t n_points, const carve_t *c,
-                      occ_bitset_t *const bs, const size_t bricks, const size_t cbricks,
-                      bool *const dense)
+                      occ_vset_t *const vs, const size_t max_chunks, const size_t cbricks)
 {
     const size_t hits_cap = occ_sat_add(n_points, 1u);
-    /* FAST_DISCRETE with n = 0 casts no voxel rays: only hits, no dense set needed. */
-    const bool no_fine = x->cbs != NULL && x->cn == 0u;
-    *dense = !no_fine && bricks > 0u && bricks <= c->rest_bytes / 64u &&
-             hits_cap <= (c->rest_bytes / 2u - 16u * bricks) / 16u;
+    /* FAST_DISCRETE with n = 0 casts no voxel rays: only hits, no voxel set needed. */
+    bool set = max_chunks > 0u && !(x->cbs != NULL && x->cn == 0u);
     int rc = 0;
     for (unsigned attempt = 0; attempt < 2u; attempt++) {
         if (x->cbs != NULL) {
@@ -843,14 +946,22 @@ static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const para
             x->cbs->n_set = 0;
             x->cbs->overflow = false;
         }
-        layout_pass(x, c, *dense, bs, bricks, hits_cap);
-        x->chunked = !*dense && chunkable(params);
+        set = set && layout_set(x, c, vs, hits_cap, set_work(params, n_points, hits_cap),
+                                max_chunks);
+        if (!set) {
+            layout_sorted(x, c);
+        }
+        x->chunked = !set && chunkable(params);
+        PROBE(traces);
+        if (set) {
+            PROBE(set_traces);
+        }
         rc = run_method(x, params, points, n_points, c->ends);
-        if (rc < 0 || !*dense || !bs->overflow) {
+        if (!set || (rc == 0 && !vs->overflow && (chunkable(params) || set_fits_once(x)))) {
             break;
         }
-        memset(x->r, 0, sizeof *x->r); /* cannot happen with the padded box; stay exact anyway */
-        *dense = false;
+        memset(x->r, 0, sizeof *x->r);
+        set = false;
     }
     return rc;
 }
@@ -865,6 +976,7 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
     /* cppcheck-suppress uninitvar ; only its address is taken here (cppcheck 2.10 flags &x of a fresh local) */
     occ_insert_result_t *const r = out != NULL ? out : &local;
     memset(r, 0, sizeof *r);
+    PROBE_RESET();
     occ_err_t e = check_args(map, origin, points, n_points, params, scratch, scratch_bytes);
     occ_ictx_t x;
     if (e != OCC_OK || (e = ictx_begin(&x, map, origin, params, r)) != OCC_OK) {
@@ -876,17 +988,20 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
                        &c)) {
         return OCC_ERR_SCRATCH;
     }
-    occ_bitset_t bs, cbs;
-    memset(&bs, 0, sizeof bs);
+    occ_vset_t vs;
+    occ_bitset_t cbs;
+    memset(&vs, 0, sizeof vs);
     memset(&cbs, 0, sizeof cbs);
-    const size_t bricks = box_bricks(&x, points, n_points, &bs);
+    size_t codes;
+    const size_t chunks = box_chunks(&x, points, n_points, &codes);
     size_t cbricks = 0;
     if (params->method == OCC_INSERT_FAST_DISCRETE && params->fast_d > 0u &&
         (cbricks = setup_coarse(&x, params, &cbs, &c)) == 0u) {
         return OCC_ERR_SCRATCH;
     }
-    bool dense = false;
-    const int rc = trace_scan(&x, params, points, n_points, &c, &bs, bricks, cbricks, &dense);
+    const int rc = trace_scan(&x, params, points, n_points, &c, &vs,
+                              prefer_set(&c, params, n_points, chunks, codes) ? chunks : 0u,
+                              cbricks);
     occ_ictx_note(&x, x.n, 0);
     /* A shared map publishes the scan's evictions, coarse and voxel updates as one version. */
     const bool shared = map->priv.shared != NULL && occ_map_write_begin(map) == OCC_OK;
@@ -894,13 +1009,15 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
         e = OCC_ERR_SCRATCH;
     } else if (x.win_hi != OCC_CODE_HIT_BIT) {
         e = run_chunks(&x, params, points, n_points, &c, origin);
+    } else if (x.bs != NULL && !set_prepare(&x)) {
+        e = set_pieces(&x, params, origin);
     } else {
-        e = collapse_and_apply(&x, params, origin, dense, &bs, &cbs);
+        e = collapse_and_apply(&x, params, origin, &cbs);
     }
     if (shared) {
         (void)occ_map_write_end(map);
     }
-    r->scratch_used = touched_bytes(&x, params, dense ? bricks : 0u, cbricks);
+    r->scratch_used = touched_bytes(&x, params, cbricks);
     return e;
 }
 

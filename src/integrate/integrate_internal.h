@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
- * integrate_internal.h - what raycast.c, keyset.c, integrate.c and superray.c share (src/integrate
- * only): OctoMap's key arithmetic, the exact DDA writing Morton codes, the key-set sort.
+ * integrate_internal.h - what raycast.c, keyset.c, vset.c, integrate.c and superray.c share
+ * (src/integrate only): OctoMap's key arithmetic, the exact DDA writing Morton codes or marking
+ * a voxel set, the key-set sort.
  */
 #ifndef OCC_INTEGRATE_INTERNAL_H_INCLUDED
 #define OCC_INTEGRATE_INTERNAL_H_INCLUDED
@@ -65,11 +66,10 @@ uint64_t *occi_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_
  * OR of the run's. Returns the new length. */
 size_t occi_keyset_unique(occ_code_t *a, size_t n);
 
-/* ---- dense per-scan voxel set over the scan's bounding box (keyset.c, raycast.c) -------------
- * One 64-bit word per 4x4x4-voxel brick aligned to absolute keys, so a brick's voxels are the
+/* ---- dense set over a bounding box (keyset.c): FAST_DISCRETE's coarse nodes ------------------
+ * One 64-bit word per 4x4x4 brick aligned to absolute keys, so a brick's voxels are the
  * 64 consecutive Morton codes (brick code << 6) + bit. Bricks are stored in chunks of 8x8x8
- * (4 KiB, Morton order inside) so that a ray stays on one page for 32 voxels. Used when the box
- * fits the scratch: a visit is a test-and-set, and only first visits are ever stored. */
+ * (4 KiB, Morton order inside). A visit is a test-and-set; first visits of a brick are listed. */
 typedef struct {
     uint64_t *words;     /* chunks * 512 words, zeroed */
     uint64_t *touched;   /* word indices of bricks in first-touch order (cap: all bricks) */
@@ -131,10 +131,74 @@ static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, ui
     return true;
 }
 
-/* computeRayKeys(o, e) into the set; returns the visits. Sets bs->overflow and stops when a
- * voxel is outside the box. */
+/* ---- the scan's voxel set (vset.c): sparse, grows with the chunks a scan touches -------------
+ * The same bricks (one word per 4x4x4 voxels, bit = Morton order inside) in chunks of 32^3
+ * voxels (512 words, 4 KiB, bricks in Morton order) aligned to absolute keys, so voxel code =
+ * (chunk code << 15) | (word << 6) | bit. Chunks are taken on first touch from the top of the
+ * set's memory downward and found through an open-addressing hash directory of the chunk
+ * coordinates. A visit is one OR; memory is 4 KiB per chunk touched, not per visit. */
+#define OCC_VSET_WORDS 512u
+/* Bytes per chunk of room: its words, its entry in the list and the list's sort temporary,
+ * and up to 4 directory entries (uint64_t key, uint32_t slot). */
+#define OCC_VSET_CHUNK_BYTES (OCC_VSET_WORDS * 8u + 16u + 48u)
+typedef struct {
+    uint64_t *top;       /* chunk s: the 512 words below top - s * 512 */
+    uint64_t *keys;      /* directory: packed chunk coordinates + 1, 0 = empty (2^tbits) */
+    uint32_t *slots;     /* directory: the chunk's s */
+    uint64_t *list;      /* chunk codes by s; sorted by occi_vset_sort() */
+    uint64_t *ltmp;      /* the list's sort temporary */
+    size_t cap, n;       /* chunks: room and taken */
+    uint32_t cmax;       /* chunk coordinates are below this (the map's edge / 32) */
+    unsigned tbits;      /* log2 of the directory's entries */
+    bool overflow;       /* full, or a visit left the map: the caller falls back to sorting */
+} occ_vset_t;
+
+/* Lay a set with room for at most max_chunks chunks out in [mem, mem + bytes) (mem 8-aligned):
+ * the directory at the top, the chunks below it. False when not one chunk fits. */
+bool occi_vset_init(occ_vset_t *vs, uint8_t *mem, size_t bytes, size_t max_chunks,
+                    unsigned depth);
+/* The words of chunk (cx, cy, cz) (key >> 5 per axis), taken and zeroed on first touch; NULL
+ * when the set is full or the chunk is outside the map. */
+uint64_t *occi_vset_chunk(occ_vset_t *vs, uint32_t cx, uint32_t cy, uint32_t cz);
+/* Lowest byte of the set's memory in use (chunks taken): what is below it is free. */
+uint8_t *occi_vset_low(const occ_vset_t *vs);
+/* Bytes of the set's memory written so far (chunks, directory, list). */
+size_t occi_vset_bytes(const occ_vset_t *vs);
+/* Voxels in the set (a popcount over the chunks taken). */
+size_t occi_vset_count(const occ_vset_t *vs);
+/* Sort the chunk list by code: call once after the scan, before reading. */
+void occi_vset_sort(occ_vset_t *vs, uint32_t *hist);
+
+/* Reading the set back in Morton order, merged with the scan's hits, in pieces that end at
+ * brick borders. */
+typedef struct {
+    size_t ci;           /* chunks of the sorted list begun */
+    const uint64_t *cw;  /* the current chunk's words (NULL: none yet / after the last) */
+    occ_code_t base;     /* the current chunk's first voxel code */
+    uint32_t wi;         /* next word of the chunk */
+    uint64_t w;          /* the set's next brick not merged yet (0: none) */
+    occ_code_t wbase;    /* its first voxel code */
+    size_t h;            /* next hit not merged yet */
+    occ_code_t pbase;    /* the pending merged brick: first voxel code, */
+    uint64_t pbits;      /* its voxels, */
+    uint64_t phits;      /* which of them are hits, */
+    bool pend;           /* and whether there is one */
+} occ_vset_cursor_t;
+
+/* The next codes of the set merged with `hits` (sorted, unique, hit bit set; a voxel in both
+ * is a hit), whole bricks only, at most cap (>= 64) of them into out. Returns how many; 0 only
+ * at the end. */
+size_t occi_vset_read(const occ_vset_t *vs, occ_vset_cursor_t *cur, const occ_code_t *hits,
+                      size_t n_hits, occ_code_t *out, size_t cap);
+/* occi_coarse_need(piece, m, 0, depth) summed over the pieces occi_vset_read() makes with this
+ * cap from a new cursor, counted on the bricks (without writing the codes). */
+void occi_vset_need(const occ_vset_t *vs, const occ_code_t *hits, size_t n_hits, size_t cap,
+                    unsigned depth, uint64_t *inner, uint64_t *leaf);
+
+/* computeRayKeys(o, e) into the set; returns the visits. Sets vs->overflow and stops when the
+ * set is full or a voxel is outside the map. */
 size_t occi_dda_mark(const occ_raygeo_t *g, const float o[3], const float e[3],
-                     const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *bs);
+                     const uint32_t ko[3], const uint32_t ke[3], occ_vset_t *vs);
 
 /* Sorted, collapsed codes of the set merged with `hits` (sorted, unique, hit bit set): a voxel
  * in both is a hit. Writes to out (cap codes); returns the count, or SIZE_MAX when cap is too
@@ -154,8 +218,8 @@ typedef struct {
     uint32_t *hist;        /* radix histograms */
     occ_code_t *a, *b;     /* emitted codes (may repeat) and the sort's temporary, cap each */
     size_t cap, n;
-    size_t b_cap;          /* dense path: codes that fit at b (free until the final merge) */
-    occ_bitset_t *bs;      /* non-NULL: free voxels go to this set, hits to a[] */
+    size_t b_cap;          /* set path: codes that fit at b (free until the set is read) */
+    occ_vset_t *bs;        /* non-NULL: free voxels go to this set, hits to a[] */
     occ_bitset_t *cbs;     /* FAST_DISCRETE, d > 0: coarse nodes (keys >> cd) to clear */
     uint8_t cd, cn;        /* FAST_DISCRETE: coarse level d and n */
     uint32_t box_lo[3], box_hi[3]; /* keys of the scan's box (padded) */
@@ -188,6 +252,18 @@ static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
     x->a[x->n++] = c;
 }
 
+#ifdef OCC_TESTING
+/* Test builds only: how the last occ_map_insert_rays() call ran - traversals of the whole scan
+ * (run_method / a window's pass), those into the voxel set, and batches applied with
+ * occ_map_observe_codes(). */
+typedef struct {
+    unsigned traces;
+    unsigned set_traces;
+    unsigned pieces;
+} occi_insert_probe_t;
+extern occi_insert_probe_t occi_insert_probe;
+#endif
+
 /* FAST_DISCRETE's ray (fastdiscrete.c): coarse marching, then fine DDA near the end. */
 void occi_fast_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
 
@@ -204,5 +280,7 @@ int occi_ictx_points(occ_ictx_t *x, const occ_vec3_t *points, size_t n, bool no_
  * Returns false when scratch ran out. */
 bool occi_superray_run(occ_ictx_t *x, const occ_vec3_t *points, size_t n_points,
                        uint16_t k_min);
+/* Bytes occi_superray_run() needs at x->b for n points (less: it casts each ray alone). */
+size_t occi_superray_need(size_t n);
 
 #endif

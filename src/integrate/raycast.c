@@ -170,8 +170,9 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
     return n;
 }
 
-/* The DDA_LOOP decisions with the set's word index kept incrementally: a step moves the voxel's
- * 15-bit Morton offset inside its 32^3 chunk by dilated +-1, and the chunk only on a wrap. */
+/* The DDA_LOOP decisions with the voxel's place in the set kept incrementally: a step moves
+ * the voxel's 15-bit Morton offset inside its 32^3 chunk by dilated +-1, and the chunk only on
+ * a wrap (then the set is asked for the next chunk's words). */
 #define MARK_STEP(a, ka, sa, ta, da)                                                          \
     do {                                                                                          \
         const uint32_t m_ = 0x1249u << (a);                                                       \
@@ -180,14 +181,12 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
         if (sa > 0) {                                                                             \
             local = (((local | ~m_) + 1u) & m_) | (local & ~m_);                                  \
             if (((uint32_t)ka & 31u) == 0u) {                                                     \
-                chunk += stride[a];                                                               \
                 cc[a]++;                                                                          \
                 moved = true;                                                                     \
             }                                                                                     \
         } else {                                                                                  \
             local = (((local & m_) - 1u) & m_) | (local & ~m_);                                   \
             if (((uint32_t)ka & 31u) == 31u) {                                                    \
-                chunk -= stride[a];                                                               \
                 cc[a]--;                                                                          \
                 moved = true;                                                                     \
             }                                                                                     \
@@ -195,27 +194,22 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
     } while (0)
 
 size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
-                     const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *const bs)
+                     const uint32_t ko[3], const uint32_t ke[3], occ_vset_t *const vs)
 {
     if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
         return 0;
     }
     dda_t s;
     dda_init(&s, g, o, e, ko, ke);
-    if (!occ_bitset_add(bs, ko[0], ko[1], ko[2])) {
-        bs->overflow = true;
+    uint32_t cc[3] = {ko[0] >> 5, ko[1] >> 5, ko[2] >> 5};
+    uint64_t *cw = occi_vset_chunk(vs, cc[0], cc[1], cc[2]);
+    if (cw == NULL) {
+        vs->overflow = true;
         return 0;
     }
-    const size_t stride[3] = {1u, bs->stride_y, bs->stride_z};
-    const uint32_t ncs[3] = {bs->nb[0] >> 3, bs->nb[1] >> 3, bs->nb[2] >> 3};
-    uint32_t cc[3];
-    for (unsigned a = 0; a < 3u; a++) {
-        cc[a] = (ko[a] >> 5) - (bs->b0[a] >> 3);
-    }
-    size_t chunk = cc[0] + stride[1] * cc[1] + stride[2] * cc[2];
     uint32_t local = (uint32_t)occi_spread5[ko[0] & 31u] | ((uint32_t)occi_spread5[ko[1] & 31u] << 1) |
                      ((uint32_t)occi_spread5[ko[2] & 31u] << 2);
-    uint64_t *const words = bs->words;
+    cw[local >> 6] |= (uint64_t)1 << (local & 63u);
     size_t n = 1;
     occ_rr_t t0 = s.dd.tmax[0], t1 = s.dd.tmax[1], t2 = s.dd.tmax[2];
     const occ_rr_t d0 = s.dd.tdelta[0], d1 = s.dd.tdelta[1], d2 = s.dd.tdelta[2];
@@ -227,8 +221,9 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     bool pending = false, moved = false;
     /* OctoMap's order per step: advance, stop at the end key, stop when min(tMax) > length,
      * else add the key. The min is the next step's choice, so the length test and the add
-     * happen at the top of the next iteration. Leaving the map means leaving the box (which
-     * lies inside it): the caller then redoes the scan on the sorted path, which stops there. */
+     * happen at the top of the next iteration. A chunk outside the map (or a full set) ends the
+     * ray with vs->overflow: the caller then redoes the scan on the sorted path, which stops
+     * at the map's edge as OctoMap does. */
     for (;;) {
         const unsigned dim = occ_dda_axis(t0, t1, t2);
         const occ_rr_t tsel = dim == 0u ? t0 : (dim == 1u ? t1 : t2);
@@ -236,25 +231,19 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
             if (tsel > len) {
                 break;
             }
-            if (moved && (cc[0] >= ncs[0] || cc[1] >= ncs[1] || cc[2] >= ncs[2])) {
-                bs->overflow = true;
-                break;
-            }
-            const size_t wi = (chunk << 9) | (local >> 6);
-            const uint64_t bit = (uint64_t)1 << (local & 63u);
-            const uint64_t w = words[wi];
-            if ((w & bit) == 0u) {
-                if (w == 0u) {
-                    bs->touched[bs->n_touched++] = wi;
+            if (moved) {
+                cw = occi_vset_chunk(vs, cc[0], cc[1], cc[2]);
+                if (cw == NULL) {
+                    vs->overflow = true;
+                    break;
                 }
-                words[wi] = w | bit;
-                bs->n_set++;
+                moved = false;
             }
+            cw[local >> 6] |= (uint64_t)1 << (local & 63u);
             n++;
             if (--left == 0u) {
                 break;
             }
-            moved = false;
         }
         if (dim == 0u) {
             MARK_STEP(0u, k0, s0, t0, d0);

@@ -332,7 +332,7 @@ static bool run_voxel(occ_ictx_t *const x, const occ_vec3_t *const points,
     return true;
 }
 
-/* The dense path's free scratch, carved: end cells and point indices (sorted as pairs, with
+/* The voxel set path's room at x->b, carved: end cells and point indices (sorted as pairs, with
  * room for the sort's second copy), then the per-bundle workspace. */
 typedef struct {
     uint64_t *keys, *tkeys; /* end cell per point, and the sort's second buffer */
@@ -340,7 +340,7 @@ typedef struct {
     uint64_t bx, by;        /* the scan box's size in voxels along x and y */
 } sr_cells_t;
 
-static size_t superray_need(const size_t n)
+size_t occi_superray_need(const size_t n)
 {
     return occ_sat_add(occ_sat_mul(n, 24u), SR_MAX_GROUP * (sizeof(sr_ray_t) + 8u) +
                                                 3u * SR_MAX_EDGES * sizeof(occ_rr_t) +
@@ -455,7 +455,7 @@ static bool run_cells_sorted(occ_ictx_t *const x, const occ_vec3_t *const points
 bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
                        const uint16_t k_min)
 {
-    const size_t need = superray_need(n);
+    const size_t need = occi_superray_need(n);
     if (x->bs == NULL || x->b_cap < need / 8u + 1u || n >= UINT32_MAX) {
         return occi_ictx_points(x, points, n, false) == 0;
     }
