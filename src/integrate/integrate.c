@@ -677,7 +677,6 @@ static void layout_pass(occ_ictx_t *const x, const carve_t *const c, const bool 
         bs->words = (uint64_t *)(void *)c->rest;
         bs->touched = bs->words + bricks;
         bs->n_touched = 0;
-        bs->n_set = 0;
         bs->overflow = false;
         memset(bs->words, 0, bricks * 8u);
         x->bs = bs;
@@ -840,7 +839,6 @@ static int trace_scan(occ_ictx_t *const x, const occ_insert_params_t *const para
         if (x->cbs != NULL) {
             memset(x->cbs->words, 0, cbricks * 8u);
             x->cbs->n_touched = 0;
-            x->cbs->n_set = 0;
             x->cbs->overflow = false;
         }
         layout_pass(x, c, *dense, bs, bricks, hits_cap);

@@ -74,7 +74,6 @@ typedef struct {
     uint64_t *words;     /* chunks * 512 words, zeroed */
     uint64_t *touched;   /* word indices of bricks in first-touch order (cap: all bricks) */
     size_t n_touched;
-    size_t n_set;        /* voxels in the set */
     uint32_t b0[3];      /* first brick (key >> 2) per axis, a multiple of 8 */
     uint32_t nb[3];      /* bricks per axis, multiples of 8 */
     size_t stride_y, stride_z; /* chunks per y step and per z step */
@@ -126,7 +125,6 @@ static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, ui
             bs->touched[bs->n_touched++] = idx;
         }
         bs->words[idx] = w | bit;
-        bs->n_set++;
     }
     return true;
 }

@@ -71,15 +71,15 @@ size_t occi_dda_bound(const uint32_t ko[3], const uint32_t ke[3])
     return n;
 }
 
-/* DDA state; dda_init/dda_next are inlined into both users below. The set-up's tMax, tDelta
- * and steps are written in place (a copy from a temporary was 40 B more under every ray of
- * the integration, make cross). */
+/* DDA state; dda_init is inlined into every user below. The set-up's tMax, tDelta and steps are
+ * written in place (a copy from a temporary was 40 B more under every ray of the integration,
+ * make cross). */
 typedef struct {
     occ_dda_t dd;
     int32_t key[3];
     int32_t kmax;
     float length;
-    occ_code_t c;
+    occ_code_t c; /* the origin's code */
     size_t limit;
 } dda_t;
 
@@ -103,8 +103,8 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
     s->limit = occi_dda_bound(ko, ke);
 }
 
-/* The hot loop, with the state in scalars so that it stays in registers. EMIT(kx, ky, kz) is
- * called for every voxel after the origin's; it may `goto out`. */
+/* The hot loop of occ_ray_keys, with the state in scalars so that it stays in registers.
+ * EMIT(kx, ky, kz) is called for every voxel after the origin's. */
 #define DDA_LOOP(s, EMIT)                                                                         \
     do {                                                                                          \
         occ_rr_t t0 = (s).dd.tmax[0], t1 = (s).dd.tmax[1], t2 = (s).dd.tmax[2];                     \
@@ -143,6 +143,49 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
         }                                                                                         \
     } while (0)
 
+/* The walks below in OctoMap's order, rotated: the axis of step i + 1 is chosen right after step
+ * i, so that its tMax (the minimum) serves as step i's length test, and one chain of branches
+ * on the axis does both. A step moves the key and the voxel's Morton code together (dilated
+ * +-1, occ_code_step), so no voxel is ever encoded. */
+#define DDA_STATE(s, ke)                                                                          \
+    const occ_key_t ke_ = {{(ke)[0], (ke)[1], (ke)[2]}};                                          \
+    const occ_code_t ce = occ_morton_encode(ke_); /* the walk ends on it: codes equal iff keys */ \
+    occ_rr_t t0 = (s).dd.tmax[0], t1 = (s).dd.tmax[1], t2 = (s).dd.tmax[2];                         \
+    const occ_rr_t d0 = (s).dd.tdelta[0], d1 = (s).dd.tdelta[1], d2 = (s).dd.tdelta[2];             \
+    const int32_t s0 = (s).dd.step[0], s1 = (s).dd.step[1], s2 = (s).dd.step[2];                    \
+    const occ_rr_t len = (occ_rr_t)(s).length;                                                    \
+    occ_code_t c = (s).c;                                                                         \
+    size_t left = (s).limit - 1u
+
+/* Step along the axis `a` of the smallest tMax (keys in k0..k2, dead where unused); the step's
+ * sign in sa. */
+#define DDA_STEP(a, k0, k1, k2, sa)                                                               \
+    do {                                                                                          \
+        if ((a) == 0u) {                                                                          \
+            t0 += d0;                                                                             \
+            k0 += s0;                                                                             \
+            c = occ_code_step(c, 0u, s0);                                                         \
+            sa = s0;                                                                              \
+        } else if ((a) == 1u) {                                                                   \
+            t1 += d1;                                                                             \
+            k1 += s1;                                                                             \
+            c = occ_code_step(c, 1u, s1);                                                         \
+            sa = s1;                                                                              \
+        } else {                                                                                  \
+            t2 += d2;                                                                             \
+            k2 += s2;                                                                             \
+            c = occ_code_step(c, 2u, s2);                                                         \
+            sa = s2;                                                                              \
+        }                                                                                         \
+    } while (0)
+
+/* The next step's axis and its tMax, the smallest. */
+#define DDA_NEXT(a, tsel)                                                                         \
+    do {                                                                                          \
+        a = occ_dda_axis(t0, t1, t2);                                                             \
+        tsel = a == 0u ? t0 : (a == 1u ? t1 : t2);                                                \
+    } while (0)
+
 size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float e[3],
                       const uint32_t ko[3], const uint32_t ke[3], occ_code_t *const out,
                       const size_t cap)
@@ -152,47 +195,37 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
     }
     dda_t s;
     dda_init(&s, g, o, e, ko, ke);
-    size_t n = 0;
+    DDA_STATE(s, ke);
     if (cap > 0u) {
-        out[0] = s.c;
+        out[0] = c;
     }
-    n = 1;
-#define EMIT_CODE(x, y, z)                                                                        \
-    do {                                                                                          \
-        if (n < cap) {                                                                            \
-            const occ_key_t kk = {{(x), (y), (z)}};                                               \
-            out[n] = occ_morton_encode(kk);                                                       \
-        }                                                                                         \
-        n++;                                                                                      \
-    } while (0)
-    DDA_LOOP(s, EMIT_CODE);
-#undef EMIT_CODE
+    size_t n = 1;
+    const uint32_t kmax = (uint32_t)s.kmax;
+    int32_t k0 = s.key[0], k1 = s.key[1], k2 = s.key[2];
+    unsigned a = occ_dda_axis(t0, t1, t2);
+    for (;;) {
+        int32_t sa;
+        DDA_STEP(a, k0, k1, k2, sa);
+        (void)sa;
+        if (c == ce) {
+            break;
+        }
+        occ_rr_t tsel;
+        DDA_NEXT(a, tsel);
+        /* past the end by rounding (OctoMap's stop), or left the map (OctoMap wraps) */
+        if (tsel > len || ((uint32_t)k0 | (uint32_t)k1 | (uint32_t)k2) >= kmax) {
+            break;
+        }
+        if (n < cap) {
+            out[n] = c;
+        }
+        n++;
+        if (--left == 0u) {
+            break; /* cannot happen with finite input; bounds the work regardless */
+        }
+    }
     return n;
 }
-
-/* The DDA_LOOP decisions with the set's word index kept incrementally: a step moves the voxel's
- * 15-bit Morton offset inside its 32^3 chunk by dilated +-1, and the chunk only on a wrap. */
-#define MARK_STEP(a, ka, sa, ta, da)                                                          \
-    do {                                                                                          \
-        const uint32_t m_ = 0x1249u << (a);                                                       \
-        ka += sa;                                                                                 \
-        ta += da;                                                                                 \
-        if (sa > 0) {                                                                             \
-            local = (((local | ~m_) + 1u) & m_) | (local & ~m_);                                  \
-            if (((uint32_t)ka & 31u) == 0u) {                                                     \
-                chunk += stride[a];                                                               \
-                cc[a]++;                                                                          \
-                moved = true;                                                                     \
-            }                                                                                     \
-        } else {                                                                                  \
-            local = (((local & m_) - 1u) & m_) | (local & ~m_);                                   \
-            if (((uint32_t)ka & 31u) == 31u) {                                                    \
-                chunk -= stride[a];                                                               \
-                cc[a]--;                                                                          \
-                moved = true;                                                                     \
-            }                                                                                     \
-        }                                                                                         \
-    } while (0)
 
 size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
                      const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *const bs)
@@ -209,66 +242,57 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     const size_t stride[3] = {1u, bs->stride_y, bs->stride_z};
     const uint32_t ncs[3] = {bs->nb[0] >> 3, bs->nb[1] >> 3, bs->nb[2] >> 3};
     uint32_t cc[3];
-    for (unsigned a = 0; a < 3u; a++) {
-        cc[a] = (ko[a] >> 5) - (bs->b0[a] >> 3);
+    for (unsigned i = 0; i < 3u; i++) {
+        cc[i] = (ko[i] >> 5) - (bs->b0[i] >> 3);
     }
+    /* The 32^3 chunk of the current voxel: its words hold the voxel at Morton offset c & 0x7FFF. */
     size_t chunk = cc[0] + stride[1] * cc[1] + stride[2] * cc[2];
-    uint32_t local = (uint32_t)occi_spread5[ko[0] & 31u] | ((uint32_t)occi_spread5[ko[1] & 31u] << 1) |
-                     ((uint32_t)occi_spread5[ko[2] & 31u] << 2);
     uint64_t *const words = bs->words;
-    size_t n = 1;
-    occ_rr_t t0 = s.dd.tmax[0], t1 = s.dd.tmax[1], t2 = s.dd.tmax[2];
-    const occ_rr_t d0 = s.dd.tdelta[0], d1 = s.dd.tdelta[1], d2 = s.dd.tdelta[2];
-    const int32_t s0 = s.dd.step[0], s1 = s.dd.step[1], s2 = s.dd.step[2];
-    const int32_t e0 = (int32_t)ke[0], e1 = (int32_t)ke[1], e2 = (int32_t)ke[2];
-    int32_t k0 = s.key[0], k1 = s.key[1], k2 = s.key[2];
-    const occ_rr_t len = (occ_rr_t)s.length;
-    size_t left = s.limit - 1u;
-    bool pending = false, moved = false;
-    /* OctoMap's order per step: advance, stop at the end key, stop when min(tMax) > length,
-     * else add the key. The min is the next step's choice, so the length test and the add
-     * happen at the top of the next iteration. Leaving the map means leaving the box (which
-     * lies inside it): the caller then redoes the scan on the sorted path, which stops there. */
+    uint64_t *cw = words + (chunk << 9);
+    uint64_t *const touched = bs->touched;
+    size_t nt = bs->n_touched;
+    DDA_STATE(s, ke);
+    const size_t limit = left;
+    /* The length test's bound; below every tMax once a step left the box, which ends the walk
+     * (an overflow unless OctoMap's length test ends it there too). */
+    occ_rr_t lim = len;
+    int32_t k0 = 0, k1 = 0, k2 = 0; /* not needed: the chunk test finds the box's (and map's) edge */
+    unsigned a = occ_dda_axis(t0, t1, t2);
+    occ_rr_t tsel = 0;
     for (;;) {
-        const unsigned dim = occ_dda_axis(t0, t1, t2);
-        const occ_rr_t tsel = dim == 0u ? t0 : (dim == 1u ? t1 : t2);
-        if (pending) {
-            if (tsel > len) {
-                break;
-            }
-            if (moved && (cc[0] >= ncs[0] || cc[1] >= ncs[1] || cc[2] >= ncs[2])) {
-                bs->overflow = true;
-                break;
-            }
-            const size_t wi = (chunk << 9) | (local >> 6);
-            const uint64_t bit = (uint64_t)1 << (local & 63u);
-            const uint64_t w = words[wi];
-            if ((w & bit) == 0u) {
-                if (w == 0u) {
-                    bs->touched[bs->n_touched++] = wi;
-                }
-                words[wi] = w | bit;
-                bs->n_set++;
-            }
-            n++;
-            if (--left == 0u) {
-                break;
-            }
-            moved = false;
-        }
-        if (dim == 0u) {
-            MARK_STEP(0u, k0, s0, t0, d0);
-        } else if (dim == 1u) {
-            MARK_STEP(1u, k1, s1, t1, d1);
-        } else {
-            MARK_STEP(2u, k2, s2, t2, d2);
-        }
-        if (k0 == e0 && k1 == e1 && k2 == e2) {
+        const occ_code_t pc = c;
+        int32_t sa;
+        DDA_STEP(a, k0, k1, k2, sa);
+        if (c == ce) {
             break;
         }
-        pending = true;
+        if (((c ^ pc) >> 15) != 0u) { /* into the next chunk along axis a */
+            cc[a] += (uint32_t)sa;
+            chunk = sa > 0 ? chunk + stride[a] : chunk - stride[a];
+            cw = words + (chunk << 9);
+            if (cc[a] >= ncs[a]) {
+                lim = -OCC_REAL_MAX;
+            }
+        }
+        DDA_NEXT(a, tsel);
+        if (tsel > lim) {
+            break;
+        }
+        uint64_t *const wp = cw + (size_t)((c >> 6) & 511u);
+        const uint64_t w = *wp;
+        if (w == 0u) {
+            touched[nt++] = (size_t)(wp - words);
+        }
+        *wp = w | ((uint64_t)1 << (c & 63u));
+        if (--left == 0u) {
+            break;
+        }
     }
-    return n;
+    if (lim < len && !(tsel > len)) {
+        bs->overflow = true;
+    }
+    bs->n_touched = nt;
+    return 1u + (limit - left);
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */
