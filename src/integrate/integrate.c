@@ -491,16 +491,16 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
     occ_code_t *codes, *spare; /* spare: free scratch after the fine codes, for the coarse ones */
     size_t m, spare_cap;
     if (dense) {
-        if (x->b_cap < x->n || x->b_cap < bs->n_touched) {
+        if (x->b_cap < x->n) {
             return OCC_ERR_SCRATCH;
         }
-        occ_ictx_note(x, 0, x->n > bs->n_touched ? x->n : bs->n_touched);
+        occ_ictx_note(x, 0, x->n);
         occ_code_t *const hs = occi_keyset_sort(x->a, x->b, x->n, x->hist);
         const size_t nh = occi_keyset_unique(hs, x->n);
         if (hs != x->a) {
             memcpy(x->a, hs, nh * sizeof *hs);
         }
-        m = occi_bitset_extract(bs, x->a, nh, x->b, x->b_cap, x->b, x->hist);
+        m = occi_denseset_extract(bs, x->a, nh, x->b, x->b_cap, x->hist);
         if (m == SIZE_MAX) {
             occ_ictx_note(x, 0, x->b_cap);
             return OCC_ERR_SCRATCH;
@@ -552,16 +552,18 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
 }
 
 /* out->scratch_used: the bytes of scratch the call wrote - the histograms, the filter (sorted
- * path), the end voxels, the dense and coarse sets (words and touched lists) and the high-water
- * marks of the two code arrays. Memory the call reserved but never wrote is not counted. */
+ * path), the end voxels, the dense set (entered chunks) and the coarse set (words and touched
+ * list) and the high-water marks of the two code arrays. Memory the call reserved but never
+ * wrote is not counted. */
 static size_t touched_bytes(const occ_ictx_t *const x, const occ_insert_params_t *const params,
                             const size_t dense_bricks, const size_t cbricks)
 {
     size_t b = OCC_KS_HIST_WORDS * 4u;
     if (x->bs == NULL) {
         b += FILTER_N * 8u;
-    } else {
-        b += 8u * (dense_bricks + x->bs->n_touched);
+    } else { /* the entered chunks' words, the chunk mask, list and sort temporary */
+        b += 4096u * x->bs->n_chunks + 8u * (((dense_bricks >> 9) + 63u) >> 6) +
+             16u * x->bs->n_chunks;
     }
     if (params->method == OCC_INSERT_DISCRETE || params->method == OCC_INSERT_FAST_DISCRETE) {
         b += 8u * x->n_ends;
@@ -674,13 +676,18 @@ static void layout_pass(occ_ictx_t *const x, const carve_t *const c, const bool 
     x->a_hwm = 0;
     x->b_hwm = 0;
     if (dense) {
+        /* words | entered-chunk mask | chunk list | its sort's temporary | hits | the rest; the
+         * words are zeroed chunk by chunk as rays enter them */
+        const size_t chunks = bricks >> 9, mask_words = (chunks + 63u) >> 6;
         bs->words = (uint64_t *)(void *)c->rest;
-        bs->touched = bs->words + bricks;
-        bs->n_touched = 0;
+        bs->cmask = bs->words + bricks;
+        bs->clist = bs->cmask + mask_words;
+        bs->ctmp = bs->clist + chunks;
+        bs->n_chunks = 0;
         bs->overflow = false;
-        memset(bs->words, 0, bricks * 8u);
+        memset(bs->cmask, 0, mask_words * 8u);
         x->bs = bs;
-        x->a = bs->touched + bricks;
+        x->a = bs->ctmp + chunks;
         x->cap = hits_cap;
         x->b = x->a + hits_cap;
         x->b_cap = (size_t)((c->rest + c->rest_bytes) - (uint8_t *)(void *)x->b) / 8u;

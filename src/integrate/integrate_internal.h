@@ -65,20 +65,55 @@ uint64_t *occi_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_
  * OR of the run's. Returns the new length. */
 size_t occi_keyset_unique(occ_code_t *a, size_t n);
 
-/* ---- dense per-scan voxel set over the scan's bounding box (keyset.c, raycast.c) -------------
+/* ---- dense per-scan voxel set over the scan's bounding box (keyset.c, raycast.c, denseset.c) --
  * One 64-bit word per 4x4x4-voxel brick aligned to absolute keys, so a brick's voxels are the
  * 64 consecutive Morton codes (brick code << 6) + bit. Bricks are stored in chunks of 8x8x8
- * (4 KiB, Morton order inside) so that a ray stays on one page for 32 voxels. Used when the box
- * fits the scratch: a visit is a test-and-set, and only first visits are ever stored. */
+ * (4 KiB, Morton order inside: the chunk's voxels are the 2^15 codes (chunk code << 15) + c)
+ * so that a ray stays on one page for 32 voxels. Used when the box fits the scratch: a visit
+ * is a test-and-set. Two ways to know which words hold anything:
+ *  - the fine set (rays' voxels, denseset.c): a chunk's words are zeroed when a ray first
+ *    enters it (occ_denseset_enter), which lists the chunk; the walk reads the listed chunks in
+ *    Morton order. Nothing per visit.
+ *  - the coarse set (FAST_DISCRETE's level-d nodes, occ_bitset_add): every word is zeroed
+ *    first, and each word's first bit lists it in `touched`. */
 typedef struct {
-    uint64_t *words;     /* chunks * 512 words, zeroed */
-    uint64_t *touched;   /* word indices of bricks in first-touch order (cap: all bricks) */
+    uint64_t *words;     /* chunks * 512 words */
+    uint64_t *touched;   /* coarse set: word indices in first-touch order (cap: all bricks) */
     size_t n_touched;
+    uint64_t *cmask;     /* fine set: one bit per chunk, set once entered (zeroed first) */
+    uint64_t *clist;     /* fine set: entered chunks (index), then their codes, sorted */
+    uint64_t *ctmp;      /* fine set: the sort's temporary (cap: all chunks) */
+    size_t n_chunks;     /* fine set: entered chunks */
     uint32_t b0[3];      /* first brick (key >> 2) per axis, a multiple of 8 */
     uint32_t nb[3];      /* bricks per axis, multiples of 8 */
     size_t stride_y, stride_z; /* chunks per y step and per z step */
     bool overflow;       /* a visit fell outside the box: the caller falls back to sorting */
 } occ_bitset_t;
+
+/* The fine set's words of chunk `chunk` (in the box), zeroed and listed on the first entry. */
+static inline uint64_t *occ_denseset_enter(occ_bitset_t *bs, size_t chunk)
+{
+    uint64_t *const w = bs->words + (chunk << 9);
+    const uint64_t bit = (uint64_t)1 << (chunk & 63u);
+    if ((bs->cmask[chunk >> 6] & bit) == 0u) {
+        bs->cmask[chunk >> 6] |= bit;
+        bs->clist[bs->n_chunks++] = chunk;
+        memset(w, 0, 512u * sizeof *w);
+    }
+    return w;
+}
+
+/* Chunk coordinates (relative to the box) of key k on each axis; false outside the box. */
+static inline bool occ_denseset_chunk_of(const occ_bitset_t *bs, const uint32_t k[3], uint32_t cc[3])
+{
+    for (unsigned a = 0; a < 3u; a++) {
+        cc[a] = (k[a] >> 5) - (bs->b0[a] >> 3);
+        if (cc[a] >= (bs->nb[a] >> 3)) {
+            return false;
+        }
+    }
+    return true;
+}
 
 /* Spread 3 bits to every third bit. */
 static inline uint32_t occ_spread3b(uint32_t v)
@@ -107,7 +142,7 @@ static inline unsigned occ_brick_bit(uint32_t kx, uint32_t ky, uint32_t kz)
 /* Morton interleave of the low 5 bits of a key for one axis (shift by the axis). */
 extern const uint16_t occi_spread5[32];
 
-/* Add voxel (kx, ky, kz); false when it is outside the box. */
+/* Add voxel (kx, ky, kz) to the coarse set; false when it is outside the box. */
 static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, uint32_t kz)
 {
     const uint32_t cx = (kx >> 5) - (bs->b0[0] >> 3), cy = (ky >> 5) - (bs->b0[1] >> 3),
@@ -129,16 +164,22 @@ static inline bool occ_bitset_add(occ_bitset_t *bs, uint32_t kx, uint32_t ky, ui
     return true;
 }
 
-/* computeRayKeys(o, e) into the set; returns the visits. Sets bs->overflow and stops when a
- * voxel is outside the box. */
+/* computeRayKeys(o, e) into the fine set; returns the visits. Sets bs->overflow and stops when
+ * a voxel is outside the box. */
 size_t occi_dda_mark(const occ_raygeo_t *g, const float o[3], const float e[3],
                      const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *bs);
 
-/* Sorted, collapsed codes of the set merged with `hits` (sorted, unique, hit bit set): a voxel
- * in both is a hit. Writes to out (cap codes); returns the count, or SIZE_MAX when cap is too
- * small. tmp must hold n_touched codes. The touched list is reordered. */
+/* Sorted, collapsed codes of the coarse set merged with `hits` (sorted, unique, hit bit set): a
+ * voxel in both is a hit. Writes to out (cap codes); returns the count, or SIZE_MAX when cap is
+ * too small. tmp must hold n_touched codes. The touched list is reordered. */
 size_t occi_bitset_extract(occ_bitset_t *bs, const occ_code_t *hits, size_t n_hits,
                            occ_code_t *out, size_t cap, occ_code_t *tmp, uint32_t *hist);
+
+/* The fine set's voxels in Morton order merged with `hits` (sorted, unique, hit bit set; a
+ * voxel in both is a hit), as codes in out (cap); returns the count, or SIZE_MAX when cap is
+ * too small. The chunk list is turned into sorted chunk codes (hist: the sort's histograms). */
+size_t occi_denseset_extract(occ_bitset_t *bs, const occ_code_t *hits, size_t n_hits,
+                             occ_code_t *out, size_t cap, uint32_t *hist);
 
 /* ---- one insert call (integrate.c); superray.c and fastdiscrete.c add rays through it ----- */
 typedef struct {

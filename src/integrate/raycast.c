@@ -233,25 +233,20 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
         return 0;
     }
-    dda_t s;
-    dda_init(&s, g, o, e, ko, ke);
-    if (!occ_bitset_add(bs, ko[0], ko[1], ko[2])) {
+    uint32_t cc[3];
+    if (!occ_denseset_chunk_of(bs, ko, cc)) {
         bs->overflow = true;
         return 0;
     }
+    dda_t s;
+    dda_init(&s, g, o, e, ko, ke);
     const size_t stride[3] = {1u, bs->stride_y, bs->stride_z};
     const uint32_t ncs[3] = {bs->nb[0] >> 3, bs->nb[1] >> 3, bs->nb[2] >> 3};
-    uint32_t cc[3];
-    for (unsigned i = 0; i < 3u; i++) {
-        cc[i] = (ko[i] >> 5) - (bs->b0[i] >> 3);
-    }
     /* The 32^3 chunk of the current voxel: its words hold the voxel at Morton offset c & 0x7FFF. */
     size_t chunk = cc[0] + stride[1] * cc[1] + stride[2] * cc[2];
-    uint64_t *const words = bs->words;
-    uint64_t *cw = words + (chunk << 9);
-    uint64_t *const touched = bs->touched;
-    size_t nt = bs->n_touched;
+    uint64_t *cw = occ_denseset_enter(bs, chunk);
     DDA_STATE(s, ke);
+    cw[(c >> 6) & 511u] |= (uint64_t)1 << (c & 63u);
     const size_t limit = left;
     /* The length test's bound; below every tMax once a step left the box, which ends the walk
      * (an overflow unless OctoMap's length test ends it there too). */
@@ -269,21 +264,17 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
         if (((c ^ pc) >> 15) != 0u) { /* into the next chunk along axis a */
             cc[a] += (uint32_t)sa;
             chunk = sa > 0 ? chunk + stride[a] : chunk - stride[a];
-            cw = words + (chunk << 9);
             if (cc[a] >= ncs[a]) {
                 lim = -OCC_REAL_MAX;
+            } else {
+                cw = occ_denseset_enter(bs, chunk);
             }
         }
         DDA_NEXT(a, tsel);
         if (tsel > lim) {
             break;
         }
-        uint64_t *const wp = cw + (size_t)((c >> 6) & 511u);
-        const uint64_t w = *wp;
-        if (w == 0u) {
-            touched[nt++] = (size_t)(wp - words);
-        }
-        *wp = w | ((uint64_t)1 << (c & 63u));
+        cw[(c >> 6) & 511u] |= (uint64_t)1 << (c & 63u);
         if (--left == 0u) {
             break;
         }
@@ -291,7 +282,6 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     if (lim < len && !(tsel > len)) {
         bs->overflow = true;
     }
-    bs->n_touched = nt;
     return 1u + (limit - left);
 }
 
