@@ -195,6 +195,20 @@ static inline unsigned occ_first_slot(unsigned mask)
 #endif
 }
 
+/* The lowest set bit of a non-zero 64-bit mask. */
+static inline unsigned occ_first_slot64(uint64_t mask)
+{
+#if defined(__GNUC__)
+    return (unsigned)__builtin_ctzll(mask);
+#else
+    unsigned slot = 0;
+    while (((mask >> slot) & 1u) == 0u) {
+        slot++;
+    }
+    return slot;
+#endif
+}
+
 /* Number of significant bits of x (0 for 0): 1 + the highest set bit. */
 static inline unsigned occ_bit_length32(uint32_t x)
 {
@@ -330,5 +344,32 @@ typedef struct {
  * no node existed) against the pools: OCC_ERR_NOMEM (oom_count bumped, nothing written), else
  * every update, refreshing and pruning as it goes. O(entries x depth). */
 occ_err_t occi_tree_apply_frame(occ_map_t *m, const occi_frame_t *f, occi_frame_out_t *out);
+
+/* A scan's voxel updates as the integrator's dense set holds them (integrate/denseset.c):
+ * 32^3-voxel chunks in Morton order, 512 words each, word w of chunk i the mask of the 64
+ * voxels of brick (chunks[i] << 9 | w) (codes (brick << 6) + bit) to update by the miss; and
+ * the hits, voxel codes with the hit bit, sorted and unique, which win over the misses. */
+typedef struct {
+    const uint64_t *words;
+    const uint64_t *chunks; /* chunk codes (voxel code >> 15), sorted, unique */
+    const uint64_t *slots;  /* chunk i's words are words + 512 * slots[i] */
+    size_t n_chunks;
+    const occ_code_t *hits;
+    size_t n_hits;
+} occi_dense_t;
+
+/* Voxels named and voxel values changed. */
+typedef struct {
+    size_t voxels, changed;
+} occi_dense_out_t;
+
+/* The update occ_map_observe_codes() makes of the set's codes, in one pass by 4x4x4 bricks
+ * (tree_dense.c), when the bound of the blocks it can allocate (as if no node existed) fits
+ * the pools; else OCC_ERR_NOMEM with nothing written and oom_count unchanged (the caller takes
+ * the exact path). Also OCC_ERR_NOMEM for depth_levels < 2. O(bricks x depth + voxels). */
+occ_err_t occi_tree_apply_dense(occ_map_t *m, const occi_dense_t *d, occi_dense_out_t *out);
+/* The set's voxels as sorted codes (hits with the hit bit) in out (cap); the count, or SIZE_MAX
+ * when cap is too small. */
+size_t occi_dense_codes(const occi_dense_t *d, occ_code_t *out, size_t cap);
 
 #endif /* OCC_TREE_INTERNAL_H_INCLUDED */

@@ -7,11 +7,19 @@
  */
 #include "integrate_internal.h"
 
-/* The entered chunks' codes (chunk key = key >> 5), sorted; returns where they are. */
-static const uint64_t *sorted_chunks(occ_bitset_t *const bs, uint32_t *const hist)
+/* Index of the chunk whose code is `cc`, relative to the box. */
+static uint64_t chunk_index(const occ_bitset_t *const bs, const uint64_t cc)
+{
+    const occ_key_t k = occ_morton_decode(cc);
+    return (uint64_t)(k.k[0] - (bs->b0[0] >> 3)) +
+           (uint64_t)bs->stride_y * (k.k[1] - (bs->b0[1] >> 3)) +
+           (uint64_t)bs->stride_z * (k.k[2] - (bs->b0[2] >> 3));
+}
+
+void occi_denseset_order(occ_bitset_t *const bs, uint32_t *const hist, occi_dense_t *const d)
 {
     const size_t ncx = bs->nb[0] >> 3, ncy = bs->nb[1] >> 3;
-    for (size_t i = 0; i < bs->n_chunks; i++) {
+    for (size_t i = 0; i < bs->n_chunks; i++) { /* chunk index -> its code (chunk key = key >> 5) */
         const size_t ci = (size_t)bs->clist[i];
         occ_key_t k;
         k.k[0] = (bs->b0[0] >> 3) + (uint32_t)(ci % ncx);
@@ -19,55 +27,13 @@ static const uint64_t *sorted_chunks(occ_bitset_t *const bs, uint32_t *const his
         k.k[2] = (bs->b0[2] >> 3) + (uint32_t)(ci / (ncx * ncy));
         bs->clist[i] = occ_morton_encode(k);
     }
-    return occi_keyset_sort(bs->clist, bs->ctmp, bs->n_chunks, hist);
-}
-
-/* Words of the chunk whose code is `cc`. */
-static const uint64_t *chunk_words(const occ_bitset_t *const bs, const uint64_t cc)
-{
-    const occ_key_t k = occ_morton_decode(cc);
-    const size_t ci = (size_t)(k.k[0] - (bs->b0[0] >> 3)) +
-                      bs->stride_y * (size_t)(k.k[1] - (bs->b0[1] >> 3)) +
-                      bs->stride_z * (size_t)(k.k[2] - (bs->b0[2] >> 3));
-    return bs->words + (ci << 9);
-}
-
-size_t occi_denseset_extract(occ_bitset_t *const bs, const occ_code_t *const hits,
-                             const size_t n_hits, occ_code_t *const out, const size_t cap,
-                             uint32_t *const hist)
-{
-    const uint64_t *const chunks = sorted_chunks(bs, hist);
-    size_t n = 0, h = 0;
+    const uint64_t *const sorted = occi_keyset_sort(bs->clist, bs->ctmp, bs->n_chunks, hist);
+    uint64_t *const slots = sorted == bs->clist ? bs->ctmp : bs->clist;
     for (size_t i = 0; i < bs->n_chunks; i++) {
-        const uint64_t *const words = chunk_words(bs, chunks[i]);
-        const occ_code_t base = (occ_code_t)chunks[i] << 15;
-        for (unsigned wi = 0; wi < 512u; wi++) {
-            uint64_t w = words[wi];
-            while (w != 0u) {
-                const occ_code_t c = base | ((occ_code_t)wi << 6) | (unsigned)__builtin_ctzll(w);
-                w &= w - 1u;
-                while (h < n_hits && (hits[h] & ~OCC_CODE_HIT_BIT) < c) {
-                    if (n == cap) {
-                        return SIZE_MAX;
-                    }
-                    out[n++] = hits[h++];
-                }
-                if (n == cap) {
-                    return SIZE_MAX;
-                }
-                if (h < n_hits && (hits[h] & ~OCC_CODE_HIT_BIT) == c) {
-                    out[n++] = hits[h++];
-                } else {
-                    out[n++] = c;
-                }
-            }
-        }
+        slots[i] = chunk_index(bs, sorted[i]);
     }
-    while (h < n_hits) {
-        if (n == cap) {
-            return SIZE_MAX;
-        }
-        out[n++] = hits[h++];
-    }
-    return n;
+    d->words = bs->words;
+    d->chunks = sorted;
+    d->slots = slots;
+    d->n_chunks = bs->n_chunks;
 }

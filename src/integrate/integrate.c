@@ -479,8 +479,38 @@ static uint8_t *align8(void *const p)
     return (uint8_t *)p + ((8u - (u & 7u)) & 7u);
 }
 
+/* The counts of an applied scan. */
+static void set_counts(occ_insert_result_t *const r, const size_t voxels, const size_t hits,
+                       const size_t changed)
+{
+    r->voxels_updated = voxels;
+    r->voxels_occupied = hits;
+    r->voxels_free = voxels - hits;
+    r->voxels_changed = changed;
+}
+
+/* The dense set's hits sorted and collapsed at a, its chunks in Morton order: d. False when the
+ * sort has no room. */
+static bool dense_order(occ_ictx_t *const x, occ_bitset_t *const bs, occi_dense_t *const d)
+{
+    if (x->b_cap < x->n) {
+        return false;
+    }
+    occ_ictx_note(x, 0, x->n);
+    occ_code_t *const hs = occi_keyset_sort(x->a, x->b, x->n, x->hist);
+    const size_t nh = occi_keyset_unique(hs, x->n);
+    if (hs != x->a) {
+        memcpy(x->a, hs, nh * sizeof *hs);
+    }
+    occi_denseset_order(bs, x->hist, d);
+    d->hits = x->a;
+    d->n_hits = nh;
+    return true;
+}
+
 /* The scan's sorted, collapsed codes; FAST_DISCRETE's coarse pass (d > 0); then one coherent
- * batch update in Morton order (all or nothing, except in automatic mode). Out of line: inlined,
+ * batch update in Morton order (all or nothing, except in automatic mode). The dense set goes
+ * to the tree by bricks when the pools surely suffice, else as codes. Out of line: inlined,
  * its locals stayed in occ_map_insert_rays' frame under the ray traversal too (make cross). */
 OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
                                                  const occ_insert_params_t *const params,
@@ -491,16 +521,16 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
     occ_code_t *codes, *spare; /* spare: free scratch after the fine codes, for the coarse ones */
     size_t m, spare_cap;
     if (dense) {
-        if (x->b_cap < x->n) {
+        occi_dense_t d;
+        if (!dense_order(x, bs, &d)) {
             return OCC_ERR_SCRATCH;
         }
-        occ_ictx_note(x, 0, x->n);
-        occ_code_t *const hs = occi_keyset_sort(x->a, x->b, x->n, x->hist);
-        const size_t nh = occi_keyset_unique(hs, x->n);
-        if (hs != x->a) {
-            memcpy(x->a, hs, nh * sizeof *hs);
+        occi_dense_out_t o;
+        if (x->cbs == NULL && occi_tree_apply_dense(x->map, &d, &o) == OCC_OK) {
+            set_counts(r, o.voxels, d.n_hits, o.changed);
+            return OCC_OK;
         }
-        m = occi_denseset_extract(bs, x->a, nh, x->b, x->b_cap, x->hist);
+        m = occi_dense_codes(&d, x->b, x->b_cap);
         if (m == SIZE_MAX) {
             occ_ictx_note(x, 0, x->b_cap);
             return OCC_ERR_SCRATCH;
@@ -544,10 +574,7 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
     if (e != OCC_OK) {
         return e;
     }
-    r->voxels_updated = m;
-    r->voxels_occupied = hits;
-    r->voxels_free = m - hits;
-    r->voxels_changed = changed;
+    set_counts(r, m, hits, changed);
     return OCC_OK;
 }
 

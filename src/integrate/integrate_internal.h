@@ -8,6 +8,7 @@
 
 #include "occmap/occmap.h"
 #include "../geom/geom_internal.h"
+#include "../core/tree_internal.h"
 
 typedef occ_real_t occ_rr_t;
 
@@ -175,11 +176,9 @@ size_t occi_dda_mark(const occ_raygeo_t *g, const float o[3], const float e[3],
 size_t occi_bitset_extract(occ_bitset_t *bs, const occ_code_t *hits, size_t n_hits,
                            occ_code_t *out, size_t cap, occ_code_t *tmp, uint32_t *hist);
 
-/* The fine set's voxels in Morton order merged with `hits` (sorted, unique, hit bit set; a
- * voxel in both is a hit), as codes in out (cap); returns the count, or SIZE_MAX when cap is
- * too small. The chunk list is turned into sorted chunk codes (hist: the sort's histograms). */
-size_t occi_denseset_extract(occ_bitset_t *bs, const occ_code_t *hits, size_t n_hits,
-                             occ_code_t *out, size_t cap, uint32_t *hist);
+/* The fine set's entered chunks in Morton order (their codes sorted, and where their words
+ * are) in d; d's hits are the caller's. hist: the sort's histograms. */
+void occi_denseset_order(occ_bitset_t *bs, uint32_t *hist, occi_dense_t *d);
 
 /* ---- one insert call (integrate.c); superray.c and fastdiscrete.c add rays through it ----- */
 typedef struct {
