@@ -172,7 +172,10 @@ static void bench_insert(const char *data, const std::vector<Scan> &scans, float
     insert_once(lib_new, scans, res, meth, &rn, &dnew);
     ro.scratch_used = rn.scratch_used = 0; /* a layout change may use other scratch */
     if (std::memcmp(&ro, &rn, sizeof ro) != 0 || dold != dnew) {
-        std::fprintf(stderr, "ab_split: %s: old and new results differ\n", name);
+        std::fprintf(stderr, "ab_split: %s: old and new results differ (visits %zu / %zu, updated %zu / %zu, changed %zu / %zu, digest %s)\n",
+                     name, (size_t)ro.voxel_visits, (size_t)rn.voxel_visits, (size_t)ro.voxels_updated,
+                     (size_t)rn.voxels_updated, (size_t)ro.voxels_changed, (size_t)rn.voxels_changed,
+                     dold == dnew ? "equal" : "differs");
         std::exit(1);
     }
     std::printf("%s: last scan %zu rays, %zu voxel visits, %zu voxels updated\n", name,

@@ -41,12 +41,14 @@ size_t occi_dda_bound(const uint32_t ko[3], const uint32_t ke[3]);
 size_t occi_dda_codes(const occ_raygeo_t *g, const float o[3], const float e[3],
                       const uint32_t ko[3], const uint32_t ke[3], occ_code_t *out, size_t cap);
 
-/* Dilated (Morton) +-1 along axis `dim`. */
+/* Dilated (Morton) +-1 along axis `dim`: the axis' bits x = c & m step as an integer whose
+ * carries (x - m = x + 1 through the other bits) and borrows (x - 1) the mask then drops; one
+ * constant, so that a walk keeps its three in registers. */
 static inline occ_code_t occ_code_step(occ_code_t c, unsigned dim, int step)
 {
     const occ_code_t m = (occ_code_t)0x1249249249249249ull << dim;
-    const occ_code_t part = step > 0 ? (((c | ~m) + 1u) & m) : (((c & m) - 1u) & m);
-    return (c & ~m) | part;
+    const occ_code_t x = c & m;
+    return c + (((step > 0 ? x - m : x - 1u) & m) - x); /* c - x + x': only m's bits change */
 }
 
 /* ---- key sets (keyset.c) ----------------------------------------------------------------- */

@@ -227,62 +227,145 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
     return n;
 }
 
+/* ---- the fine set's walk -----------------------------------------------------------------------
+ * occi_dda_mark's loop, specialised per octant (the steps' signs are constants: a step is five
+ * operations on the code, no sign test). Per step one chain of branches picks the axis; the
+ * length test and the 32^3 chunk crossing are tested on that axis alone and resolved off the
+ * common path: the walk stops once every tMax passed the length (each only grows), and a
+ * countdown per axis says when its key crosses into the next chunk. */
+typedef struct {
+    occ_rr_t t[3], d[3], len;
+    occ_code_t c, ce;
+    size_t chunk;
+    uint32_t cc[3]; /* chunk coordinates in the box */
+    uint32_t n[3];  /* steps on each axis until the next chunk */
+} mwalk_t;
+
+/* Steps along axis a until its key leaves its 32-voxel row. */
+static uint32_t chunk_countdown(const uint32_t k, const int step)
+{
+    return step < 0 ? (k & 31u) + 1u : 32u - (k & 31u);
+}
+
+/* Leaving the box ends the walk, an overflow unless OctoMap's walk ends there too (end key, or
+ * every tMax past the length). */
+static bool mark_left_box(const mwalk_t *const w, const occ_rr_t t0, const occ_rr_t t1,
+                          const occ_rr_t t2, const occ_code_t c)
+{
+    return c != w->ce && !(t0 > w->len && t1 > w->len && t2 > w->len);
+}
+
+/* One step on axis A (sign S, chunk countdown nA), with its rare cases: every tMax past the
+ * length (stop), the next chunk (enter it, or stop at the box's edge). */
+#define MARK_STEP(A, S, nA, tA, dA, tB, tC)                                                       \
+    do {                                                                                          \
+        tA += dA;                                                                                 \
+        c = occ_code_step(c, A, S);                                                               \
+        nA--; /* counted before any stop: the visits are the steps */                             \
+        if (tA > len && tB > len && tC > len) {                                                   \
+            goto done;                                                                            \
+        }                                                                                         \
+        if (nA == 0u) {                                                                           \
+            nA = 32u;                                                                             \
+            w->cc[A] += (uint32_t)(S);                                                            \
+            w->chunk = (S) > 0 ? w->chunk + stride[A] : w->chunk - stride[A];                     \
+            if (w->cc[A] >= (bs->nb[A] >> 3)) {                                                   \
+                bs->overflow = mark_left_box(w, t0, t1, t2, c);                                   \
+                goto done;                                                                        \
+            }                                                                                     \
+            cw = occ_denseset_enter(bs, w->chunk);                                                \
+        }                                                                                         \
+    } while (0)
+
+static OCC_ALWAYS_INLINE void mark_walk(mwalk_t *const w, occ_bitset_t *const bs,
+                                        uint64_t *cw, const int s0, const int s1, const int s2)
+{
+    occ_rr_t t0 = w->t[0], t1 = w->t[1], t2 = w->t[2];
+    const occ_rr_t d0 = w->d[0], d1 = w->d[1], d2 = w->d[2], len = w->len;
+    const occ_code_t ce = w->ce;
+    occ_code_t c = w->c;
+    uint32_t n0 = w->n[0], n1 = w->n[1], n2 = w->n[2];
+    const size_t stride[3] = {1u, bs->stride_y, bs->stride_z};
+    for (;;) {
+        if (t0 < t1 && t0 < t2) { /* OctoMap's axis: the smallest tMax, ties to the higher */
+            MARK_STEP(0u, s0, n0, t0, d0, t1, t2);
+        } else if (t1 < t2) {
+            MARK_STEP(1u, s1, n1, t1, d1, t0, t2);
+        } else {
+            MARK_STEP(2u, s2, n2, t2, d2, t0, t1);
+        }
+        if (c == ce) {
+            break;
+        }
+        cw[(c >> 6) & 511u] |= (uint64_t)1 << (c & 63u);
+    }
+done:
+    w->c = c;
+    w->n[0] = n0;
+    w->n[1] = n1;
+    w->n[2] = n2;
+}
+
+/* The eight octants' walks, out of line: one frame under occi_dda_mark's (make cross). */
+#define MARK_OCTANT(NAME, S0, S1, S2)                                                             \
+    static OCC_NOINLINE void NAME(mwalk_t *const w, occ_bitset_t *const bs, uint64_t *const cw)  \
+    {                                                                                             \
+        mark_walk(w, bs, cw, S0, S1, S2);                                                         \
+    }
+MARK_OCTANT(mark_ppp, 1, 1, 1)
+MARK_OCTANT(mark_npp, -1, 1, 1)
+MARK_OCTANT(mark_pnp, 1, -1, 1)
+MARK_OCTANT(mark_nnp, -1, -1, 1)
+MARK_OCTANT(mark_ppn, 1, 1, -1)
+MARK_OCTANT(mark_npn, -1, 1, -1)
+MARK_OCTANT(mark_pnn, 1, -1, -1)
+MARK_OCTANT(mark_nnn, -1, -1, -1)
+
 size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
                      const uint32_t ko[3], const uint32_t ke[3], occ_bitset_t *const bs)
 {
+    mwalk_t w;
     if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
         return 0;
     }
-    uint32_t cc[3];
-    if (!occ_denseset_chunk_of(bs, ko, cc)) {
+    if (!occ_denseset_chunk_of(bs, ko, w.cc)) {
         bs->overflow = true;
         return 0;
     }
     dda_t s;
     dda_init(&s, g, o, e, ko, ke);
-    const size_t stride[3] = {1u, bs->stride_y, bs->stride_z};
-    const uint32_t ncs[3] = {bs->nb[0] >> 3, bs->nb[1] >> 3, bs->nb[2] >> 3};
-    /* The 32^3 chunk of the current voxel: its words hold the voxel at Morton offset c & 0x7FFF. */
-    size_t chunk = cc[0] + stride[1] * cc[1] + stride[2] * cc[2];
-    uint64_t *cw = occ_denseset_enter(bs, chunk);
-    DDA_STATE(s, ke);
-    cw[(c >> 6) & 511u] |= (uint64_t)1 << (c & 63u);
-    const size_t limit = left;
-    /* The length test's bound; below every tMax once a step left the box, which ends the walk
-     * (an overflow unless OctoMap's length test ends it there too). */
-    occ_rr_t lim = len;
-    int32_t k0 = 0, k1 = 0, k2 = 0; /* not needed: the chunk test finds the box's (and map's) edge */
-    unsigned a = occ_dda_axis(t0, t1, t2);
-    occ_rr_t tsel = 0;
-    for (;;) {
-        const occ_code_t pc = c;
-        int32_t sa;
-        DDA_STEP(a, k0, k1, k2, sa);
-        if (c == ce) {
-            break;
-        }
-        if (((c ^ pc) >> 15) != 0u) { /* into the next chunk along axis a */
-            cc[a] += (uint32_t)sa;
-            chunk = sa > 0 ? chunk + stride[a] : chunk - stride[a];
-            if (cc[a] >= ncs[a]) {
-                lim = -OCC_REAL_MAX;
-            } else {
-                cw = occ_denseset_enter(bs, chunk);
-            }
-        }
-        DDA_NEXT(a, tsel);
-        if (tsel > lim) {
-            break;
-        }
-        cw[(c >> 6) & 511u] |= (uint64_t)1 << (c & 63u);
-        if (--left == 0u) {
-            break;
-        }
+    const occ_key_t kek = {{ke[0], ke[1], ke[2]}};
+    w.ce = occ_morton_encode(kek);
+    w.c = s.c;
+    w.len = (occ_rr_t)s.length;
+    uint32_t n0[3], cc0[3];
+    for (unsigned i = 0; i < 3u; i++) {
+        w.t[i] = s.dd.tmax[i];
+        w.d[i] = s.dd.tdelta[i];
+        w.n[i] = n0[i] = chunk_countdown(ko[i], s.dd.step[i]);
+        cc0[i] = w.cc[i];
     }
-    if (lim < len && !(tsel > len)) {
-        bs->overflow = true;
+    w.chunk = w.cc[0] + bs->stride_y * w.cc[1] + bs->stride_z * w.cc[2];
+    uint64_t *const cw = occ_denseset_enter(bs, w.chunk);
+    cw[(w.c >> 6) & 511u] |= (uint64_t)1 << (w.c & 63u);
+    switch ((s.dd.step[0] < 0 ? 1u : 0u) | (s.dd.step[1] < 0 ? 2u : 0u) | (s.dd.step[2] < 0 ? 4u : 0u)) {
+    case 0u: mark_ppp(&w, bs, cw); break;
+    case 1u: mark_npp(&w, bs, cw); break;
+    case 2u: mark_pnp(&w, bs, cw); break;
+    case 3u: mark_nnp(&w, bs, cw); break;
+    case 4u: mark_ppn(&w, bs, cw); break;
+    case 5u: mark_npn(&w, bs, cw); break;
+    case 6u: mark_pnn(&w, bs, cw); break;
+    default: mark_nnn(&w, bs, cw); break;
     }
-    return 1u + (limit - left);
+    /* Visits: the origin and one per step but the last (the end, or past the length), i.e. the
+     * steps, counted per axis by the chunk countdowns and crossings. */
+    size_t steps = 0;
+    for (unsigned i = 0; i < 3u; i++) {
+        const uint32_t x = w.cc[i] > cc0[i] ? w.cc[i] - cc0[i] : cc0[i] - w.cc[i];
+        steps += (size_t)n0[i] - w.n[i] + 32u * (size_t)x;
+    }
+    return steps;
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */
