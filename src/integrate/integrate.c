@@ -214,10 +214,15 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3], const bool hit)
     return 0;
 }
 
-int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
-                     const bool no_hit_only)
+/* occi_ictx_points in the order order[0..n) (NULL: as given). */
+static int ictx_points_in(occ_ictx_t *const x, const occ_vec3_t *const points,
+                          const uint32_t *const order, const size_t n, const bool no_hit_only)
 {
-    for (size_t i = 0; i < n; i++) {
+    for (size_t k = 0; k < n; k++) {
+        const size_t i = order != NULL ? (size_t)order[k] : k;
+        if (order != NULL && k + 8u < n) {
+            OCC_PREFETCH(&points[order[k + 8u]]); /* the order jumps: fetch ahead */
+        }
         const bool hit = occ_ictx_hit(x, i);
         if (no_hit_only && hit) {
             continue;
@@ -234,6 +239,12 @@ int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const 
         }
     }
     return 0;
+}
+
+int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                     const bool no_hit_only)
+{
+    return ictx_points_in(x, points, NULL, n, no_hit_only);
 }
 
 /* ---- DISCRETE: one ray per distinct end voxel, to its centre ------------------------------- */
@@ -309,8 +320,8 @@ static int run_method(occ_ictx_t *const x, const occ_insert_params_t *const para
                       occ_code_t *const ends)
 {
     switch (params->method) {
-    case OCC_INSERT_SIMPLE:
-        return occi_ictx_points(x, points, n_points, false);
+    case OCC_INSERT_SIMPLE: /* the dense set takes the rays in direction order */
+        return ictx_points_in(x, points, occi_ray_order(x, points, n_points), n_points, false);
     case OCC_INSERT_DISCRETE:
     case OCC_INSERT_FAST_DISCRETE: {
         if (x->cap < n_points) {

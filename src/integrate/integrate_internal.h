@@ -239,6 +239,11 @@ int occi_ictx_point(occ_ictx_t *x, const float p[3], bool hit);
  * integrated or skipped. Returns 0, or -1 when scratch ran out. */
 int occi_ictx_points(occ_ictx_t *x, const occ_vec3_t *points, size_t n, bool no_hit_only);
 
+/* The dense path's points in the order of their directions from the origin (rayorder.c): a
+ * permutation in the spare scratch at b (3 codes a point), or NULL (no dense set, too little
+ * room: take them as given). */
+const uint32_t *occi_ray_order(occ_ictx_t *x, const occ_vec3_t *points, size_t n);
+
 /* SUPER_RAYS (superray.c): integrate the valid points whose end voxel codes are ends[0..n)
  * (sorted, bit 63 clear) - equal result to occi_ictx_point() on each. `work` has work_cap codes.
  * Returns false when scratch ran out. */
