@@ -66,16 +66,13 @@ static bool next_brick(cursor_t *const c, brick_t *const b)
     return true;
 }
 
+/* Bits set (SWAR: without a popcount instruction in the build, the builtin is a library call). */
 static unsigned popcount64(uint64_t x)
 {
-#if defined(__GNUC__)
-    return (unsigned)__builtin_popcountll(x);
-#else
     x = x - ((x >> 1) & 0x5555555555555555ull);
     x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
     x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
     return (unsigned)((x * 0x0101010101010101ull) >> 56);
-#endif
 }
 
 /* Blocks the bricks can allocate if no node existed (codes_valid's bound, a brick at a time):
@@ -131,6 +128,43 @@ static void set_uniform(occ_map_t *const m, const occ_nodep_t n, const occ_value
     occ_touch_node(m, n);
 }
 
+/* A uniform level-1 node n (value v) whose voxels mb take the miss (vm) and hb the hit (vh),
+ * some of them changing: its leaf block is written once with the three values, and the node's
+ * summary follows from the values present (what expanding, updating and refreshing it gives);
+ * eight equal values leave it uniform. Returns the voxels whose value changed. */
+static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigned mb,
+                          const unsigned hb, const occ_value_t vm, const occ_value_t vh)
+{
+    const occ_value_t v = *n.value;
+    const size_t changed = (occ_value_eq(vm, v) ? 0u : popcount64(mb)) +
+                           (occ_value_eq(vh, v) ? 0u : popcount64(hb));
+    occ_value_t vals[8];
+    for (unsigned k = 0; k < 8u; k++) {
+        vals[k] = ((hb >> k) & 1u) != 0u ? vh : (((mb >> k) & 1u) != 0u ? vm : v);
+    }
+    const bool same = ((mb | hb) == 0xFFu || occ_value_eq(v, vals[occ_first_slot(mb | hb)])) &&
+                      (mb == 0u || hb == 0u || occ_value_eq(vm, vh));
+    if (same) {
+        set_uniform(m, n, vals[0]);
+        return changed;
+    }
+    const uint32_t idx = occi_pool_alloc_leaf(m);
+    OCC_ASSERT(idx != OCC_NONE);
+    occ_leaf_block_t *const lb = occ_leaf_at(m, idx);
+    occ_value_t mx = vals[0];
+    uint8_t f = 0u;
+    for (unsigned k = 0; k < 8u; k++) {
+        lb->value[k] = vals[k];
+        mx = vals[k] > mx ? vals[k] : mx;
+        f = (uint8_t)(f | occ_value_flags_nb(m, vals[k]));
+    }
+    *n.child = idx;
+    *n.value = mx;
+    *n.flags = f;
+    occ_touch_node(m, n);
+    return changed;
+}
+
 /* The voxels of level-1 node n named by the byte masks mb (miss) and hb (hit); returns the
  * voxels whose value changed, and sets *dirty when n's value, flags or block changed. */
 static size_t node1_step(occ_map_t *const m, const occ_nodep_t n, const unsigned mb,
@@ -139,16 +173,12 @@ static size_t node1_step(occ_map_t *const m, const occ_nodep_t n, const unsigned
     if (*n.child == OCC_NONE) {
         const occ_value_t v = *n.value;
         const occ_value_t vm = occ_value_apply_delta(m, v, m->priv.q_miss);
-        const bool cm = mb != 0u && !occ_value_eq(vm, v);
-        if (!cm && (hb == 0u || occ_value_eq(occ_value_apply_delta(m, v, m->priv.q_hit), v))) {
+        const occ_value_t vh = occ_value_apply_delta(m, v, m->priv.q_hit);
+        if ((mb == 0u || occ_value_eq(vm, v)) && (hb == 0u || occ_value_eq(vh, v))) {
             return 0u;
         }
-        if (mb == 0xFFu) { /* all eight alike: it stays uniform */
-            set_uniform(m, n, vm);
-            *dirty = true;
-            return 8u;
-        }
-        occi_tree_expand(m, n, 1u);
+        *dirty = true;
+        return node1_split(m, n, mb, hb, vm, vh);
     }
     occ_leaf_block_t *const lb = occ_leaf_at(m, *n.child);
     size_t changed = 0;

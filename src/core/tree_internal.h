@@ -253,6 +253,15 @@ static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_
     return (uint8_t)(v < m->priv.q_free_max ? OCC_NODE_HAS_FREE : OCC_NODE_HAS_UNKNOWN);
 }
 
+/* occ_value_flags without branches (for loops over a block's values). */
+static inline uint8_t occ_value_flags_nb(const occ_map_t *const m, const occ_value_t v)
+{
+    const unsigned occ = v >= m->priv.q_occ_min ? 1u : 0u;
+    const unsigned fr = (occ_is_observed(v) && v < m->priv.q_free_max) ? 1u : 0u;
+    return (uint8_t)(occ * (unsigned)OCC_NODE_HAS_OCCUPIED + fr * (unsigned)OCC_NODE_HAS_FREE +
+                     (1u - (occ | fr)) * (unsigned)OCC_NODE_HAS_UNKNOWN);
+}
+
 /* An update's delta. The 8-bit mode's values span +-127 steps while a delta may need to cross
  * the whole clamp range and more (-72 .. +126 is 198 steps), so its deltas are int16 (in
  * value steps, saturated to +-32767); the other modes use the value type itself. */
