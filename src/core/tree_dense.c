@@ -138,25 +138,25 @@ static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigne
     const occ_value_t v = *n.value;
     const size_t changed = (occ_value_eq(vm, v) ? 0u : popcount64(mb)) +
                            (occ_value_eq(vh, v) ? 0u : popcount64(hb));
-    occ_value_t vals[8];
-    for (unsigned k = 0; k < 8u; k++) {
-        vals[k] = ((hb >> k) & 1u) != 0u ? vh : (((mb >> k) & 1u) != 0u ? vm : v);
-    }
-    const bool same = ((mb | hb) == 0xFFu || occ_value_eq(v, vals[occ_first_slot(mb | hb)])) &&
-                      (mb == 0u || hb == 0u || occ_value_eq(vm, vh));
+    /* the values present: untouched (pu), missed (pm), hit (ph) */
+    const bool pu = (mb | hb) != 0xFFu, pm = mb != 0u, ph = hb != 0u;
+    const bool same = (!pu || occ_value_eq(v, ph ? vh : vm)) && (!pm || !ph || occ_value_eq(vm, vh));
     if (same) {
-        set_uniform(m, n, vals[0]);
+        set_uniform(m, n, ph ? vh : vm);
         return changed;
     }
+    occ_value_t mx = pu ? v : vm; /* not uniform: two values present at least */
+    mx = pm && vm > mx ? vm : mx;
+    mx = ph && vh > mx ? vh : mx;
+    const uint8_t f = (uint8_t)((pu ? occ_value_flags(m, v) : 0u) |
+                                (pm ? occ_value_flags(m, vm) : 0u) |
+                                (ph ? occ_value_flags(m, vh) : 0u));
     const uint32_t idx = occi_pool_alloc_leaf(m);
     OCC_ASSERT(idx != OCC_NONE);
     occ_leaf_block_t *const lb = occ_leaf_at(m, idx);
-    occ_value_t mx = vals[0];
-    uint8_t f = 0u;
     for (unsigned k = 0; k < 8u; k++) {
-        lb->value[k] = vals[k];
-        mx = vals[k] > mx ? vals[k] : mx;
-        f = (uint8_t)(f | occ_value_flags_nb(m, vals[k]));
+        const occ_value_t vk = ((mb >> k) & 1u) != 0u ? vm : v;
+        lb->value[k] = ((hb >> k) & 1u) != 0u ? vh : vk;
     }
     *n.child = idx;
     *n.value = mx;

@@ -256,10 +256,9 @@ static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_
 /* occ_value_flags without branches (for loops over a block's values). */
 static inline uint8_t occ_value_flags_nb(const occ_map_t *const m, const occ_value_t v)
 {
-    const unsigned occ = v >= m->priv.q_occ_min ? 1u : 0u;
-    const unsigned fr = (occ_is_observed(v) && v < m->priv.q_free_max) ? 1u : 0u;
-    return (uint8_t)(occ * (unsigned)OCC_NODE_HAS_OCCUPIED + fr * (unsigned)OCC_NODE_HAS_FREE +
-                     (1u - (occ | fr)) * (unsigned)OCC_NODE_HAS_UNKNOWN);
+    const unsigned fr = (unsigned)occ_is_observed(v) & (unsigned)(v < m->priv.q_free_max);
+    const uint8_t low = fr != 0u ? (uint8_t)OCC_NODE_HAS_FREE : (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    return v >= m->priv.q_occ_min ? (uint8_t)OCC_NODE_HAS_OCCUPIED : low;
 }
 
 /* An update's delta. The 8-bit mode's values span +-127 steps while a delta may need to cross
