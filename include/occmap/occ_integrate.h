@@ -10,11 +10,15 @@
  * when OCC_RAY_DOUBLE=1) on the map's decimal resolution (occmap.h), so the keys are bit-for-bit
  * OctoMap's for the octomap::OcTree(0.1) a user writes for cfg.resolution_m = 0.1f.
  *
- * Memory: no heap. The per-scan key sets live in the caller's scratch buffer. They are sorted
- * Morton codes (radix sort), de-duplicated and applied with one occ_map_observe_codes() call,
- * which touches the tree in Morton order. If the scratch cannot hold them the call returns
- * OCC_ERR_SCRATCH; if the pools cannot hold the result, OCC_ERR_NOMEM; either way the map is
- * exactly as before (automatic eviction aside, see auto_evict).
+ * Memory: no heap. The per-scan key sets live in the caller's scratch buffer. When the scratch
+ * holds about a byte per voxel of the scan's bounding box, the rays mark a dense bit set of
+ * 32^3-voxel chunks (zeroed as rays first enter them) and the scan goes to the tree by 4x4x4
+ * bricks in Morton order (SIMPLE's rays taken in the order of their directions, which only
+ * changes the speed); otherwise the sets are sorted Morton codes (radix
+ * sort), de-duplicated and applied with one occ_map_observe_codes() call, which touches the
+ * tree in Morton order. Both give the same map and counts. If the scratch cannot hold the sets
+ * the call returns OCC_ERR_SCRATCH; if the pools cannot hold the result, OCC_ERR_NOMEM; either
+ * way the map is exactly as before (automatic eviction aside, see auto_evict).
  *
  * Bounded scratch (SIMPLE and DISCRETE, issue 22): when the scan's sorted codes do not fit, the
  * scan runs in Morton-range windows instead of failing. The first pass keeps the lowest codes
