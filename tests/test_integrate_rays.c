@@ -18,26 +18,13 @@
 #include "occmap/occmap.h"
 #include "support/oracle_rays.h"
 #include "support/integrate_fixture.h"
+#include "support/test_rng.h"
 
 #define ARENA_BYTES ((size_t)48 << 20)
 #define SCRATCH_BYTES ((size_t)64 << 20)
 #define RAYS 240u
 
 static uint8_t *arena_a, *arena_b, *scratch;
-static uint64_t rng_state;
-
-static uint64_t rnd(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return rng_state;
-}
-
-static float urand(float lo, float hi)
-{
-    return lo + (hi - lo) * (float)((double)(rnd() >> 11) / 9007199254740992.0);
-}
 
 /* A point `cells` voxels (integer) from the origin per axis: on voxel corners and edges when
  * the origin is on one. */

@@ -23,6 +23,7 @@
 #include "occmap/occmap.h"
 #include "core/tree_internal.h"
 #include "support/integrate_fixture.h"
+#include "support/test_rng.h"
 
 #define ARENA_BYTES OCC_ARENA_BYTES(200000, 200000)
 #define CHUNKS 6u
@@ -32,15 +33,6 @@ static uint8_t arena_a[ARENA_BYTES], arena_b[ARENA_BYTES];
 static uint64_t words[CHUNKS * 512u];
 static uint64_t chunk_codes[CHUNKS], slots[CHUNKS];
 static occ_code_t hits[HITS], codes[CHUNKS * 512u * 64u + HITS];
-static uint64_t rng_state;
-
-static uint64_t rnd(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return rng_state;
-}
 
 /* A chunk code near the map's centre (keys 32768 +- a few chunks). */
 static uint64_t near_chunk(void)
@@ -82,7 +74,8 @@ static int cmp_code(const void *a, const void *b)
 static void random_set(occi_dense_t *const d)
 {
     size_t n = 0;
-    for (unsigned i = 0; i < CHUNKS && n < 1u + rnd() % CHUNKS; i++) {
+    const size_t want_chunks = 1u + rnd_below(CHUNKS);
+    for (unsigned i = 0; i < CHUNKS && n < want_chunks; i++) {
         const uint64_t c = near_chunk();
         bool dup = false;
         for (size_t j = 0; j < n; j++) {
@@ -101,9 +94,9 @@ static void random_set(occi_dense_t *const d)
         words[i] = sparse && rnd() % 8u != 0u ? 0u : brick_mask();
     }
     size_t nh = 0;
-    const size_t want = rnd() % HITS;
+    const size_t want = rnd_below(HITS);
     for (size_t i = 0; i < want; i++) {
-        const uint64_t c = rnd() % 4u == 0u ? near_chunk() : chunk_codes[rnd() % n];
+        const uint64_t c = rnd() % 4u == 0u ? near_chunk() : chunk_codes[rnd_below((unsigned)n)];
         hits[nh++] = ((c << 15) | (rnd() & 0x7FFFu)) | OCC_CODE_HIT_BIT;
     }
     qsort(hits, nh, sizeof hits[0], cmp_code);

@@ -361,18 +361,7 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
     size_t changed = 0;
     for (size_t i = 0; i < n; i++) {
         const occ_code_t c = codes[i] & ~OCC_CODE_HIT_BIT;
-        unsigned start = depth;
-        if (i > 0u) {
-            /* Nodes below the split are finished: no later code enters them (sorted order),
-             * so they can be refreshed and pruned now without ever being re-expanded. */
-            const unsigned s = split_level(c, prev);
-            if (s > p.low) {
-                refresh_up_to(m, &p, s - 1u);
-                start = s;
-            } else {
-                start = p.low;
-            }
-        }
+        const unsigned start = path_start(m, &p, c, prev, i == 0u);
         prev = c;
         unsigned stop;
         const occ_value_t v = descend(m, &p, c, start, &stop);

@@ -270,17 +270,7 @@ occ_err_t occi_tree_apply_dense(occ_map_t *const m, const occi_dense_t *const d,
     occ_code_t prev = 0;
     bool first = true;
     while (next_brick(&c, &b)) {
-        unsigned start = depth;
-        if (!first) {
-            /* Nodes below the split are finished (sorted order): refresh them now. */
-            const unsigned s = split_level(b.code, prev);
-            if (s > p.low) {
-                refresh_up_to(m, &p, s - 1u);
-                start = s;
-            } else {
-                start = p.low;
-            }
-        }
+        const unsigned start = path_start(m, &p, b.code, prev, first);
         first = false;
         prev = b.code;
         out->changed += brick_step(m, &p, &b, start);

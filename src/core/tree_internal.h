@@ -195,18 +195,12 @@ static inline unsigned occ_first_slot(unsigned mask)
 #endif
 }
 
-/* The lowest set bit of a non-zero 64-bit mask. */
-static inline unsigned occ_first_slot64(uint64_t mask)
+/* The lowest set bit of a non-zero 64-bit mask (two 32-bit halves: no 64-bit count on a
+ * 32-bit core). */
+static inline unsigned occ_first_slot64(const uint64_t mask)
 {
-#if defined(__GNUC__)
-    return (unsigned)__builtin_ctzll(mask);
-#else
-    unsigned slot = 0;
-    while (((mask >> slot) & 1u) == 0u) {
-        slot++;
-    }
-    return slot;
-#endif
+    const unsigned lo = (unsigned)(mask & 0xFFFFFFFFu);
+    return lo != 0u ? occ_first_slot(lo) : 32u + occ_first_slot((unsigned)(mask >> 32));
 }
 
 /* Number of significant bits of x (0 for 0): 1 + the highest set bit. */
