@@ -519,6 +519,24 @@ static bool dense_order(occ_ictx_t *const x, occ_bitset_t *const bs, occi_dense_
     return true;
 }
 
+/* The dense set to the tree by bricks when the pools surely suffice (1: done), else its codes
+ * at b (0, *m codes, SIZE_MAX: no room); -1 when the hits' sort has no room. Out of line: its
+ * locals stay off the frame under the eviction that the codes may take (make cross). */
+static OCC_NOINLINE int dense_apply(occ_ictx_t *const x, occ_bitset_t *const bs, size_t *const m)
+{
+    occi_dense_t d;
+    if (!dense_order(x, bs, &d)) {
+        return -1;
+    }
+    occi_dense_out_t o;
+    if (x->cbs == NULL && occi_tree_apply_dense(x->map, &d, &o) == OCC_OK) {
+        set_counts(x->r, o.voxels, d.n_hits, o.changed);
+        return 1;
+    }
+    *m = occi_dense_codes(&d, x->b, x->b_cap);
+    return 0;
+}
+
 /* The scan's sorted, collapsed codes; FAST_DISCRETE's coarse pass (d > 0); then one coherent
  * batch update in Morton order (all or nothing, except in automatic mode). The dense set goes
  * to the tree by bricks when the pools surely suffice, else as codes. Out of line: inlined,
@@ -532,16 +550,10 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
     occ_code_t *codes, *spare; /* spare: free scratch after the fine codes, for the coarse ones */
     size_t m, spare_cap;
     if (dense) {
-        occi_dense_t d;
-        if (!dense_order(x, bs, &d)) {
-            return OCC_ERR_SCRATCH;
+        const int dr = dense_apply(x, bs, &m);
+        if (dr != 0) {
+            return dr > 0 ? OCC_OK : OCC_ERR_SCRATCH;
         }
-        occi_dense_out_t o;
-        if (x->cbs == NULL && occi_tree_apply_dense(x->map, &d, &o) == OCC_OK) {
-            set_counts(r, o.voxels, d.n_hits, o.changed);
-            return OCC_OK;
-        }
-        m = occi_dense_codes(&d, x->b, x->b_cap);
         if (m == SIZE_MAX) {
             occ_ictx_note(x, 0, x->b_cap);
             return OCC_ERR_SCRATCH;
@@ -600,8 +612,8 @@ static size_t touched_bytes(const occ_ictx_t *const x, const occ_insert_params_t
     if (x->bs == NULL) {
         b += FILTER_N * 8u;
     } else { /* the entered chunks' words, the chunk mask, list and sort temporary */
-        b += 4096u * x->bs->n_chunks + 8u * (((dense_bricks >> 9) + 63u) >> 6) +
-             16u * x->bs->n_chunks;
+        b += 4096u * x->bs->n_touched + 8u * (((dense_bricks >> 9) + 63u) >> 6) +
+             16u * x->bs->n_touched;
     }
     if (params->method == OCC_INSERT_DISCRETE || params->method == OCC_INSERT_FAST_DISCRETE) {
         b += 8u * x->n_ends;
@@ -718,14 +730,12 @@ static void layout_pass(occ_ictx_t *const x, const carve_t *const c, const bool 
          * words are zeroed chunk by chunk as rays enter them */
         const size_t chunks = bricks >> 9, mask_words = (chunks + 63u) >> 6;
         bs->words = (uint64_t *)(void *)c->rest;
-        bs->cmask = bs->words + bricks;
-        bs->clist = bs->cmask + mask_words;
-        bs->ctmp = bs->clist + chunks;
-        bs->n_chunks = 0;
+        bs->touched = bs->words + bricks + mask_words;
+        bs->n_touched = 0;
         bs->overflow = false;
-        memset(bs->cmask, 0, mask_words * 8u);
+        memset(bs->words + bricks, 0, mask_words * 8u);
         x->bs = bs;
-        x->a = bs->ctmp + chunks;
+        x->a = bs->touched + 2u * chunks;
         x->cap = hits_cap;
         x->b = x->a + hits_cap;
         x->b_cap = (size_t)((c->rest + c->rest_bytes) - (uint8_t *)(void *)x->b) / 8u;

@@ -75,32 +75,43 @@ size_t occi_keyset_unique(occ_code_t *a, size_t n);
  * so that a ray stays on one page for 32 voxels. Used when the box fits the scratch: a visit
  * is a test-and-set. Two ways to know which words hold anything:
  *  - the fine set (rays' voxels, denseset.c): a chunk's words are zeroed when a ray first
- *    enters it (occ_denseset_enter), which lists the chunk; the walk reads the listed chunks in
- *    Morton order. Nothing per visit.
+ *    enters it (occ_denseset_enter), which sets its bit in a mask after the words and lists
+ *    it in `touched`; the walk reads the listed chunks in Morton order. Nothing per visit.
+ *    Scratch: words | mask | list | the list's sort temporary, each list of all chunks' size.
  *  - the coarse set (FAST_DISCRETE's level-d nodes, occ_bitset_add): every word is zeroed
  *    first, and each word's first bit lists it in `touched`. */
 typedef struct {
     uint64_t *words;     /* chunks * 512 words */
-    uint64_t *touched;   /* coarse set: word indices in first-touch order (cap: all bricks) */
+    uint64_t *touched;   /* word indices in first-touch order (coarse set; cap: all bricks), or
+                          * entered chunks (fine set; cap: all chunks) */
     size_t n_touched;
-    uint64_t *cmask;     /* fine set: one bit per chunk, set once entered (zeroed first) */
-    uint64_t *clist;     /* fine set: entered chunks (index), then their codes, sorted */
-    uint64_t *ctmp;      /* fine set: the sort's temporary (cap: all chunks) */
-    size_t n_chunks;     /* fine set: entered chunks */
     uint32_t b0[3];      /* first brick (key >> 2) per axis, a multiple of 8 */
     uint32_t nb[3];      /* bricks per axis, multiples of 8 */
     size_t stride_y, stride_z; /* chunks per y step and per z step */
     bool overflow;       /* a visit fell outside the box: the caller falls back to sorting */
 } occ_bitset_t;
 
+/* Chunks in the box. */
+static inline size_t occ_denseset_chunks(const occ_bitset_t *bs)
+{
+    return bs->stride_z * (bs->nb[2] >> 3);
+}
+
+/* The fine set's entered-chunk mask, after the words. */
+static inline uint64_t *occ_denseset_mask(const occ_bitset_t *bs)
+{
+    return bs->words + (occ_denseset_chunks(bs) << 9);
+}
+
 /* The fine set's words of chunk `chunk` (in the box), zeroed and listed on the first entry. */
 static inline uint64_t *occ_denseset_enter(occ_bitset_t *bs, size_t chunk)
 {
     uint64_t *const w = bs->words + (chunk << 9);
+    uint64_t *const mask = occ_denseset_mask(bs) + (chunk >> 6);
     const uint64_t bit = (uint64_t)1 << (chunk & 63u);
-    if ((bs->cmask[chunk >> 6] & bit) == 0u) {
-        bs->cmask[chunk >> 6] |= bit;
-        bs->clist[bs->n_chunks++] = chunk;
+    if ((*mask & bit) == 0u) {
+        *mask |= bit;
+        bs->touched[bs->n_touched++] = chunk;
         memset(w, 0, 512u * sizeof *w);
     }
     return w;

@@ -83,17 +83,27 @@ typedef struct {
     size_t limit;
 } dda_t;
 
+/* computeRayKeys' set-up: the float direction and length of o -> e, then tMax, tDelta and
+ * steps from the origin's voxel ko. Returns the length. */
+static OCC_ALWAYS_INLINE float dda_start(occ_dda_t *const dd, const occ_raygeo_t *const g,
+                                         const float o[3],
+                              const float e[3], const uint32_t ko[3])
+{
+    float d[3] = {e[0] - o[0], e[1] - o[1], e[2] - o[2]};
+    const float length = (float)occi_raygeo_dist(o, e);
+    d[0] /= length;
+    d[1] /= length;
+    d[2] /= length;
+    /* computeRayKeys rounds the half-voxel step to float. */
+    occ_dda_start(dd, g->res, g->tmv, o, d, ko, true);
+    return length;
+}
+
 /* Prepares the traversal; the first voxel (the origin's) is s->c. ko != ke. */
 static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const float o[3],
                             const float e[3], const uint32_t ko[3], const uint32_t ke[3])
 {
-    float d[3] = {e[0] - o[0], e[1] - o[1], e[2] - o[2]};
-    s->length = (float)occi_raygeo_dist(o, e);
-    d[0] /= s->length;
-    d[1] /= s->length;
-    d[2] /= s->length;
-    /* computeRayKeys rounds the half-voxel step to float. */
-    occ_dda_start(&s->dd, g->res, g->tmv, o, d, ko, true);
+    s->length = dda_start(&s->dd, g, o, e, ko);
     for (unsigned i = 0; i < 3u; i++) {
         s->key[i] = (int32_t)ko[i];
     }
@@ -234,7 +244,8 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
  * common path: the walk stops once every tMax passed the length (each only grows), and a
  * countdown per axis says when its key crosses into the next chunk. */
 typedef struct {
-    occ_rr_t t[3], d[3], len;
+    occ_dda_t dd;   /* tMax, tDelta, steps (the walk keeps them in registers) */
+    occ_rr_t len;
     occ_code_t c, ce;
     size_t chunk;
     uint32_t cc[3]; /* chunk coordinates in the box */
@@ -280,8 +291,9 @@ static bool mark_left_box(const mwalk_t *const w, const occ_rr_t t0, const occ_r
 static OCC_ALWAYS_INLINE void mark_walk(mwalk_t *const w, occ_bitset_t *const bs,
                                         uint64_t *cw, const int s0, const int s1, const int s2)
 {
-    occ_rr_t t0 = w->t[0], t1 = w->t[1], t2 = w->t[2];
-    const occ_rr_t d0 = w->d[0], d1 = w->d[1], d2 = w->d[2], len = w->len;
+    occ_rr_t t0 = w->dd.tmax[0], t1 = w->dd.tmax[1], t2 = w->dd.tmax[2];
+    const occ_rr_t d0 = w->dd.tdelta[0], d1 = w->dd.tdelta[1], d2 = w->dd.tdelta[2];
+    const occ_rr_t len = w->len;
     const occ_code_t ce = w->ce;
     occ_code_t c = w->c;
     uint32_t n0 = w->n[0], n1 = w->n[1], n2 = w->n[2];
@@ -332,23 +344,18 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
         bs->overflow = true;
         return 0;
     }
-    dda_t s;
-    dda_init(&s, g, o, e, ko, ke);
-    const occ_key_t kek = {{ke[0], ke[1], ke[2]}};
+    w.len = (occ_rr_t)dda_start(&w.dd, g, o, e, ko);
+    const occ_key_t kok = {{ko[0], ko[1], ko[2]}}, kek = {{ke[0], ke[1], ke[2]}};
+    w.c = occ_morton_encode(kok);
     w.ce = occ_morton_encode(kek);
-    w.c = s.c;
-    w.len = (occ_rr_t)s.length;
-    uint32_t n0[3], cc0[3];
     for (unsigned i = 0; i < 3u; i++) {
-        w.t[i] = s.dd.tmax[i];
-        w.d[i] = s.dd.tdelta[i];
-        w.n[i] = n0[i] = chunk_countdown(ko[i], s.dd.step[i]);
-        cc0[i] = w.cc[i];
+        w.n[i] = chunk_countdown(ko[i], w.dd.step[i]);
     }
     w.chunk = w.cc[0] + bs->stride_y * w.cc[1] + bs->stride_z * w.cc[2];
     uint64_t *const cw = occ_denseset_enter(bs, w.chunk);
     cw[(w.c >> 6) & 511u] |= (uint64_t)1 << (w.c & 63u);
-    switch ((s.dd.step[0] < 0 ? 1u : 0u) | (s.dd.step[1] < 0 ? 2u : 0u) | (s.dd.step[2] < 0 ? 4u : 0u)) {
+    switch ((w.dd.step[0] < 0 ? 1u : 0u) | (w.dd.step[1] < 0 ? 2u : 0u) |
+            (w.dd.step[2] < 0 ? 4u : 0u)) {
     case 0u: mark_ppp(&w, bs, cw); break;
     case 1u: mark_npp(&w, bs, cw); break;
     case 2u: mark_pnp(&w, bs, cw); break;
@@ -359,13 +366,9 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     default: mark_nnn(&w, bs, cw); break;
     }
     /* Visits: the origin and one per step but the last (the end, or past the length), i.e. the
-     * steps, counted per axis by the chunk countdowns and crossings. */
-    size_t steps = 0;
-    for (unsigned i = 0; i < 3u; i++) {
-        const uint32_t x = w.cc[i] > cc0[i] ? w.cc[i] - cc0[i] : cc0[i] - w.cc[i];
-        steps += (size_t)n0[i] - w.n[i] + 32u * (size_t)x;
-    }
-    return steps;
+     * steps; each moves one key by one toward the end, so they sum to the keys' distance. */
+    const occ_key_t kf = occ_morton_decode(w.c);
+    return occi_dda_bound(ko, kf.k) - 4u;
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */
