@@ -2,7 +2,9 @@
 // ab_split.cpp - the library built from AB_BASE (its symbols renamed old_*, bench/ab_split.mk)
 // against this tree's, in one process, on the same inputs, in interleaved rounds (the order
 // flips every round, so drift and cache warmth hit both alike):
-//   super rays: occ_map_insert_cloud(SUPER_RAYS) of scan.dat into a fresh map, 0.1 and 0.05 m;
+//   inserts:    occ_map_insert_cloud(SIMPLE, DISCRETE, SUPER_RAYS) of scan.dat into a fresh map,
+//               0.1 and 0.05 m, and of the 10 TUM pioneer frames at 0.05 m (SIMPLE, DISCRETE);
+//               both sides' maps must be equal node for node (a walk digest);
 //   castRay:    occ_cast_ray 10 m from random free points of geb079.bt (ignore / stop at unknown);
 //   los:        occ_line_of_sight between free points 1..10.8 m apart on geb079.bt;
 //   collide:    occ_collide_sphere (r 0.25 m), _capsule (1 m, r 0.3 m) and _obb (0.6 x 0.4 x
@@ -11,7 +13,10 @@
 // Prints, per case, each side's median and range (min..max) over the rounds and the median and
 // quartiles of the per-round ratio new / old (< 1: the new code is faster). Both sides must give
 // the same answers (checked on every input first).
-// usage: ab_split [--rounds N] [--queries-only] SCAN.dat MAP.bt
+// usage: ab_split [--rounds N] [--queries-only | --inserts-only] [--case SUBSTR] [--tum DIR]
+//                 SCAN.dat MAP.bt
+// (--case runs only the insert cases whose name contains SUBSTR; --inserts-only under callgrind
+// with --toggle-collect=occ_map_insert_cloud profiles this tree's side alone.)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -29,6 +34,8 @@ extern "C" {
 
 extern "C" decltype(occ_map_init) old_occ_map_init;
 extern "C" decltype(occ_map_insert_cloud) old_occ_map_insert_cloud;
+extern "C" decltype(occ_walk_begin) old_occ_walk_begin;
+extern "C" decltype(occ_walk_next) old_occ_walk_next;
 extern "C" decltype(occ_cast_ray) old_occ_cast_ray;
 extern "C" decltype(occ_line_of_sight) old_occ_line_of_sight;
 extern "C" decltype(occ_collide_sphere) old_occ_collide_sphere;
@@ -77,51 +84,134 @@ static void ab(const char *name, int rounds, const FA &fa, const FB &fb)
 
 static std::vector<uint8_t> arena((size_t)768 << 20), scratch;
 
-static double insert_once(decltype(occ_map_init) *init, decltype(occ_map_insert_cloud) *insert,
-                          const std::vector<occ_vec3_t> &pts, float res, occ_insert_result_t *out)
+// One side of the library: its init, insert and walk (for the digest).
+struct Lib {
+    decltype(occ_map_init) *init;
+    decltype(occ_map_insert_cloud) *insert;
+    decltype(occ_walk_begin) *walk_begin;
+    decltype(occ_walk_next) *walk_next;
+};
+static const Lib lib_old = {old_occ_map_init, old_occ_map_insert_cloud, old_occ_walk_begin,
+                            old_occ_walk_next};
+static const Lib lib_new = {occ_map_init, occ_map_insert_cloud, occ_walk_begin, occ_walk_next};
+
+struct Scan {
+    std::vector<occ_vec3_t> pts;
+    occ_vec3_t origin;
+};
+
+// FNV-1a over every observed node the walk reports (key, level, value, children).
+static uint64_t map_digest(const Lib &l, const occ_map_t &m)
+{
+    uint64_t h = 1469598103934665603ull;
+    const auto mix = [&h](uint64_t v) {
+        for (int i = 0; i < 8; i++, v >>= 8) h = (h ^ (v & 0xFFu)) * 1099511628211ull;
+    };
+    occ_walk_t w;
+    occ_walk_node_t n;
+    l.walk_begin(&w, &m);
+    while (l.walk_next(&w, &n)) {
+        mix(((uint64_t)n.key.k[0] << 42) ^ ((uint64_t)n.key.k[1] << 21) ^ n.key.k[2]);
+        mix(((uint64_t)n.level << 1) | (n.has_children ? 1u : 0u));
+        mix((uint64_t)(uint16_t)n.value);
+    }
+    return h;
+}
+
+// All scans into a fresh map: CPU ms of the insert calls; *digest of the map when non-NULL.
+static double insert_once(const Lib &l, const std::vector<Scan> &scans, float res,
+                          occ_insert_method_t meth, occ_insert_result_t *out, uint64_t *digest)
 {
     occ_map_config_t cfg = occ_map_config_default();
     cfg.resolution_m = res;
     occ_map_t m;
-    if (init(&m, &cfg, arena.data(), arena.size()) != OCC_OK) std::abort();
+    if (l.init(&m, &cfg, arena.data(), arena.size()) != OCC_OK) std::abort();
     occ_insert_params_t p = occ_insert_params_default();
-    p.method = OCC_INSERT_SUPER_RAYS;
-    const occ_vec3_t origin = {0, 0, 0};
-    const double t0 = cpu_ms();
-    const occ_err_t e =
-        insert(&m, &origin, pts.data(), pts.size(), &p, scratch.data(), scratch.size(), out);
-    const double t = cpu_ms() - t0;
-    if (e != OCC_OK) {
-        std::fprintf(stderr, "ab_split: insert: %s\n", occ_err_str(e));
-        std::exit(1);
+    p.method = meth;
+    double t = 0;
+    for (const Scan &s : scans) {
+        const double t0 = cpu_ms();
+        const occ_err_t e = l.insert(&m, &s.origin, s.pts.data(), s.pts.size(), &p,
+                                     scratch.data(), scratch.size(), out);
+        t += cpu_ms() - t0;
+        if (e != OCC_OK) {
+            std::fprintf(stderr, "ab_split: insert: %s\n", occ_err_str(e));
+            std::exit(1);
+        }
     }
+    if (digest != nullptr) *digest = map_digest(l, m);
     return t;
 }
 
-static void bench_superrays(const std::vector<occ_vec3_t> &pts, float res, int rounds)
+static const char *meth_name(occ_insert_method_t m)
 {
+    return m == OCC_INSERT_SIMPLE ? "simple" : m == OCC_INSERT_DISCRETE ? "discrete" : "super rays";
+}
+
+static void bench_insert(const char *data, const std::vector<Scan> &scans, float res,
+                         occ_insert_method_t meth, int rounds, const char *filter)
+{
+    char name[64];
+    std::snprintf(name, sizeof name, "%s %s %.2f m", meth_name(meth), data, res);
+    if (filter != nullptr && std::strstr(name, filter) == nullptr) return;
     occ_map_config_t cfg = occ_map_config_default();
     cfg.resolution_m = res;
     occ_map_t tmp;
     static uint8_t small[OCC_ARENA_BYTES(2, 2)];
     occ_map_init(&tmp, &cfg, small, sizeof small);
     occ_insert_params_t p = occ_insert_params_default();
-    p.method = OCC_INSERT_SUPER_RAYS;
-    const occ_vec3_t origin = {0, 0, 0};
-    scratch.assign(occ_insert_scratch_bytes_scan(&tmp, &origin, pts.data(), pts.size(), &p), 0);
+    p.method = meth;
+    size_t need = 0;
+    for (const Scan &s : scans)
+        need = std::max(need, occ_insert_scratch_bytes_scan(&tmp, &s.origin, s.pts.data(),
+                                                            s.pts.size(), &p));
+    scratch.assign(need, 0);
     occ_insert_result_t ro, rn;
-    insert_once(old_occ_map_init, old_occ_map_insert_cloud, pts, res, &ro);
-    insert_once(occ_map_init, occ_map_insert_cloud, pts, res, &rn);
-    if (std::memcmp(&ro, &rn, sizeof ro) != 0) {
-        std::fprintf(stderr, "ab_split: super rays at %.2f m: old and new results differ\n", res);
+    uint64_t dold = 0, dnew = 0;
+    insert_once(lib_old, scans, res, meth, &ro, &dold);
+    insert_once(lib_new, scans, res, meth, &rn, &dnew);
+    ro.scratch_used = rn.scratch_used = 0; /* a layout change may use other scratch */
+    if (std::memcmp(&ro, &rn, sizeof ro) != 0 || dold != dnew) {
+        std::fprintf(stderr, "ab_split: %s: old and new results differ (visits %zu / %zu, updated %zu / %zu, changed %zu / %zu, digest %s)\n",
+                     name, (size_t)ro.voxel_visits, (size_t)rn.voxel_visits, (size_t)ro.voxels_updated,
+                     (size_t)rn.voxels_updated, (size_t)ro.voxels_changed, (size_t)rn.voxels_changed,
+                     dold == dnew ? "equal" : "differs");
         std::exit(1);
     }
-    char name[64];
-    std::snprintf(name, sizeof name, "super rays scan.dat %.2f m (%zu rays)", res,
-                  (size_t)rn.rays_cast);
-    ab(name, rounds,
-       [&] { return insert_once(old_occ_map_init, old_occ_map_insert_cloud, pts, res, &ro); },
-       [&] { return insert_once(occ_map_init, occ_map_insert_cloud, pts, res, &rn); });
+    std::printf("%s: last scan %zu rays, %zu voxel visits, %zu voxels updated\n", name,
+                (size_t)rn.rays_cast, (size_t)rn.voxel_visits, (size_t)rn.voxels_updated);
+    ab(name, rounds, [&] { return insert_once(lib_old, scans, res, meth, &ro, nullptr); },
+       [&] { return insert_once(lib_new, scans, res, meth, &rn, nullptr); });
+}
+
+static void bench_inserts(const std::vector<occ_vec3_t> &pts, const std::vector<Scan> &tum,
+                          int rounds, const char *filter)
+{
+    const std::vector<Scan> scan = {Scan{pts, {0, 0, 0}}};
+    const occ_insert_method_t ms[] = {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE,
+                                      OCC_INSERT_SUPER_RAYS};
+    for (const float res : {0.1f, 0.05f})
+        for (const occ_insert_method_t m : ms) bench_insert("scan.dat", scan, res, m, rounds, filter);
+    if (!tum.empty())
+        for (const occ_insert_method_t m : {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE})
+            bench_insert("tum10", tum, 0.05f, m, rounds, filter);
+}
+
+static std::vector<Scan> load_tum(const char *dir)
+{
+    std::vector<Scan> out;
+    occ_scan_frame_t *f = nullptr;
+    size_t n = 0;
+    char msg[256] = "";
+    if (occ_depth_read_tum_dir(dir, 1, 10, &f, &n, msg, sizeof msg) != OCC_OK) {
+        std::fprintf(stderr, "ab_split: TUM frames skipped: %s\n", msg);
+        return out;
+    }
+    for (size_t i = 0; i < n; i++)
+        out.push_back(Scan{std::vector<occ_vec3_t>(f[i].points, f[i].points + f[i].n_points),
+                           f[i].origin});
+    occ_scan_frames_free(f, n);
+    return out;
 }
 
 struct Box {
@@ -339,19 +429,27 @@ static void bench_queries(const occ_map_t &m, int rounds)
 int main(int argc, char **argv)
 {
     int rounds = 15;
-    bool queries_only = false;
+    bool queries_only = false, inserts_only = false;
+    const char *filter = nullptr, *tum_dir = nullptr;
     int a = 1;
     for (; a < argc && argv[a][0] == '-'; a++) {
         if (std::strcmp(argv[a], "--rounds") == 0 && a + 1 < argc) {
             rounds = std::max(1, std::atoi(argv[++a]));
         } else if (std::strcmp(argv[a], "--queries-only") == 0) {
             queries_only = true; /* e.g. under callgrind, where the inserts take minutes */
+        } else if (std::strcmp(argv[a], "--inserts-only") == 0) {
+            inserts_only = true;
+        } else if (std::strcmp(argv[a], "--case") == 0 && a + 1 < argc) {
+            filter = argv[++a];
+        } else if (std::strcmp(argv[a], "--tum") == 0 && a + 1 < argc) {
+            tum_dir = argv[++a];
         } else {
             break;
         }
     }
     if (argc - a != 2) {
-        std::fprintf(stderr, "usage: ab_split [--rounds N] [--queries-only] SCAN.dat MAP.bt\n");
+        std::fprintf(stderr, "usage: ab_split [--rounds N] [--queries-only | --inserts-only] "
+                             "[--case SUBSTR] [--tum DIR] SCAN.dat MAP.bt\n");
         return 2;
     }
     char msg[256] = "";
@@ -372,10 +470,10 @@ int main(int argc, char **argv)
     }
     std::printf("A/B old (AB_BASE) vs new (this tree), %d interleaved rounds, CPU time\n", rounds);
     if (!queries_only) {
-        bench_superrays(scan, 0.1f, rounds);
-        bench_superrays(scan, 0.05f, rounds);
+        const std::vector<Scan> tum = tum_dir != nullptr ? load_tum(tum_dir) : std::vector<Scan>();
+        bench_inserts(scan, tum, rounds, filter);
     }
-    bench_queries(m, rounds);
+    if (!inserts_only) bench_queries(m, rounds);
     std::free(map_arena);
     return 0;
 }

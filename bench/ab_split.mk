@@ -2,11 +2,14 @@
 # ab_split.mk - `make bench-ab-split` (in neither `make test` nor `make bench`): the library as
 # of AB_BASE (default: main before the long functions were split) against this tree's, linked
 # into one program (bench/ab_split.cpp) with the old library's symbols renamed old_*, run in
-# interleaved rounds on scan.dat (super rays, 0.1 / 0.05 m) and geb079.bt (castRay, line of
-# sight). Proves a refactor of a hot path costs nothing: `make bench-ab-split AB_BASE=<commit>`.
+# interleaved rounds on scan.dat (SIMPLE, DISCRETE, super rays at 0.1 / 0.05 m), the 10 TUM
+# pioneer frames (SIMPLE, DISCRETE at 0.05 m) and geb079.bt (castRay, line of sight, collision).
+# Proves a refactor of a hot path costs nothing: `make bench-ab-split AB_BASE=<commit>`; AB_ARGS
+# passes options (e.g. AB_ARGS='--inserts-only --case simple').
 AB_BASE ?= 6e02855
 AB_DIR := $(BUILD)/ab
 AB_MAP := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt
+AB_TUM := ../shared/data/depth/tum_fr2_pioneer_slam2
 # The map modules only (no front ends). Rebuilt when AB_BASE names another commit (its id is kept in $(AB_DIR)/base).
 $(AB_DIR)/libocc_old.a: FORCE_AB
 	@set -e; sha=$$(git rev-parse --verify '$(AB_BASE)^{commit}'); \
@@ -26,9 +29,11 @@ $(AB_DIR)/libocc_old.a: FORCE_AB
 	objcopy --redefine-syms=rename.txt lib.a ../libocc_old.a; \
 	cd - > /dev/null; echo "$$sha" > $(AB_DIR)/base
 $(BUILD)/bench/ab_split: bench/ab_split.cpp $(BUILD)/relhost/port/posix/file_io.o \
-    $(BUILD)/relhost/port/posix/scan_xyz.o $(BUILD)/libocc.a $(AB_DIR)/libocc_old.a
+    $(patsubst %,$(BUILD)/relhost/port/posix/%.o,scan_xyz scan_graph depth_png) \
+    $(BUILD)/libocc.a $(AB_DIR)/libocc_old.a
 	@mkdir -p $(dir $@)
-	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $^ -lccd -lm
+	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $^ -lccd -lpng -lm
 bench-ab-split: $(BUILD)/bench/ab_split $(BUILD)/data/scan.dat
-	./$(BUILD)/bench/ab_split --rounds $(or $(AB_ROUNDS),15) $(BUILD)/data/scan.dat $(AB_MAP)
+	./$(BUILD)/bench/ab_split --rounds $(or $(AB_ROUNDS),15) --tum $(AB_TUM) $(AB_ARGS) \
+	  $(BUILD)/data/scan.dat $(AB_MAP)
 .PHONY: bench-ab-split FORCE_AB

@@ -129,12 +129,14 @@ typedef enum {
     WAY_PIECES,
     WAY_SET,
     WAY_WINDOWS,
+    WAY_BRICKS,
     WAY_ANY
 } way_t;
 
 /* How the last insert ran: one trace into the voxel set and one batch, one trace as sorted
- * codes and one batch, one trace into the set and several batches (or any number), or more
- * traces as sorted codes (windows, after a set that ran full or without one). */
+ * codes and one batch, one trace into the set and several batches (or any number), more
+ * traces as sorted codes (windows, after a set that ran full or without one), or one trace
+ * into the set applied by bricks (no batch of codes). */
 static void assert_way(const way_t way)
 {
     const occi_insert_probe_t p = occi_insert_probe;
@@ -148,12 +150,20 @@ static void assert_way(const way_t way)
         assert_true(p.traces == 1u && p.set_traces == 1u && p.pieces >= 1u);
     } else if (way == WAY_WINDOWS) {
         assert_true(p.traces > 1u && p.set_traces <= 1u);
+    } else if (way == WAY_BRICKS) {
+        assert_true(p.traces == 1u && p.set_traces == 1u && p.pieces == 0u && p.bricks == 1u);
+    }
+    if (way != WAY_BRICKS && way != WAY_ANY) {
+        assert_int_equal(p.bricks, 0);
     }
 }
 
+/* Scratch, the way expected, and whether bricks may be taken (else the set goes the way of
+ * the codes: occi_insert_bricks_off). */
 typedef struct {
     size_t bytes;
     way_t way;
+    bool bricks;
 } size_case_t;
 
 /* The scan into a cleared map with `bytes` of scratch: the result, the one-shot map's and
@@ -164,12 +174,14 @@ static void check_size(occ_map_t *m, const occ_map_t *ref, void *oracle, const i
 {
     occ_insert_result_t r;
     occ_map_clear(m);
-    assert_int_equal(occ_map_insert_cloud(m, &c->origin, c->p, c->n, p, scratch, sc.bytes, &r),
-                     OCC_OK);
+    occi_insert_bricks_off = !sc.bricks;
+    const occ_err_t e = occ_map_insert_cloud(m, &c->origin, c->p, c->n, p, scratch, sc.bytes, &r);
+    occi_insert_bricks_off = false;
+    assert_int_equal(e, OCC_OK);
     printf("  method %d scratch %zu (one-shot used %zu): %zu voxels, %u traces (%u into the set), "
-           "%u batches\n",
+           "%u batches, %u by bricks\n",
            (int)p->method, sc.bytes, r0->scratch_used, r.voxels_updated, occi_insert_probe.traces,
-           occi_insert_probe.set_traces, occi_insert_probe.pieces);
+           occi_insert_probe.set_traces, occi_insert_probe.pieces, occi_insert_probe.bricks);
     assert_way(sc.way);
     assert_true(r.scratch_used <= sc.bytes);
     assert_int_equal(r.voxels_updated, r0->voxels_updated);
@@ -222,7 +234,7 @@ static bool fixture_begin(fixture_t *f, const occ_insert_method_t method, const 
     assert_int_equal(occ_map_insert_cloud(&f->ref, &f->c.origin, f->c.p, f->c.n, &f->p, scratch,
                                           SCRATCH_BYTES, &f->r0),
                      OCC_OK);
-    assert_way(WAY_ONE_SHOT);
+    assert_way(WAY_BRICKS);
     f->oracle = oracle_ins_new((double)res);
     const float o[3] = {f->c.origin.x, f->c.origin.y, f->c.origin.z};
     oracle_ins_cloud(f->oracle, (const float *)(const void *)f->c.p, f->c.n, o, -1.0,
@@ -249,9 +261,12 @@ static void check_method(const occ_insert_method_t method, const float res, cons
     const size_t sm = set_min(&f.c, ray_chunks(&f.m, &f.c, discrete), discrete);
     /* The windows' minimum, the set's exact threshold and 8 bytes under it (one chunk short:
      * the set runs full, the scan goes to windows), the set with little and with much room. */
-    const size_case_t cases[] = {{lo, WAY_WINDOWS},         {lo + 4096u, WAY_WINDOWS},
-                                 {sm - 8u, WAY_WINDOWS},    {sm, WAY_PIECES},
-                                 {sm + 65536u, WAY_PIECES}, {f.r0.scratch_used / 3u, WAY_ANY}};
+    const size_case_t cases[] = {{lo, WAY_WINDOWS, false},
+                                 {lo + 4096u, WAY_WINDOWS, false},
+                                 {sm - 8u, WAY_WINDOWS, false},
+                                 {sm, WAY_PIECES, false},
+                                 {sm + 65536u, WAY_PIECES, false},
+                                 {f.r0.scratch_used / 3u, WAY_ANY, false}};
     for (size_t i = at_min ? 0u : 2u; i < (at_min ? 2u : 6u); i++) {
         size_case_t sc = cases[i];
         sc.bytes = sc.bytes > lo ? sc.bytes : lo;
@@ -286,17 +301,21 @@ static void test_discrete_min(void **state)
 }
 
 /* Issue 22's case: all of scan.dat at 0.05 m in 8 MiB of scratch - one trace, applied in
- * pieces, equal to the one-shot map (which takes ~34 MB of scratch) and to OctoMap's. SIMPLE
- * here (DISCRETE in pieces above at 0.1 m; make bench-scratch compares both at 0.05 m). */
+ * pieces of codes (one batch of codes would take the set and 8 bytes a voxel, ~35 MB) and by
+ * bricks (no codes: the set alone, ~4.2 MB), equal to the one-shot map and to OctoMap's.
+ * SIMPLE here (DISCRETE in pieces above at 0.1 m; make bench-scratch compares both at
+ * 0.05 m). */
 static void check_8mib(const occ_insert_method_t method)
 {
     static fixture_t f;
     if (!fixture_begin(&f, method, 0.05f, 1u)) {
         skip();
     }
-    assert_true(f.r0.scratch_used > ((size_t)8 << 20));
-    const size_case_t sc = {(size_t)8 << 20, WAY_PIECES};
+    assert_true(8u * f.r0.voxels_updated > ((size_t)8 << 20));
+    const size_case_t sc = {(size_t)8 << 20, WAY_PIECES, false};
     check_size(&f.m, &f.ref, f.oracle, &f.c, &f.p, &f.r0, sc);
+    const size_case_t sb = {(size_t)8 << 20, WAY_BRICKS, true};
+    check_size(&f.m, &f.ref, f.oracle, &f.c, &f.p, &f.r0, sb);
     fixture_end(&f);
 }
 
@@ -317,8 +336,8 @@ static void test_sorted_when_one_batch(void **state)
     const size_t sm = set_min(&f.c, ray_chunks(&f.m, &f.c, false), false);
     printf("  sorted codes in one batch from %zu, the set's threshold %zu\n", one, sm);
     assert_true(sm + 65536u < one);
-    const size_case_t cases[] = {{one, WAY_SORTED_ONE_SHOT}, {one - 8u, WAY_SET},
-                                 {sm + 65536u, WAY_PIECES}};
+    const size_case_t cases[] = {{one, WAY_SORTED_ONE_SHOT, false}, {one - 8u, WAY_SET, false},
+                                 {sm + 65536u, WAY_PIECES, false}};
     for (size_t i = 0; i < 3u; i++) {
         check_size(&f.m, &f.ref, f.oracle, &f.c, &f.p, &f.r0, cases[i]);
     }
@@ -357,7 +376,7 @@ static void test_pool_full_unchanged(void **state)
     assert_int_equal(occ_map_insert_cloud(&small, &c.origin, c.p, c.n / 10u, &p, scratch,
                                           SCRATCH_BYTES, &r),
                      OCC_OK);
-    const size_case_t sizes[] = {{sm - 8u, WAY_WINDOWS}, {sm + 65536u, WAY_PIECES}};
+    const size_case_t sizes[] = {{sm - 8u, WAY_WINDOWS, false}, {sm + 65536u, WAY_PIECES, false}};
     for (size_t i = 0; i < 2u; i++) {
         size_t n0, n1;
         const uint64_t d0 = it_map_digest(&small, &n0);

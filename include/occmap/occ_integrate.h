@@ -15,7 +15,10 @@
  * not fit; either way they are de-duplicated and applied with occ_map_observe_codes(), which
  * touches the tree in Morton order. If the scratch cannot hold them the call returns
  * OCC_ERR_SCRATCH; if the pools cannot hold the result, OCC_ERR_NOMEM; either way the map is
- * exactly as before (automatic eviction aside, see auto_evict).
+ * exactly as before (automatic eviction aside, see auto_evict). The voxel set goes to the tree
+ * by 4x4x4 bricks in Morton order, without codes, when the blocks its update can allocate (as
+ * if none of its nodes existed) fit the pools (not after FAST_DISCRETE's coarse pass); else as
+ * codes, below. Both give the same map and counts.
  *
  * The voxel set (SIMPLE, DISCRETE, SUPER_RAYS and FAST_DISCRETE's voxel rays): one bit per voxel
  * in 32^3-voxel chunks (4 KiB, aligned to keys), taken from the scratch when a ray first enters

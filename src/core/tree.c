@@ -18,15 +18,26 @@ static bool key_in_range(const occ_map_t *const m, const occ_key_t key)
     return key.k[0] < limit && key.k[1] < limit && key.k[2] < limit;
 }
 
-static occ_value_t max_of8(const occ_value_t *const v)
+/* Max, indicator flags and "all eight equal" of a block's values, without data-dependent
+ * branches (refresh runs once per written block: its compares would mispredict). */
+typedef struct {
+    occ_value_t max;
+    uint8_t flags;
+    bool same;
+} summary8_t;
+
+static summary8_t summarize8(const occ_map_t *const m, const occ_value_t *const v)
 {
-    occ_value_t mx = v[0];
-    for (unsigned i = 1; i < 8u; i++) {
-        if (v[i] > mx) {
-            mx = v[i];
-        }
+    summary8_t s;
+    s.max = v[0];
+    s.flags = 0u;
+    s.same = true;
+    for (unsigned i = 0; i < 8u; i++) {
+        s.max = v[i] > s.max ? v[i] : s.max;
+        s.flags = (uint8_t)(s.flags | occ_value_flags_nb(m, v[i]));
+        s.same = s.same & occ_value_eq(v[i], v[0]);
     }
-    return mx;
+    return s;
 }
 
 void occi_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
@@ -69,24 +80,22 @@ bool occi_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigne
     uint8_t nf = 0u;
     bool prunable;
     if (level == 1u) {
-        const occ_leaf_block_t *const b = occ_leaf_at(m, child);
-        nv = max_of8(b->value);
-        prunable = true;
-        for (unsigned i = 0; i < 8u; i++) {
-            nf = (uint8_t)(nf | occ_value_flags(m, b->value[i]));
-            prunable = prunable && occ_value_eq(b->value[i], b->value[0]);
-        }
+        const summary8_t s = summarize8(m, occ_leaf_at(m, child)->value);
+        nv = s.max;
+        nf = s.flags;
+        prunable = s.same;
         if (prunable) {
             const bool freed = occi_pool_free_leaf(m, child);
             OCC_ASSERT(freed);
         }
     } else {
         const occ_inner_block_t *const b = occ_inner_at(m, child);
-        nv = max_of8(b->value);
+        nv = b->value[0];
         prunable = true;
         for (unsigned i = 0; i < 8u; i++) {
+            nv = b->value[i] > nv ? b->value[i] : nv;
             nf = (uint8_t)(nf | b->flags[i]);
-            prunable = prunable && b->child[i] == OCC_NONE && occ_value_eq(b->value[i], b->value[0]);
+            prunable = prunable & (b->child[i] == OCC_NONE) & occ_value_eq(b->value[i], b->value[0]);
         }
         if (prunable) {
             const bool freed = occi_pool_free_inner(m, child);
@@ -352,18 +361,7 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
     size_t changed = 0;
     for (size_t i = 0; i < n; i++) {
         const occ_code_t c = codes[i] & ~OCC_CODE_HIT_BIT;
-        unsigned start = depth;
-        if (i > 0u) {
-            /* Nodes below the split are finished: no later code enters them (sorted order),
-             * so they can be refreshed and pruned now without ever being re-expanded. */
-            const unsigned s = split_level(c, prev);
-            if (s > p.low) {
-                refresh_up_to(m, &p, s - 1u);
-                start = s;
-            } else {
-                start = p.low;
-            }
-        }
+        const unsigned start = path_start(m, &p, c, prev, i == 0u);
         prev = c;
         unsigned stop;
         const occ_value_t v = descend(m, &p, c, start, &stop);

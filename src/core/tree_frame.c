@@ -287,16 +287,7 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
     while (next_entry(m, &c, &e)) {
         OCC_ASSERT(first || e.code >= end); /* nothing inside a whole node */
         end = e.code + ((occ_code_t)1 << (3u * e.level));
-        unsigned start = depth;
-        if (!first) {
-            const unsigned s = split_level(e.code, prev);
-            if (s > p.low) {
-                refresh_up_to(m, &p, s - 1u);
-                start = s;
-            } else {
-                start = p.low;
-            }
-        }
+        const unsigned start = path_start(m, &p, e.code, prev, first);
         prev = e.code;
         first = false;
         if (e.level == 0u) {

@@ -195,6 +195,14 @@ static inline unsigned occ_first_slot(unsigned mask)
 #endif
 }
 
+/* The lowest set bit of a non-zero 64-bit mask (two 32-bit halves: no 64-bit count on a
+ * 32-bit core). */
+static inline unsigned occ_first_slot64(const uint64_t mask)
+{
+    const unsigned lo = (unsigned)(mask & 0xFFFFFFFFu);
+    return lo != 0u ? occ_first_slot(lo) : 32u + occ_first_slot((unsigned)(mask >> 32));
+}
+
 /* Number of significant bits of x (0 for 0): 1 + the highest set bit. */
 static inline unsigned occ_bit_length32(uint32_t x)
 {
@@ -237,6 +245,14 @@ static inline uint8_t occ_value_flags(const occ_map_t *const m, const occ_value_
         return (uint8_t)OCC_NODE_HAS_OCCUPIED;
     }
     return (uint8_t)(v < m->priv.q_free_max ? OCC_NODE_HAS_FREE : OCC_NODE_HAS_UNKNOWN);
+}
+
+/* occ_value_flags without branches (for loops over a block's values). */
+static inline uint8_t occ_value_flags_nb(const occ_map_t *const m, const occ_value_t v)
+{
+    const unsigned fr = (unsigned)occ_is_observed(v) & (unsigned)(v < m->priv.q_free_max);
+    const uint8_t low = fr != 0u ? (uint8_t)OCC_NODE_HAS_FREE : (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    return v >= m->priv.q_occ_min ? (uint8_t)OCC_NODE_HAS_OCCUPIED : low;
 }
 
 /* An update's delta. The 8-bit mode's values span +-127 steps while a delta may need to cross
@@ -330,5 +346,32 @@ typedef struct {
  * no node existed) against the pools: OCC_ERR_NOMEM (oom_count bumped, nothing written), else
  * every update, refreshing and pruning as it goes. O(entries x depth). */
 occ_err_t occi_tree_apply_frame(occ_map_t *m, const occi_frame_t *f, occi_frame_out_t *out);
+
+/* A scan's voxel updates as the integrator's dense set holds them (integrate/denseset.c):
+ * 32^3-voxel chunks in Morton order, 512 words each, word w of chunk i the mask of the 64
+ * voxels of brick (chunks[i] << 9 | w) (codes (brick << 6) + bit) to update by the miss; and
+ * the hits, voxel codes with the hit bit, sorted and unique, which win over the misses. */
+typedef struct {
+    const uint64_t *words;
+    const uint64_t *chunks; /* chunk codes (voxel code >> 15), sorted, unique */
+    const uint64_t *slots;  /* chunk i's words are words + 512 * slots[i] */
+    size_t n_chunks;
+    const occ_code_t *hits;
+    size_t n_hits;
+} occi_dense_t;
+
+/* Voxels named and voxel values changed. */
+typedef struct {
+    size_t voxels, changed;
+} occi_dense_out_t;
+
+/* The update occ_map_observe_codes() makes of the set's codes, in one pass by 4x4x4 bricks
+ * (tree_dense.c), when the bound of the blocks it can allocate (as if no node existed) fits
+ * the pools; else OCC_ERR_NOMEM with nothing written and oom_count unchanged (the caller takes
+ * the exact path). Also OCC_ERR_NOMEM for depth_levels < 2. O(bricks x depth + voxels). */
+occ_err_t occi_tree_apply_dense(occ_map_t *m, const occi_dense_t *d, occi_dense_out_t *out);
+/* The set's voxels as sorted codes (hits with the hit bit) in out (cap); the count, or SIZE_MAX
+ * when cap is too small. */
+size_t occi_dense_codes(const occi_dense_t *d, occ_code_t *out, size_t cap);
 
 #endif /* OCC_TREE_INTERNAL_H_INCLUDED */

@@ -74,4 +74,21 @@ static inline void refresh_up_to(occ_map_t *const m, path_t *const p, const unsi
     }
 }
 
+/* The level the next sorted entry descends from: nodes below its split from the previous one
+ * are finished (no later entry enters them), so they are refreshed and pruned now, never to
+ * be re-expanded. `first`: no previous entry (start at the root). */
+static inline unsigned path_start(occ_map_t *const m, path_t *const p, const occ_code_t code,
+                                  const occ_code_t prev, const bool first)
+{
+    if (first) {
+        return m->cfg.depth_levels;
+    }
+    const unsigned s = split_level(code, prev);
+    if (s > p->low) {
+        refresh_up_to(m, p, s - 1u);
+        return s;
+    }
+    return p->low;
+}
+
 #endif

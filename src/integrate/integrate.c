@@ -23,9 +23,12 @@ typedef char fixed_term_matches_header[OCC_INSERT_SCRATCH_FIXED_BYTES == 7u + FI
 
 #ifdef OCC_TESTING
 occi_insert_probe_t occi_insert_probe;
+bool occi_insert_bricks_off;
+#define BRICKS_OFF() occi_insert_bricks_off
 #define PROBE(field) (occi_insert_probe.field++)
 #define PROBE_RESET() memset(&occi_insert_probe, 0, sizeof occi_insert_probe)
 #else
+#define BRICKS_OFF() false
 #define PROBE(field) ((void)0)
 #define PROBE_RESET() ((void)0)
 #endif
@@ -483,6 +486,16 @@ static uint8_t *align8(void *const p)
     return (uint8_t *)p + ((8u - (u & 7u)) & 7u);
 }
 
+/* The counts of an applied scan. */
+static void set_counts(occ_insert_result_t *const r, const size_t voxels, const size_t hits,
+                       const size_t changed)
+{
+    r->voxels_updated = voxels;
+    r->voxels_occupied = hits;
+    r->voxels_free = voxels - hits;
+    r->voxels_changed = changed;
+}
+
 /* The scan's sorted, collapsed codes; FAST_DISCRETE's coarse pass (d > 0); then one coherent
  * batch update in Morton order (all or nothing, except in automatic mode). Out of line: inlined,
  * its locals stayed in occ_map_insert_rays' frame under the ray traversal too (make cross).
@@ -536,20 +549,16 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
     if (e != OCC_OK) {
         return e;
     }
-    r->voxels_updated = m;
-    r->voxels_occupied = hits;
-    r->voxels_free = m - hits;
-    r->voxels_changed = changed;
+    set_counts(r, m, hits, changed);
     return OCC_OK;
 }
 
-/* ---- the voxel set read back in pieces (bounded scratch without retracing) -----------------
- * After the scan: the hits sorted and collapsed, the set's chunk list sorted, and x->b_cap
- * widened to all the room between b and the set's chunks. When the set and the hits fit there
- * in one piece, they are read into x->b (x->n codes, as the sorted path leaves them for
- * collapse_and_apply) and true is returned; else x->a holds the x->n hits and set_pieces()
- * applies the set in pieces. Out of line: its cursor stays off the tree update's stack. */
-OCC_NOINLINE static bool set_prepare(occ_ictx_t *const x)
+/* ---- the voxel set to the tree ------------------------------------------------------------
+ * After the scan: the hits sorted and collapsed (at x->a, x->n of them), the set's chunk list
+ * sorted. Then, in this order: the set and the hits straight to the tree by 4x4x4 bricks when
+ * the pools surely suffice (set_bricks); else read into x->b as codes in one piece for
+ * collapse_and_apply (set_prepare); else applied in pieces (set_pieces). */
+OCC_NOINLINE static void set_sort(occ_ictx_t *const x)
 {
     occ_ictx_note(x, 0, x->n);
     occ_code_t *const hs = occi_keyset_sort(x->a, x->b, x->n, x->hist);
@@ -558,6 +567,34 @@ OCC_NOINLINE static bool set_prepare(occ_ictx_t *const x)
         memcpy(x->a, hs, x->n * sizeof *hs);
     }
     occi_vset_sort(x->bs, x->hist);
+}
+
+/* The set to the tree by bricks (not after FAST_DISCRETE's coarse pass, which needs the codes'
+ * block count): true when applied; false, with nothing written, when the pools might not
+ * suffice (the code paths then check exactly and evict). Out of line: the tree walk's frame
+ * stays off the ray traversal's (make cross). */
+OCC_NOINLINE static bool set_bricks(occ_ictx_t *const x)
+{
+    if (x->cbs != NULL || BRICKS_OFF()) {
+        return false;
+    }
+    occi_dense_t d;
+    occi_vset_dense(x->bs, x->a, x->n, &d);
+    occi_dense_out_t o;
+    if (occi_tree_apply_dense(x->map, &d, &o) != OCC_OK) {
+        return false;
+    }
+    PROBE(bricks);
+    set_counts(x->r, o.voxels, x->n, o.changed);
+    return true;
+}
+
+/* x->b_cap widened to all the room between b and the set's chunks. When the set and the hits
+ * fit there in one piece, they are read into x->b (x->n codes, as the sorted path leaves them
+ * for collapse_and_apply) and true is returned; else x->a keeps the x->n hits and set_pieces()
+ * applies the set in pieces. Out of line: its cursor stays off the tree update's stack. */
+OCC_NOINLINE static bool set_prepare(occ_ictx_t *const x)
+{
     x->b_cap = (size_t)(occi_vset_low(x->bs) - (uint8_t *)(void *)x->b) / 8u;
     if (x->n > x->b_cap || occi_vset_count(x->bs) > x->b_cap - x->n) {
         return false;
@@ -1009,6 +1046,8 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
         e = OCC_ERR_SCRATCH;
     } else if (x.win_hi != OCC_CODE_HIT_BIT) {
         e = run_chunks(&x, params, points, n_points, &c, origin);
+    } else if (x.bs != NULL && (set_sort(&x), set_bricks(&x))) {
+        e = OCC_OK;
     } else if (x.bs != NULL && !set_prepare(&x)) {
         e = set_pieces(&x, params, origin);
     } else {

@@ -9,6 +9,7 @@
 
 #include "occmap/occmap.h"
 #include "../geom/geom_internal.h"
+#include "../core/tree_internal.h"
 
 typedef occ_real_t occ_rr_t;
 
@@ -41,12 +42,14 @@ size_t occi_dda_bound(const uint32_t ko[3], const uint32_t ke[3]);
 size_t occi_dda_codes(const occ_raygeo_t *g, const float o[3], const float e[3],
                       const uint32_t ko[3], const uint32_t ke[3], occ_code_t *out, size_t cap);
 
-/* Dilated (Morton) +-1 along axis `dim`. */
+/* Dilated (Morton) +-1 along axis `dim`: the axis' bits x = c & m step as an integer whose
+ * carries (x - m = x + 1 through the other bits) and borrows (x - 1) the mask then drops; one
+ * constant, so that a walk keeps its three in registers. */
 static inline occ_code_t occ_code_step(occ_code_t c, unsigned dim, int step)
 {
     const occ_code_t m = (occ_code_t)0x1249249249249249ull << dim;
-    const occ_code_t part = step > 0 ? (((c | ~m) + 1u) & m) : (((c & m) - 1u) & m);
-    return (c & ~m) | part;
+    const occ_code_t x = c & m;
+    return c + (((step > 0 ? x - m : x - 1u) & m) - x); /* c - x + x': only m's bits change */
 }
 
 /* ---- key sets (keyset.c) ----------------------------------------------------------------- */
@@ -145,7 +148,8 @@ typedef struct {
     uint64_t *top;       /* chunk s: the 512 words below top - s * 512 */
     uint64_t *keys;      /* directory: packed chunk coordinates + 1, 0 = empty (2^tbits) */
     uint32_t *slots;     /* directory: the chunk's s */
-    uint64_t *list;      /* chunk codes by s; sorted by occi_vset_sort() */
+    uint64_t *list;      /* packed chunk coordinates + 1 by s; chunk codes, sorted, after
+                          * occi_vset_sort() */
     uint64_t *ltmp;      /* the list's sort temporary */
     size_t cap, n;       /* chunks: room and taken */
     uint32_t cmax;       /* chunk coordinates are below this (the map's edge / 32) */
@@ -168,6 +172,10 @@ size_t occi_vset_bytes(const occ_vset_t *vs);
 size_t occi_vset_count(const occ_vset_t *vs);
 /* Sort the chunk list by code: call once after the scan, before reading. */
 void occi_vset_sort(occ_vset_t *vs, uint32_t *hist);
+/* After occi_vset_sort(): the set and `hits` (sorted, unique, hit bit set) as the tree's
+ * brick-wise update takes them (occi_tree_apply_dense). Writes the chunks' places into the
+ * list's sort temporary. */
+void occi_vset_dense(occ_vset_t *vs, const occ_code_t *hits, size_t n_hits, occi_dense_t *d);
 
 /* Reading the set back in Morton order, merged with the scan's hits, in pieces that end at
  * brick borders. */
@@ -254,14 +262,18 @@ static inline void occ_ictx_emit(occ_ictx_t *x, occ_code_t c)
 
 #ifdef OCC_TESTING
 /* Test builds only: how the last occ_map_insert_rays() call ran - traversals of the whole scan
- * (run_method / a window's pass), those into the voxel set, and batches applied with
- * occ_map_observe_codes(). */
+ * (run_method / a window's pass), those into the voxel set, batches applied with
+ * occ_map_observe_codes(), and sets applied by bricks (occi_tree_apply_dense). */
 typedef struct {
     unsigned traces;
     unsigned set_traces;
     unsigned pieces;
+    unsigned bricks;
 } occi_insert_probe_t;
 extern occi_insert_probe_t occi_insert_probe;
+/* Test builds only: true sends the voxel set the way of the codes (one batch or pieces), so
+ * that tests reach those paths where bricks would do. */
+extern bool occi_insert_bricks_off;
 #endif
 
 /* FAST_DISCRETE's ray (fastdiscrete.c): coarse marching, then fine DDA near the end. */

@@ -71,29 +71,39 @@ size_t occi_dda_bound(const uint32_t ko[3], const uint32_t ke[3])
     return n;
 }
 
-/* DDA state; dda_init/dda_next are inlined into both users below. The set-up's tMax, tDelta
- * and steps are written in place (a copy from a temporary was 40 B more under every ray of
- * the integration, make cross). */
+/* DDA state; dda_init is inlined into every user below. The set-up's tMax, tDelta and steps are
+ * written in place (a copy from a temporary was 40 B more under every ray of the integration,
+ * make cross). */
 typedef struct {
     occ_dda_t dd;
     int32_t key[3];
     int32_t kmax;
     float length;
-    occ_code_t c;
+    occ_code_t c; /* the origin's code */
     size_t limit;
 } dda_t;
+
+/* computeRayKeys' set-up: the float direction and length of o -> e, then tMax, tDelta and
+ * steps from the origin's voxel ko. Returns the length. */
+static OCC_ALWAYS_INLINE float dda_start(occ_dda_t *const dd, const occ_raygeo_t *const g,
+                                         const float o[3],
+                              const float e[3], const uint32_t ko[3])
+{
+    float d[3] = {e[0] - o[0], e[1] - o[1], e[2] - o[2]};
+    const float length = (float)occi_raygeo_dist(o, e);
+    d[0] /= length;
+    d[1] /= length;
+    d[2] /= length;
+    /* computeRayKeys rounds the half-voxel step to float. */
+    occ_dda_start(dd, g->res, g->tmv, o, d, ko, true);
+    return length;
+}
 
 /* Prepares the traversal; the first voxel (the origin's) is s->c. ko != ke. */
 static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const float o[3],
                             const float e[3], const uint32_t ko[3], const uint32_t ke[3])
 {
-    float d[3] = {e[0] - o[0], e[1] - o[1], e[2] - o[2]};
-    s->length = (float)occi_raygeo_dist(o, e);
-    d[0] /= s->length;
-    d[1] /= s->length;
-    d[2] /= s->length;
-    /* computeRayKeys rounds the half-voxel step to float. */
-    occ_dda_start(&s->dd, g->res, g->tmv, o, d, ko, true);
+    s->length = dda_start(&s->dd, g, o, e, ko);
     for (unsigned i = 0; i < 3u; i++) {
         s->key[i] = (int32_t)ko[i];
     }
@@ -103,8 +113,8 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
     s->limit = occi_dda_bound(ko, ke);
 }
 
-/* The hot loop, with the state in scalars so that it stays in registers. EMIT(kx, ky, kz) is
- * called for every voxel after the origin's; it may `goto out`. */
+/* The hot loop of occ_ray_keys, with the state in scalars so that it stays in registers.
+ * EMIT(kx, ky, kz) is called for every voxel after the origin's. */
 #define DDA_LOOP(s, EMIT)                                                                         \
     do {                                                                                          \
         occ_rr_t t0 = (s).dd.tmax[0], t1 = (s).dd.tmax[1], t2 = (s).dd.tmax[2];                     \
@@ -143,6 +153,49 @@ static inline void dda_init(dda_t *const s, const occ_raygeo_t *const g, const f
         }                                                                                         \
     } while (0)
 
+/* The walks below in OctoMap's order, rotated: the axis of step i + 1 is chosen right after step
+ * i, so that its tMax (the minimum) serves as step i's length test, and one chain of branches
+ * on the axis does both. A step moves the key and the voxel's Morton code together (dilated
+ * +-1, occ_code_step), so no voxel is ever encoded. */
+#define DDA_STATE(s, ke)                                                                          \
+    const occ_key_t ke_ = {{(ke)[0], (ke)[1], (ke)[2]}};                                          \
+    const occ_code_t ce = occ_morton_encode(ke_); /* the walk ends on it: codes equal iff keys */ \
+    occ_rr_t t0 = (s).dd.tmax[0], t1 = (s).dd.tmax[1], t2 = (s).dd.tmax[2];                         \
+    const occ_rr_t d0 = (s).dd.tdelta[0], d1 = (s).dd.tdelta[1], d2 = (s).dd.tdelta[2];             \
+    const int32_t s0 = (s).dd.step[0], s1 = (s).dd.step[1], s2 = (s).dd.step[2];                    \
+    const occ_rr_t len = (occ_rr_t)(s).length;                                                    \
+    occ_code_t c = (s).c;                                                                         \
+    size_t left = (s).limit - 1u
+
+/* Step along the axis `a` of the smallest tMax (keys in k0..k2, dead where unused); the step's
+ * sign in sa. */
+#define DDA_STEP(a, k0, k1, k2, sa)                                                               \
+    do {                                                                                          \
+        if ((a) == 0u) {                                                                          \
+            t0 += d0;                                                                             \
+            k0 += s0;                                                                             \
+            c = occ_code_step(c, 0u, s0);                                                         \
+            sa = s0;                                                                              \
+        } else if ((a) == 1u) {                                                                   \
+            t1 += d1;                                                                             \
+            k1 += s1;                                                                             \
+            c = occ_code_step(c, 1u, s1);                                                         \
+            sa = s1;                                                                              \
+        } else {                                                                                  \
+            t2 += d2;                                                                             \
+            k2 += s2;                                                                             \
+            c = occ_code_step(c, 2u, s2);                                                         \
+            sa = s2;                                                                              \
+        }                                                                                         \
+    } while (0)
+
+/* The next step's axis and its tMax, the smallest. */
+#define DDA_NEXT(a, tsel)                                                                         \
+    do {                                                                                          \
+        a = occ_dda_axis(t0, t1, t2);                                                             \
+        tsel = a == 0u ? t0 : (a == 1u ? t1 : t2);                                                \
+    } while (0)
+
 size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float e[3],
                       const uint32_t ko[3], const uint32_t ke[3], occ_code_t *const out,
                       const size_t cap)
@@ -152,112 +205,175 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
     }
     dda_t s;
     dda_init(&s, g, o, e, ko, ke);
-    size_t n = 0;
+    DDA_STATE(s, ke);
     if (cap > 0u) {
-        out[0] = s.c;
+        out[0] = c;
     }
-    n = 1;
-#define EMIT_CODE(x, y, z)                                                                        \
-    do {                                                                                          \
-        if (n < cap) {                                                                            \
-            const occ_key_t kk = {{(x), (y), (z)}};                                               \
-            out[n] = occ_morton_encode(kk);                                                       \
-        }                                                                                         \
-        n++;                                                                                      \
-    } while (0)
-    DDA_LOOP(s, EMIT_CODE);
-#undef EMIT_CODE
+    size_t n = 1;
+    const uint32_t kmax = (uint32_t)s.kmax;
+    int32_t k0 = s.key[0], k1 = s.key[1], k2 = s.key[2];
+    unsigned a = occ_dda_axis(t0, t1, t2);
+    for (;;) {
+        int32_t sa;
+        DDA_STEP(a, k0, k1, k2, sa);
+        (void)sa;
+        if (c == ce) {
+            break;
+        }
+        occ_rr_t tsel;
+        DDA_NEXT(a, tsel);
+        /* past the end by rounding (OctoMap's stop), or left the map (OctoMap wraps) */
+        if (tsel > len || ((uint32_t)k0 | (uint32_t)k1 | (uint32_t)k2) >= kmax) {
+            break;
+        }
+        if (n < cap) {
+            out[n] = c;
+        }
+        n++;
+        if (--left == 0u) {
+            break; /* cannot happen with finite input; bounds the work regardless */
+        }
+    }
     return n;
 }
 
-/* The DDA_LOOP decisions with the voxel's place in the set kept incrementally: a step moves
- * the voxel's 15-bit Morton offset inside its 32^3 chunk by dilated +-1, and the chunk only on
- * a wrap (then the set is asked for the next chunk's words). */
-#define MARK_STEP(a, ka, sa, ta, da)                                                          \
+/* ---- the voxel set's walk ---------------------------------------------------------------------
+ * occi_dda_mark's loop, specialised per octant (the steps' signs are constants: a step is five
+ * operations on the code, no sign test). Per step one chain of branches picks the axis; the
+ * length test and the 32^3 chunk crossing are tested on that axis alone and resolved off the
+ * common path: the walk stops once every tMax passed the length (each only grows), and a
+ * countdown per axis says when its key crosses into the next chunk (then the set is asked for
+ * that chunk's words: a directory lookup per 32 steps at most). */
+typedef struct {
+    occ_dda_t dd;   /* tMax, tDelta, steps (the walk keeps them in registers) */
+    occ_rr_t len;
+    occ_code_t c, ce;
+    uint32_t cc[3]; /* chunk coordinates (key >> 5) */
+    uint32_t n[3];  /* steps on each axis until the next chunk */
+} mwalk_t;
+
+/* Steps along axis a until its key leaves its 32-voxel row. */
+static uint32_t chunk_countdown(const uint32_t k, const int step)
+{
+    return step < 0 ? (k & 31u) + 1u : 32u - (k & 31u);
+}
+
+/* The next chunk's words, or NULL (the walk ends): outside the map that is an overflow unless
+ * OctoMap's walk ends there too (on the end key; the length test came first); a full set is
+ * one. */
+static OCC_ALWAYS_INLINE uint64_t *mark_enter(const mwalk_t *const w, occ_vset_t *const vs,
+                                               const occ_code_t c)
+{
+    if (w->cc[0] >= vs->cmax || w->cc[1] >= vs->cmax || w->cc[2] >= vs->cmax) {
+        vs->overflow = vs->overflow || c != w->ce;
+        return NULL;
+    }
+    uint64_t *const cw = occi_vset_chunk(vs, w->cc[0], w->cc[1], w->cc[2]);
+    if (cw == NULL) {
+        vs->overflow = true;
+    }
+    return cw;
+}
+
+/* One step on axis A (sign S, chunk countdown nA), with its rare cases: every tMax past the
+ * length (stop), the next chunk (enter it, or stop). */
+#define MARK_STEP(A, S, nA, tA, dA, tB, tC)                                                       \
     do {                                                                                          \
-        const uint32_t m_ = 0x1249u << (a);                                                       \
-        ka += sa;                                                                                 \
-        ta += da;                                                                                 \
-        if (sa > 0) {                                                                             \
-            local = (((local | ~m_) + 1u) & m_) | (local & ~m_);                                  \
-            if (((uint32_t)ka & 31u) == 0u) {                                                     \
-                cc[a]++;                                                                          \
-                moved = true;                                                                     \
-            }                                                                                     \
-        } else {                                                                                  \
-            local = (((local & m_) - 1u) & m_) | (local & ~m_);                                   \
-            if (((uint32_t)ka & 31u) == 31u) {                                                    \
-                cc[a]--;                                                                          \
-                moved = true;                                                                     \
+        tA += dA;                                                                                 \
+        c = occ_code_step(c, A, S);                                                               \
+        nA--; /* counted before any stop: the visits are the steps */                             \
+        if (tA > len && tB > len && tC > len) {                                                   \
+            goto done;                                                                            \
+        }                                                                                         \
+        if (nA == 0u) {                                                                           \
+            nA = 32u;                                                                             \
+            w->cc[A] += (uint32_t)(S);                                                            \
+            cw = mark_enter(w, vs, c);                                                            \
+            if (cw == NULL) {                                                                     \
+                goto done;                                                                        \
             }                                                                                     \
         }                                                                                         \
     } while (0)
+
+static OCC_ALWAYS_INLINE void mark_walk(mwalk_t *const w, occ_vset_t *const vs, uint64_t *cw,
+                                        const int s0, const int s1, const int s2)
+{
+    occ_rr_t t0 = w->dd.tmax[0], t1 = w->dd.tmax[1], t2 = w->dd.tmax[2];
+    const occ_rr_t d0 = w->dd.tdelta[0], d1 = w->dd.tdelta[1], d2 = w->dd.tdelta[2];
+    const occ_rr_t len = w->len;
+    const occ_code_t ce = w->ce;
+    occ_code_t c = w->c;
+    uint32_t n0 = w->n[0], n1 = w->n[1], n2 = w->n[2];
+    for (;;) {
+        if (t0 < t1 && t0 < t2) { /* OctoMap's axis: the smallest tMax, ties to the higher */
+            MARK_STEP(0u, s0, n0, t0, d0, t1, t2);
+        } else if (t1 < t2) {
+            MARK_STEP(1u, s1, n1, t1, d1, t0, t2);
+        } else {
+            MARK_STEP(2u, s2, n2, t2, d2, t0, t1);
+        }
+        if (c == ce) {
+            break;
+        }
+        cw[(c >> 6) & 511u] |= (uint64_t)1 << (c & 63u);
+    }
+done:
+    w->c = c;
+}
+
+/* The eight octants' walks, out of line: one frame under occi_dda_mark's (make cross). */
+#define MARK_OCTANT(NAME, S0, S1, S2)                                                             \
+    static OCC_NOINLINE void NAME(mwalk_t *const w, occ_vset_t *const vs, uint64_t *const cw)    \
+    {                                                                                             \
+        mark_walk(w, vs, cw, S0, S1, S2);                                                         \
+    }
+MARK_OCTANT(mark_ppp, 1, 1, 1)
+MARK_OCTANT(mark_npp, -1, 1, 1)
+MARK_OCTANT(mark_pnp, 1, -1, 1)
+MARK_OCTANT(mark_nnp, -1, -1, 1)
+MARK_OCTANT(mark_ppn, 1, 1, -1)
+MARK_OCTANT(mark_npn, -1, 1, -1)
+MARK_OCTANT(mark_pnn, 1, -1, -1)
+MARK_OCTANT(mark_nnn, -1, -1, -1)
 
 size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
                      const uint32_t ko[3], const uint32_t ke[3], occ_vset_t *const vs)
 {
+    mwalk_t w;
     if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
         return 0;
     }
-    dda_t s;
-    dda_init(&s, g, o, e, ko, ke);
-    uint32_t cc[3] = {ko[0] >> 5, ko[1] >> 5, ko[2] >> 5};
-    uint64_t *cw = occi_vset_chunk(vs, cc[0], cc[1], cc[2]);
+    for (unsigned i = 0; i < 3u; i++) {
+        w.cc[i] = ko[i] >> 5;
+    }
+    uint64_t *const cw = occi_vset_chunk(vs, w.cc[0], w.cc[1], w.cc[2]);
     if (cw == NULL) {
         vs->overflow = true;
         return 0;
     }
-    uint32_t local = (uint32_t)occi_spread5[ko[0] & 31u] | ((uint32_t)occi_spread5[ko[1] & 31u] << 1) |
-                     ((uint32_t)occi_spread5[ko[2] & 31u] << 2);
-    cw[local >> 6] |= (uint64_t)1 << (local & 63u);
-    size_t n = 1;
-    occ_rr_t t0 = s.dd.tmax[0], t1 = s.dd.tmax[1], t2 = s.dd.tmax[2];
-    const occ_rr_t d0 = s.dd.tdelta[0], d1 = s.dd.tdelta[1], d2 = s.dd.tdelta[2];
-    const int32_t s0 = s.dd.step[0], s1 = s.dd.step[1], s2 = s.dd.step[2];
-    const int32_t e0 = (int32_t)ke[0], e1 = (int32_t)ke[1], e2 = (int32_t)ke[2];
-    int32_t k0 = s.key[0], k1 = s.key[1], k2 = s.key[2];
-    const occ_rr_t len = (occ_rr_t)s.length;
-    size_t left = s.limit - 1u;
-    bool pending = false, moved = false;
-    /* OctoMap's order per step: advance, stop at the end key, stop when min(tMax) > length,
-     * else add the key. The min is the next step's choice, so the length test and the add
-     * happen at the top of the next iteration. A chunk outside the map (or a full set) ends the
-     * ray with vs->overflow: the caller then redoes the scan on the sorted path, which stops
-     * at the map's edge as OctoMap does. */
-    for (;;) {
-        const unsigned dim = occ_dda_axis(t0, t1, t2);
-        const occ_rr_t tsel = dim == 0u ? t0 : (dim == 1u ? t1 : t2);
-        if (pending) {
-            if (tsel > len) {
-                break;
-            }
-            if (moved) {
-                cw = occi_vset_chunk(vs, cc[0], cc[1], cc[2]);
-                if (cw == NULL) {
-                    vs->overflow = true;
-                    break;
-                }
-                moved = false;
-            }
-            cw[local >> 6] |= (uint64_t)1 << (local & 63u);
-            n++;
-            if (--left == 0u) {
-                break;
-            }
-        }
-        if (dim == 0u) {
-            MARK_STEP(0u, k0, s0, t0, d0);
-        } else if (dim == 1u) {
-            MARK_STEP(1u, k1, s1, t1, d1);
-        } else {
-            MARK_STEP(2u, k2, s2, t2, d2);
-        }
-        if (k0 == e0 && k1 == e1 && k2 == e2) {
-            break;
-        }
-        pending = true;
+    w.len = (occ_rr_t)dda_start(&w.dd, g, o, e, ko);
+    const occ_key_t kok = {{ko[0], ko[1], ko[2]}}, kek = {{ke[0], ke[1], ke[2]}};
+    w.c = occ_morton_encode(kok);
+    w.ce = occ_morton_encode(kek);
+    for (unsigned i = 0; i < 3u; i++) {
+        w.n[i] = chunk_countdown(ko[i], w.dd.step[i]);
     }
-    return n;
+    cw[(w.c >> 6) & 511u] |= (uint64_t)1 << (w.c & 63u);
+    switch ((w.dd.step[0] < 0 ? 1u : 0u) | (w.dd.step[1] < 0 ? 2u : 0u) |
+            (w.dd.step[2] < 0 ? 4u : 0u)) {
+    case 0u: mark_ppp(&w, vs, cw); break;
+    case 1u: mark_npp(&w, vs, cw); break;
+    case 2u: mark_pnp(&w, vs, cw); break;
+    case 3u: mark_nnp(&w, vs, cw); break;
+    case 4u: mark_ppn(&w, vs, cw); break;
+    case 5u: mark_npn(&w, vs, cw); break;
+    case 6u: mark_pnn(&w, vs, cw); break;
+    default: mark_nnn(&w, vs, cw); break;
+    }
+    /* Visits: the origin and one per step but the last (the end, or past the length), i.e. the
+     * steps; each moves one key by one toward the end, so they sum to the keys' distance. */
+    const occ_key_t kf = occ_morton_decode(w.c);
+    return occi_dda_bound(ko, kf.k) - 4u;
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */

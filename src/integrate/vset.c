@@ -74,8 +74,7 @@ uint64_t *occi_vset_chunk(occ_vset_t *const vs, const uint32_t cx, const uint32_
     const size_t s = vs->n++;
     vs->keys[h] = key;
     vs->slots[h] = (uint32_t)s;
-    const occ_key_t ck = {{cx, cy, cz}};
-    vs->list[s] = occ_morton_encode(ck);
+    vs->list[s] = key; /* its Morton code in occi_vset_sort(): off the ray walk's stack */
     uint64_t *const w = vs->top - (s + 1u) * OCC_VSET_WORDS;
     memset(w, 0, OCC_VSET_WORDS * 8u);
     return w;
@@ -103,10 +102,33 @@ size_t occi_vset_count(const occ_vset_t *const vs)
 
 void occi_vset_sort(occ_vset_t *const vs, uint32_t *const hist)
 {
+    for (size_t i = 0; i < vs->n; i++) { /* packed coordinates + 1 -> chunk code */
+        const uint64_t p = vs->list[i] - 1u;
+        const occ_key_t ck = {{(uint32_t)(p & 0xFFFFu), (uint32_t)((p >> 16) & 0xFFFFu),
+                               (uint32_t)(p >> 32)}};
+        vs->list[i] = occ_morton_encode(ck);
+    }
     const uint64_t *const s = occi_keyset_sort(vs->list, vs->ltmp, vs->n, hist);
     if (s != vs->list) {
         memcpy(vs->list, s, vs->n * sizeof *s);
     }
+}
+
+void occi_vset_dense(occ_vset_t *const vs, const occ_code_t *const hits, const size_t n_hits,
+                     occi_dense_t *const d)
+{
+    /* chunk s lies at top - (s + 1) 512 words: from the lowest, place n - 1 - s */
+    for (size_t i = 0; i < vs->n; i++) {
+        const occ_key_t ck = occ_morton_decode(vs->list[i]);
+        const size_t h = dir_find(vs, pack(ck.k[0], ck.k[1], ck.k[2]));
+        vs->ltmp[i] = (uint64_t)(vs->n - 1u - vs->slots[h]);
+    }
+    d->words = vs->top - vs->n * OCC_VSET_WORDS;
+    d->chunks = vs->list;
+    d->slots = vs->ltmp;
+    d->n_chunks = vs->n;
+    d->hits = hits;
+    d->n_hits = n_hits;
 }
 
 /* Move the cursor to the next non-empty word; false after the last. */
