@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // scratch.cpp - `make bench-scratch` (issue 22): scan.dat at 0.05 m integrated exactly with
-// unbounded scratch vs 8 MB of scratch (the scan traced once into its voxel set, then applied in
-// pieces), SIMPLE and DISCRETE, interleaved repetitions (thread CPU time, medians, the spread of
+// unbounded scratch vs 8 MB of scratch (the scan traced once into its voxel set, then applied by
+// bricks, or in pieces of codes when the pools are tight), SIMPLE and DISCRETE, interleaved repetitions (thread CPU time, medians, the spread of
 // the per-repetition ratios), maps checked equal voxel for voxel; and the peak RSS of the 8 MB
 // integration (and of OctoMap's insertPointCloud) each in a fresh process.
 // Rows: build/bench/rows/scratch.json. Usage: scratch [reps] (default 9).

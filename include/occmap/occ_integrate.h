@@ -40,10 +40,11 @@
  *     + max(8 (n + 1), 8192, SUPER_RAYS: its tables, 24 n + 278,600 on a 64-bit host) + 4,160 C
  * (tests/test_integrate_chunks.c checks it to the byte).
  * scan.dat at 0.05 m (88,206 points; 14.2 M voxel visits, 3.9 M voxels, C = 605): 4,239,415 B
- * for SIMPLE (the one batch wants ~34 MB); in 8 MiB it runs in 7 pieces with the same
- * instructions as one batch (callgrind: 1,616 M against 1,617 M; 1,779 M before the set) and
- * 0.99x its CPU time (SIMPLE 0.988x, spread 0.93..1.13; DISCRETE 0.992x, 0.94..1.20: make
- * bench-scratch, 9 interleaved repetitions; README, Performance).
+ * for SIMPLE. By bricks the call then writes ~4.0 MB of scratch (scratch_used) and nothing
+ * more, unbounded or in 8 MiB alike (make bench-scratch; README, Performance); one batch of
+ * codes would want ~34 MB, and where the pools are too tight for the bricks' bound, 8 MiB
+ * runs in 7 pieces of codes with the instructions of one batch (callgrind: 1,616 M against
+ * 1,617 M).
  * Bounded scratch below that (SIMPLE and DISCRETE, issue 22): when the set runs full, the scan is
  * traced again as sorted codes in Morton-range windows instead of failing. The first pass keeps
  * the lowest codes that fit and narrows its window to them (codes above are dropped by every
