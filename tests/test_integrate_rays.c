@@ -135,30 +135,22 @@ static void test_tie_rays_discrete_superrays(void **state)
     run_res(0.05f, OCC_INSERT_SUPER_RAYS, 16u);
 }
 
-static int setup(void **state)
+int main(void)
 {
-    (void)state;
     arena_a = malloc(ARENA_BYTES);
     arena_b = malloc(ARENA_BYTES);
     scratch = malloc(SCRATCH_BYTES);
-    return arena_a != NULL && arena_b != NULL && scratch != NULL ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    free(arena_a);
-    free(arena_b);
-    free(scratch);
-    return 0;
-}
-
-int main(void)
-{
+    if (arena_a == NULL || arena_b == NULL || scratch == NULL) {
+        return 1;
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_tie_rays, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_tie_rays_discrete_superrays, it_timer_setup,
                                         it_timer_teardown),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    const int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    free(arena_a);
+    free(arena_b);
+    free(scratch);
+    return rc;
 }

@@ -8,8 +8,6 @@
  * (occ_map_observe_codes on the set's codes): the voxels end with the same values, and a
  * refreshed tree is the one pruned tree of its voxels.
  */
-#include <string.h>
-
 #include "tree_path.h"
 
 #define NONE (~(occ_code_t)0)
@@ -259,12 +257,9 @@ occ_err_t occi_tree_apply_dense(occ_map_t *const m, const occi_dense_t *const d,
         !occi_pool_can_supply(m, (uint32_t)inner, (uint32_t)leaf)) {
         return OCC_ERR_NOMEM;
     }
-    m->write_gen++; /* handles on the old tree are stale */
     path_t p;
-    memset(&p, 0, sizeof p); /* the path is read only from node[low] up; cppcheck cannot tell */
+    path_begin(m, &p);
     const unsigned depth = m->cfg.depth_levels;
-    p.node[depth] = occ_root(m);
-    p.low = depth;
     cursor_t c = {d, 0u, 0u, 0u};
     brick_t b;
     occ_code_t prev = 0;

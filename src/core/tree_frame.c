@@ -5,8 +5,6 @@
  * of the tree is descended, written and refreshed once (the projective integrator's output).
  * All-or-nothing: a bound of the blocks the pass can allocate is checked first.
  */
-#include <string.h>
-
 #include "tree_path.h"
 
 /* ---- a whole node's subtree ------------------------------------------------------------------ */
@@ -273,12 +271,9 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
         m->oom_count++;
         return OCC_ERR_NOMEM;
     }
-    m->write_gen++; /* handles on the old tree are stale */
     path_t p;
-    memset(&p, 0, sizeof p); /* the path is read only from node[low] up; cppcheck cannot tell */
+    path_begin(m, &p);
     const unsigned depth = m->cfg.depth_levels;
-    p.node[depth] = occ_root(m);
-    p.low = depth;
     cursor_t c;
     cursor_init(&c, f);
     entry_t e;

@@ -8,6 +8,8 @@
 #ifndef OCC_TREE_PATH_H_INCLUDED
 #define OCC_TREE_PATH_H_INCLUDED
 
+#include <string.h>
+
 #include "tree_internal.h"
 
 /* The path of the current code: node[l] for l in [low, D]; node[D] is the root. */
@@ -72,6 +74,16 @@ static inline void refresh_up_to(occ_map_t *const m, path_t *const p, const unsi
             }
         }
     }
+}
+
+/* A pass's path, at the root, after bumping the write generation (handles on the old tree
+ * are stale). */
+static inline void path_begin(occ_map_t *const m, path_t *const p)
+{
+    m->write_gen++;
+    memset(p, 0, sizeof *p); /* read only from node[low] up; cppcheck cannot tell */
+    p->node[m->cfg.depth_levels] = occ_root(m);
+    p->low = m->cfg.depth_levels;
 }
 
 /* The level the next sorted entry descends from: nodes below its split from the previous one
