@@ -565,9 +565,6 @@ static void test_vset_read_need(void **state)
 
 int main(void)
 {
-    arena_a = malloc(ARENA_BYTES);
-    arena_b = malloc(ARENA_BYTES);
-    scratch = malloc(SCRATCH_BYTES);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_vset_read_need),
         cmocka_unit_test_setup_teardown(test_simple_chunks, it_timer_setup, it_timer_teardown),
@@ -580,9 +577,6 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_pool_full_unchanged, it_timer_setup,
                                         it_timer_teardown),
     };
-    const int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    free(arena_a);
-    free(arena_b);
-    free(scratch);
-    return rc;
+    const it_buffers_t b = {&arena_a, &arena_b, &scratch, ARENA_BYTES, SCRATCH_BYTES};
+    return it_run_tests("test_integrate_chunks", tests, sizeof tests / sizeof tests[0], b);
 }

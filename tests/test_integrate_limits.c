@@ -429,9 +429,6 @@ static void test_fast_auto_evict(void **state)
 
 int main(void)
 {
-    arena_a = malloc(ARENA_BYTES);
-    arena_b = malloc(ARENA_BYTES);
-    scratch = malloc(SCRATCH_BYTES);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_bad_points, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_nomem_unchanged, it_timer_setup, it_timer_teardown),
@@ -441,9 +438,6 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_scratch_used_is_written, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_fast_auto_evict, it_timer_setup, it_timer_teardown),
     };
-    const int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    free(arena_a);
-    free(arena_b);
-    free(scratch);
-    return rc;
+    const it_buffers_t b = {&arena_a, &arena_b, &scratch, ARENA_BYTES, SCRATCH_BYTES};
+    return it_run_tests("test_integrate_limits", tests, sizeof tests / sizeof tests[0], b);
 }

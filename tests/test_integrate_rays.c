@@ -137,20 +137,11 @@ static void test_tie_rays_discrete_superrays(void **state)
 
 int main(void)
 {
-    arena_a = malloc(ARENA_BYTES);
-    arena_b = malloc(ARENA_BYTES);
-    scratch = malloc(SCRATCH_BYTES);
-    if (arena_a == NULL || arena_b == NULL || scratch == NULL) {
-        return 1;
-    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_tie_rays, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_tie_rays_discrete_superrays, it_timer_setup,
                                         it_timer_teardown),
     };
-    const int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    free(arena_a);
-    free(arena_b);
-    free(scratch);
-    return rc;
+    const it_buffers_t b = {&arena_a, &arena_b, &scratch, ARENA_BYTES, SCRATCH_BYTES};
+    return it_run_tests("test_integrate_rays", tests, sizeof tests / sizeof tests[0], b);
 }

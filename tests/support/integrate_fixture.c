@@ -221,3 +221,19 @@ size_t it_diff_oracle(const occ_map_t *m, void *t, float tol)
     }
     return bad;
 }
+
+int it_run_tests(const char *const name, const struct CMUnitTest *const tests, const size_t n,
+                 const it_buffers_t b)
+{
+    *b.arena_a = malloc(b.arena_bytes);
+    *b.arena_b = malloc(b.arena_bytes);
+    *b.scratch = malloc(b.scratch_bytes);
+    int rc = 1;
+    if (*b.arena_a != NULL && *b.arena_b != NULL && *b.scratch != NULL) {
+        rc = _cmocka_run_group_tests(name, tests, n, NULL, NULL);
+    }
+    free(*b.arena_a);
+    free(*b.arena_b);
+    free(*b.scratch);
+    return rc;
+}

@@ -38,5 +38,14 @@ uint64_t it_map_digest(const occ_map_t *m, size_t *nodes);
 /* CMocka setup/teardown that print each test's CPU time. */
 int it_timer_setup(void **state);
 int it_timer_teardown(void **state);
+/* A test file's buffers: two map arenas and a scratch buffer (malloc'd by it_run_tests). */
+typedef struct {
+    uint8_t **arena_a, **arena_b, **scratch;
+    size_t arena_bytes, scratch_bytes;
+} it_buffers_t;
+struct CMUnitTest;
+/* Allocate the buffers, run the n tests as one CMocka group, free them: CMocka's result, or 1
+ * when the buffers cannot be allocated. */
+int it_run_tests(const char *name, const struct CMUnitTest *tests, size_t n, it_buffers_t b);
 
 #endif
