@@ -476,20 +476,22 @@ static size_t reference(occ_code_t *set, const size_t n_set, const occ_code_t *h
     return u;
 }
 
-/* Read the set in pieces of at most cap: the concatenation is the reference, pieces end at brick
- * borders, and occi_vset_need() is occi_coarse_need() summed over the pieces. */
+/* Read the set in pieces of at most cap (occi_dense_read): the concatenation is the reference,
+ * pieces end at brick borders, and occi_dense_need() is occi_coarse_need() summed over the
+ * pieces. */
 static void check_pieces(const occ_vset_t *vs, const occ_code_t *hits, const size_t n_hits,
                          const occ_code_t *want, const size_t n_want, const size_t cap,
                          const unsigned depth)
 {
     occ_code_t *const piece = malloc(cap * sizeof *piece);
     assert_non_null(piece);
-    occ_vset_cursor_t cur;
-    memset(&cur, 0, sizeof cur);
+    occi_dense_t d;
+    occi_vset_dense(vs, hits, n_hits, &d);
+    occi_dense_cursor_t cur = {0u, 0u, 0u};
     size_t got = 0, m;
     uint64_t in = 0, lf = 0;
     occ_code_t last = 0;
-    while ((m = occi_vset_read(vs, &cur, hits, n_hits, piece, cap)) > 0u) {
+    while ((m = occi_dense_read(&d, &cur, piece, cap)) > 0u) {
         assert_true(m <= cap);
         assert_true(got + m <= n_want);
         assert_memory_equal(piece, want + got, m * sizeof *piece);
@@ -505,9 +507,11 @@ static void check_pieces(const occ_vset_t *vs, const occ_code_t *hits, const siz
     }
     assert_int_equal(got, n_want);
     uint64_t vi, vl;
-    occi_vset_need(vs, hits, n_hits, cap, depth, &vi, &vl);
+    size_t voxels;
+    occi_dense_need(&d, cap, depth, &vi, &vl, &voxels);
     assert_int_equal(vi, in);
     assert_int_equal(vl, lf);
+    assert_int_equal(voxels, n_want);
     free(piece);
 }
 
@@ -554,7 +558,7 @@ static void check_vset(const unsigned depth)
     free(hist);
 }
 
-static void test_vset_read_need(void **state)
+static void test_vset_dense_read_need(void **state)
 {
     (void)state;
     check_vset(16u);
@@ -566,7 +570,7 @@ static void test_vset_read_need(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_vset_read_need),
+        cmocka_unit_test(test_vset_dense_read_need),
         cmocka_unit_test_setup_teardown(test_simple_chunks, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_discrete_chunks, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_simple_min, it_timer_setup, it_timer_teardown),

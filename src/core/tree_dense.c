@@ -10,114 +10,6 @@
  */
 #include "tree_path.h"
 
-#define NONE (~(occ_code_t)0)
-
-/* The next brick of the merged streams: the set's next non-empty word, the hits' next brick. */
-typedef struct {
-    const occi_dense_t *d;
-    size_t ci;   /* chunk */
-    unsigned wi; /* next word in it */
-    size_t h;    /* next hit */
-} cursor_t;
-
-typedef struct {
-    occ_code_t code; /* the brick's first voxel */
-    uint64_t miss, hit;
-} brick_t;
-
-static occ_code_t next_word(cursor_t *const c)
-{
-    const occi_dense_t *const d = c->d;
-    for (; c->ci < d->n_chunks; c->ci++, c->wi = 0u) {
-        const uint64_t *const w = d->words + ((size_t)d->slots[c->ci] << 9);
-        while (c->wi < 512u && w[c->wi] == 0u) {
-            c->wi++;
-        }
-        if (c->wi < 512u) {
-            return ((occ_code_t)d->chunks[c->ci] << 9) | c->wi;
-        }
-    }
-    return NONE;
-}
-
-static bool next_brick(cursor_t *const c, brick_t *const b)
-{
-    const occi_dense_t *const d = c->d;
-    const occ_code_t wb = next_word(c);
-    const occ_code_t hb = c->h < d->n_hits ? (d->hits[c->h] & ~OCC_CODE_HIT_BIT) >> 6 : NONE;
-    const occ_code_t bc = wb < hb ? wb : hb;
-    if (bc == NONE) {
-        return false;
-    }
-    b->miss = 0u;
-    if (wb == bc) {
-        b->miss = d->words[((size_t)d->slots[c->ci] << 9) + c->wi];
-        c->wi++;
-    }
-    b->hit = 0u;
-    while (c->h < d->n_hits && (d->hits[c->h] & ~OCC_CODE_HIT_BIT) >> 6 == bc) {
-        b->hit |= (uint64_t)1 << (d->hits[c->h] & 63u);
-        c->h++;
-    }
-    b->miss &= ~b->hit; /* hits win */
-    b->code = bc << 6;
-    return true;
-}
-
-/* Bits set (SWAR: without a popcount instruction in the build, the builtin is a library call). */
-static unsigned popcount64(uint64_t x)
-{
-    x = x - ((x >> 1) & 0x5555555555555555ull);
-    x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
-    x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
-    return (unsigned)((x * 0x0101010101010101ull) >> 56);
-}
-
-/* Blocks the bricks can allocate if no node existed (codes_valid's bound, a brick at a time):
- * the first brick under a node at level 2 .. split - 1 counts its inner block, a non-empty byte
- * (a level-1 node) its leaf block. Also the voxels the set names. */
-static void dense_need(const occ_map_t *const m, const occi_dense_t *const d,
-                       uint64_t *const inner, uint64_t *const leaf, size_t *const voxels)
-{
-    cursor_t c = {d, 0u, 0u, 0u};
-    brick_t b;
-    occ_code_t prev = 0;
-    unsigned s = m->cfg.depth_levels + 1u;
-    *inner = 0u;
-    *leaf = 0u;
-    *voxels = 0u;
-    while (next_brick(&c, &b)) {
-        if (*voxels != 0u) {
-            s = split_level(b.code, prev);
-        }
-        prev = b.code;
-        uint64_t any = b.miss | b.hit;
-        *voxels += popcount64(any);
-        any |= any >> 4;
-        any |= any >> 2;
-        any |= any >> 1;
-        *leaf += popcount64(any & 0x0101010101010101ull);
-        *inner += s - 2u;
-    }
-}
-
-size_t occi_dense_codes(const occi_dense_t *const d, occ_code_t *const out, const size_t cap)
-{
-    cursor_t c = {d, 0u, 0u, 0u};
-    brick_t b;
-    size_t n = 0;
-    while (next_brick(&c, &b)) {
-        for (uint64_t all = b.miss | b.hit; all != 0u; all &= all - 1u) {
-            if (n == cap) {
-                return SIZE_MAX;
-            }
-            const unsigned k = (unsigned)occ_first_slot64(all);
-            out[n++] = (b.code | k) | (((b.hit >> k) & 1u) != 0u ? OCC_CODE_HIT_BIT : 0u);
-        }
-    }
-    return n;
-}
-
 /* A uniform node takes `delta` on all its voxels: it stays uniform. */
 static void set_uniform(occ_map_t *const m, const occ_nodep_t n, const occ_value_t v)
 {
@@ -134,8 +26,8 @@ static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigne
                           const unsigned hb, const occ_value_t vm, const occ_value_t vh)
 {
     const occ_value_t v = *n.value;
-    const size_t changed = (occ_value_eq(vm, v) ? 0u : popcount64(mb)) +
-                           (occ_value_eq(vh, v) ? 0u : popcount64(hb));
+    const size_t changed = (occ_value_eq(vm, v) ? 0u : occ_popcount64(mb)) +
+                           (occ_value_eq(vh, v) ? 0u : occ_popcount64(hb));
     /* the values present: untouched (pu), missed (pm), hit (ph) */
     const bool pu = (mb | hb) != 0xFFu, pm = mb != 0u, ph = hb != 0u;
     const bool same = (!pu || occ_value_eq(v, ph ? vh : vm)) && (!pm || !ph || occ_value_eq(vm, vh));
@@ -199,7 +91,7 @@ static size_t node1_step(occ_map_t *const m, const occ_nodep_t n, const unsigned
 
 /* One brick from path level `start`: descend to its level-2 node or a uniform node above it,
  * split that only where a value moves, update. Returns the voxels whose value changed. */
-static size_t brick_step(occ_map_t *const m, path_t *const p, const brick_t *const b,
+static size_t brick_step(occ_map_t *const m, path_t *const p, const occi_brick_t *const b,
                          const unsigned start)
 {
     unsigned l = start;
@@ -252,7 +144,7 @@ occ_err_t occi_tree_apply_dense(occ_map_t *const m, const occi_dense_t *const d,
         return OCC_ERR_NOMEM;
     }
     uint64_t inner, leaf;
-    dense_need(m, d, &inner, &leaf, &out->voxels);
+    occi_dense_need(d, SIZE_MAX, m->cfg.depth_levels, &inner, &leaf, &out->voxels);
     if (inner > OCC_NONE || leaf > OCC_NONE ||
         !occi_pool_can_supply(m, (uint32_t)inner, (uint32_t)leaf)) {
         return OCC_ERR_NOMEM;
@@ -260,11 +152,11 @@ occ_err_t occi_tree_apply_dense(occ_map_t *const m, const occi_dense_t *const d,
     path_t p;
     path_begin(m, &p);
     const unsigned depth = m->cfg.depth_levels;
-    cursor_t c = {d, 0u, 0u, 0u};
-    brick_t b;
+    occi_dense_cursor_t c = {0u, 0u, 0u};
+    occi_brick_t b;
     occ_code_t prev = 0;
     bool first = true;
-    while (next_brick(&c, &b)) {
+    while (occi_dense_next(d, &c, &b)) {
         const unsigned start = path_start(m, &p, b.code, prev, first);
         first = false;
         prev = b.code;

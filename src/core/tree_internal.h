@@ -203,6 +203,15 @@ static inline unsigned occ_first_slot64(const uint64_t mask)
     return lo != 0u ? occ_first_slot(lo) : 32u + occ_first_slot((unsigned)(mask >> 32));
 }
 
+/* Bits set (SWAR: without a popcount instruction in the build, the builtin is a library call). */
+static inline unsigned occ_popcount64(uint64_t x)
+{
+    x = x - ((x >> 1) & 0x5555555555555555ull);
+    x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+    x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return (unsigned)((x * 0x0101010101010101ull) >> 56);
+}
+
 /* Number of significant bits of x (0 for 0): 1 + the highest set bit. */
 static inline unsigned occ_bit_length32(uint32_t x)
 {
@@ -347,10 +356,10 @@ typedef struct {
  * every update, refreshing and pruning as it goes. O(entries x depth). */
 occ_err_t occi_tree_apply_frame(occ_map_t *m, const occi_frame_t *f, occi_frame_out_t *out);
 
-/* A scan's voxel updates as the integrator's dense set holds them (integrate/denseset.c):
- * 32^3-voxel chunks in Morton order, 512 words each, word w of chunk i the mask of the 64
- * voxels of brick (chunks[i] << 9 | w) (codes (brick << 6) + bit) to update by the miss; and
- * the hits, voxel codes with the hit bit, sorted and unique, which win over the misses. */
+/* A scan's voxel updates as the integrator's voxel set holds them (integrate/vset.c,
+ * occi_vset_dense): 32^3-voxel chunks in Morton order, 512 words each, word w of chunk i the
+ * mask of the 64 voxels of brick (chunks[i] << 9 | w) (codes (brick << 6) + bit) to update by
+ * the miss; and the hits, voxel codes with the hit bit, sorted and unique, which win. */
 typedef struct {
     const uint64_t *words;
     const uint64_t *chunks; /* chunk codes (voxel code >> 15), sorted, unique */
@@ -359,6 +368,30 @@ typedef struct {
     const occ_code_t *hits;
     size_t n_hits;
 } occi_dense_t;
+
+/* ---- reading it a brick at a time, in Morton order (dense_read.c) --------------------------- */
+typedef struct {
+    size_t ci;   /* chunk */
+    unsigned wi; /* next word in it */
+    size_t h;    /* next hit */
+} occi_dense_cursor_t; /* {0}: the start */
+
+typedef struct {
+    occ_code_t code; /* the brick's first voxel */
+    uint64_t miss, hit; /* its voxels by the miss and by the hit (disjoint: hits win) */
+} occi_brick_t;
+
+/* The next brick holding a voxel of the set or a hit; false after the last. */
+bool occi_dense_next(const occi_dense_t *d, occi_dense_cursor_t *c, occi_brick_t *b);
+/* The next codes (hits with the hit bit), whole bricks only, at most cap (>= 64) of them into
+ * out. Returns how many; 0 only at the end. */
+size_t occi_dense_read(const occi_dense_t *d, occi_dense_cursor_t *c, occ_code_t *out,
+                       size_t cap);
+/* The blocks the update of the pieces occi_dense_read() makes with this cap can allocate, each
+ * piece as if none of its nodes existed (codes_valid's bound per piece; SIZE_MAX: one piece),
+ * summed, and the voxels the set names. O(bricks). */
+void occi_dense_need(const occi_dense_t *d, size_t cap, unsigned depth, uint64_t *inner,
+                     uint64_t *leaf, size_t *voxels);
 
 /* Voxels named and voxel values changed. */
 typedef struct {
@@ -370,8 +403,5 @@ typedef struct {
  * the pools; else OCC_ERR_NOMEM with nothing written and oom_count unchanged (the caller takes
  * the exact path). Also OCC_ERR_NOMEM for depth_levels < 2. O(bricks x depth + voxels). */
 occ_err_t occi_tree_apply_dense(occ_map_t *m, const occi_dense_t *d, occi_dense_out_t *out);
-/* The set's voxels as sorted codes (hits with the hit bit) in out (cap); the count, or SIZE_MAX
- * when cap is too small. */
-size_t occi_dense_codes(const occi_dense_t *d, occ_code_t *out, size_t cap);
 
 #endif /* OCC_TREE_INTERNAL_H_INCLUDED */

@@ -553,11 +553,12 @@ OCC_NOINLINE static occ_err_t collapse_and_apply(occ_ictx_t *const x,
     return OCC_OK;
 }
 
-/* ---- the voxel set to the tree ------------------------------------------------------------
+/* ---- the voxel set to the tree (set_to_tree) -----------------------------------------------
  * After the scan: the hits sorted and collapsed (at x->a, x->n of them), the set's chunk list
  * sorted. Then, in this order: the set and the hits straight to the tree by 4x4x4 bricks when
  * the pools surely suffice (set_bricks); else read into x->b as codes in one piece for
- * collapse_and_apply (set_prepare); else applied in pieces (set_pieces). */
+ * collapse_and_apply (set_prepare); else applied in pieces (set_pieces). The core reads the
+ * set a brick at a time for all three (occi_dense_t, core/dense_read.c). */
 OCC_NOINLINE static void set_sort(occ_ictx_t *const x)
 {
     occ_ictx_note(x, 0, x->n);
@@ -599,21 +600,21 @@ OCC_NOINLINE static bool set_prepare(occ_ictx_t *const x)
     if (x->n > x->b_cap || occi_vset_count(x->bs) > x->b_cap - x->n) {
         return false;
     }
-    occ_vset_cursor_t cur;
-    memset(&cur, 0, sizeof cur);
-    x->n = occi_vset_read(x->bs, &cur, x->a, x->n, x->b, x->b_cap);
+    occi_dense_t d;
+    occi_vset_dense(x->bs, x->a, x->n, &d);
+    occi_dense_cursor_t cur = {0u, 0u, 0u};
+    x->n = occi_dense_read(&d, &cur, x->b, x->b_cap);
     occ_ictx_note(x, 0, x->n);
     return true;
 }
 
 /* Pass 2: read and apply each piece (the same pieces as pass 1), counting. */
-OCC_NOINLINE static occ_err_t set_apply(occ_ictx_t *const x)
+OCC_NOINLINE static occ_err_t set_apply(occ_ictx_t *const x, const occi_dense_t *const d)
 {
     occ_insert_result_t *const r = x->r;
-    occ_vset_cursor_t cur;
-    memset(&cur, 0, sizeof cur);
+    occi_dense_cursor_t cur = {0u, 0u, 0u};
     size_t m;
-    while ((m = occi_vset_read(x->bs, &cur, x->a, x->n, x->b, x->b_cap)) > 0u) {
+    while ((m = occi_dense_read(d, &cur, x->b, x->b_cap)) > 0u) {
         occ_ictx_note(x, 0, m);
         size_t ch = 0;
         PROBE(pieces);
@@ -637,13 +638,28 @@ OCC_NOINLINE static occ_err_t set_pieces(occ_ictx_t *const x,
                                          const occ_insert_params_t *const params,
                                          const occ_vec3_t *const origin)
 {
+    occi_dense_t d;
+    occi_vset_dense(x->bs, x->a, x->n, &d);
     uint64_t ni, nl;
-    occi_vset_need(x->bs, x->a, x->n, x->b_cap, x->map->cfg.depth_levels, &ni, &nl);
+    size_t voxels;
+    occi_dense_need(&d, x->b_cap, x->map->cfg.depth_levels, &ni, &nl, &voxels);
     if (!coarse_fits(x->map, origin, params, ni, nl)) {
         x->map->oom_count++;
         return OCC_ERR_NOMEM;
     }
-    return set_apply(x);
+    return set_apply(x, &d);
+}
+
+/* The scan's voxel set to the tree: by bricks, else as codes in one batch, else in pieces. */
+static occ_err_t set_to_tree(occ_ictx_t *const x, const occ_insert_params_t *const params,
+                             const occ_vec3_t *const origin, occ_bitset_t *const cbs)
+{
+    set_sort(x);
+    if (set_bricks(x)) {
+        return OCC_OK;
+    }
+    return set_prepare(x) ? collapse_and_apply(x, params, origin, cbs)
+                          : set_pieces(x, params, origin);
 }
 
 /* out->scratch_used: the bytes of scratch the call wrote - the histograms, the filter (sorted
@@ -1046,10 +1062,8 @@ occ_err_t occ_map_insert_rays(occ_map_t *const map, const occ_vec3_t *const orig
         e = OCC_ERR_SCRATCH;
     } else if (x.win_hi != OCC_CODE_HIT_BIT) {
         e = run_chunks(&x, params, points, n_points, &c, origin);
-    } else if (x.bs != NULL && (set_sort(&x), set_bricks(&x))) {
-        e = OCC_OK;
-    } else if (x.bs != NULL && !set_prepare(&x)) {
-        e = set_pieces(&x, params, origin);
+    } else if (x.bs != NULL) {
+        e = set_to_tree(&x, params, origin, &cbs);
     } else {
         e = collapse_and_apply(&x, params, origin, &cbs);
     }

@@ -150,7 +150,7 @@ typedef struct {
     uint32_t *slots;     /* directory: the chunk's s */
     uint64_t *list;      /* packed chunk coordinates + 1 by s; chunk codes, sorted, after
                           * occi_vset_sort() */
-    uint64_t *ltmp;      /* the list's sort temporary */
+    uint64_t *ltmp;      /* the list's sort temporary; then the chunks' places */
     size_t cap, n;       /* chunks: room and taken */
     uint32_t cmax;       /* chunk coordinates are below this (the map's edge / 32) */
     unsigned tbits;      /* log2 of the directory's entries */
@@ -170,38 +170,13 @@ uint8_t *occi_vset_low(const occ_vset_t *vs);
 size_t occi_vset_bytes(const occ_vset_t *vs);
 /* Voxels in the set (a popcount over the chunks taken). */
 size_t occi_vset_count(const occ_vset_t *vs);
-/* Sort the chunk list by code: call once after the scan, before reading. */
+/* Sort the chunk list by code and note each chunk's place (in the list's sort temporary):
+ * call once after the scan, before reading. */
 void occi_vset_sort(occ_vset_t *vs, uint32_t *hist);
-/* After occi_vset_sort(): the set and `hits` (sorted, unique, hit bit set) as the tree's
- * brick-wise update takes them (occi_tree_apply_dense). Writes the chunks' places into the
- * list's sort temporary. */
-void occi_vset_dense(occ_vset_t *vs, const occ_code_t *hits, size_t n_hits, occi_dense_t *d);
-
-/* Reading the set back in Morton order, merged with the scan's hits, in pieces that end at
- * brick borders. */
-typedef struct {
-    size_t ci;           /* chunks of the sorted list begun */
-    const uint64_t *cw;  /* the current chunk's words (NULL: none yet / after the last) */
-    occ_code_t base;     /* the current chunk's first voxel code */
-    uint32_t wi;         /* next word of the chunk */
-    uint64_t w;          /* the set's next brick not merged yet (0: none) */
-    occ_code_t wbase;    /* its first voxel code */
-    size_t h;            /* next hit not merged yet */
-    occ_code_t pbase;    /* the pending merged brick: first voxel code, */
-    uint64_t pbits;      /* its voxels, */
-    uint64_t phits;      /* which of them are hits, */
-    bool pend;           /* and whether there is one */
-} occ_vset_cursor_t;
-
-/* The next codes of the set merged with `hits` (sorted, unique, hit bit set; a voxel in both
- * is a hit), whole bricks only, at most cap (>= 64) of them into out. Returns how many; 0 only
- * at the end. */
-size_t occi_vset_read(const occ_vset_t *vs, occ_vset_cursor_t *cur, const occ_code_t *hits,
-                      size_t n_hits, occ_code_t *out, size_t cap);
-/* occi_coarse_need(piece, m, 0, depth) summed over the pieces occi_vset_read() makes with this
- * cap from a new cursor, counted on the bricks (without writing the codes). */
-void occi_vset_need(const occ_vset_t *vs, const occ_code_t *hits, size_t n_hits, size_t cap,
-                    unsigned depth, uint64_t *inner, uint64_t *leaf);
+/* After occi_vset_sort(): the set and `hits` (sorted, unique, hit bit set) as the core reads
+ * them (occi_dense_next / _read / _need, occi_tree_apply_dense). O(1). */
+void occi_vset_dense(const occ_vset_t *vs, const occ_code_t *hits, size_t n_hits,
+                     occi_dense_t *d);
 
 /* computeRayKeys(o, e) into the set; returns the visits. Sets vs->overflow and stops when the
  * set is full or a voxel is outside the map. */
