@@ -5,6 +5,8 @@
 //   inserts:    occ_map_insert_cloud(SIMPLE, DISCRETE, SUPER_RAYS) of scan.dat into a fresh map,
 //               0.1 and 0.05 m, and of the 10 TUM pioneer frames at 0.05 m (SIMPLE, DISCRETE);
 //               both sides' maps must be equal node for node (a walk digest);
+//   proj:       occ_map_insert_depth(OCC_INSERT_PROJECTIVE) of the same 10 TUM frames as images
+//               (every pixel, max range 100 m as bench/projective) at 0.05 m, maps compared alike;
 //   castRay:    occ_cast_ray 10 m from random free points of geb079.bt (ignore / stop at unknown);
 //   los:        occ_line_of_sight between free points 1..10.8 m apart on geb079.bt;
 //   collide:    occ_collide_sphere (r 0.25 m), _capsule (1 m, r 0.3 m) and _obb (0.6 x 0.4 x
@@ -16,7 +18,8 @@
 // usage: ab_split [--rounds N] [--queries-only | --inserts-only] [--case SUBSTR] [--tum DIR]
 //                 SCAN.dat MAP.bt
 // (--case runs only the insert cases whose name contains SUBSTR; --inserts-only under callgrind
-// with --toggle-collect=occ_map_insert_cloud profiles this tree's side alone.)
+// with --toggle-collect=occ_map_insert_cloud profiles this tree's side alone; the proj case:
+// --case proj --toggle-collect=occ_map_insert_depth.)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -28,12 +31,15 @@
 
 extern "C" {
 #include "occmap/occmap.h"
+#include "occmap/occ_depth.h"
+#include "occmap/occ_pose.h"
 #include "occmap/host/occ_file.h"
 #include "occmap/host/occ_scan.h"
 }
 
 extern "C" decltype(occ_map_init) old_occ_map_init;
 extern "C" decltype(occ_map_insert_cloud) old_occ_map_insert_cloud;
+extern "C" decltype(occ_map_insert_depth) old_occ_map_insert_depth;
 extern "C" decltype(occ_walk_begin) old_occ_walk_begin;
 extern "C" decltype(occ_walk_next) old_occ_walk_next;
 extern "C" decltype(occ_cast_ray) old_occ_cast_ray;
@@ -90,10 +96,12 @@ struct Lib {
     decltype(occ_map_insert_cloud) *insert;
     decltype(occ_walk_begin) *walk_begin;
     decltype(occ_walk_next) *walk_next;
+    decltype(occ_map_insert_depth) *insert_depth;
 };
 static const Lib lib_old = {old_occ_map_init, old_occ_map_insert_cloud, old_occ_walk_begin,
-                            old_occ_walk_next};
-static const Lib lib_new = {occ_map_init, occ_map_insert_cloud, occ_walk_begin, occ_walk_next};
+                            old_occ_walk_next, old_occ_map_insert_depth};
+static const Lib lib_new = {occ_map_init, occ_map_insert_cloud, occ_walk_begin, occ_walk_next,
+                            occ_map_insert_depth};
 
 struct Scan {
     std::vector<occ_vec3_t> pts;
@@ -195,6 +203,115 @@ static void bench_inserts(const std::vector<occ_vec3_t> &pts, const std::vector<
     if (!tum.empty())
         for (const occ_insert_method_t m : {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE})
             bench_insert("tum10", tum, 0.05f, m, rounds, filter);
+}
+
+// One TUM frame as the camera gave it (the proj case).
+struct DepthFrame {
+    std::vector<uint16_t> pix;
+    uint32_t w = 0, h = 0;
+    occ_pose_t pose;
+};
+
+// bench/projective's: TUM freiburg2 intrinsics, every pixel, max range 100 m (all hits).
+static occ_depth_params_t proj_params()
+{
+    const occ_depth_camera_t c = occ_depth_camera_tum_fr2();
+    return occ_depth_params_t{{c.fx, c.fy, c.cx, c.cy}, 0.0f, 100.0f, 1u};
+}
+
+static occ_depth_image_t image_of(const DepthFrame &f)
+{
+    return occ_depth_image_t{f.pix.data(), OCC_DEPTH_U16, f.w, f.h, (size_t)f.w * 2u,
+                             1.0f / 5000.0f};
+}
+
+// All frames into a fresh map by projection: CPU ms of the insert calls; *digest as above.
+static double proj_once(const Lib &l, const std::vector<DepthFrame> &fr, occ_insert_result_t *out,
+                        uint64_t *digest)
+{
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.resolution_m = 0.05f;
+    occ_map_t m;
+    if (l.init(&m, &cfg, arena.data(), arena.size()) != OCC_OK) std::abort();
+    occ_insert_params_t p = occ_insert_params_default();
+    p.method = OCC_INSERT_PROJECTIVE;
+    const occ_depth_params_t dp = proj_params();
+    double t = 0;
+    for (const DepthFrame &f : fr) {
+        const occ_depth_image_t im = image_of(f);
+        occ_depth_result_t r;
+        const double t0 = cpu_ms();
+        const occ_err_t e = l.insert_depth(&m, &im, &dp, &f.pose, &p, scratch.data(),
+                                           scratch.size(), &r);
+        t += cpu_ms() - t0;
+        if (e != OCC_OK) {
+            std::fprintf(stderr, "ab_split: insert_depth: %s\n", occ_err_str(e));
+            std::exit(1);
+        }
+        *out = r.insert;
+    }
+    if (digest != nullptr) *digest = map_digest(l, m);
+    return t;
+}
+
+static void bench_proj(const std::vector<DepthFrame> &fr, int rounds, const char *filter)
+{
+    const char *name = "proj tum10 0.05 m";
+    if (fr.empty() || (filter != nullptr && std::strstr(name, filter) == nullptr)) return;
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.resolution_m = 0.05f;
+    occ_map_t tmp;
+    static uint8_t small[OCC_ARENA_BYTES(2, 2)];
+    occ_map_init(&tmp, &cfg, small, sizeof small);
+    occ_insert_params_t p = occ_insert_params_default();
+    p.method = OCC_INSERT_PROJECTIVE;
+    scratch.assign(occ_depth_scratch_bytes(&tmp, fr[0].w, fr[0].h, 1u, proj_params().max_range_m, &p),
+                   0);
+    occ_insert_result_t ro, rn;
+    uint64_t dold = 0, dnew = 0;
+    proj_once(lib_old, fr, &ro, &dold);
+    proj_once(lib_new, fr, &rn, &dnew);
+    ro.scratch_used = rn.scratch_used = 0; /* a layout change may use other scratch */
+    ro.voxel_visits = rn.voxel_visits = 0; /* nodes tested: a walk change may test others */
+    if (std::memcmp(&ro, &rn, sizeof ro) != 0 || dold != dnew) {
+        std::fprintf(stderr, "ab_split: %s: old and new results differ (updated %zu / %zu, changed %zu / %zu, digest %s)\n",
+                     name, (size_t)ro.voxels_updated, (size_t)rn.voxels_updated,
+                     (size_t)ro.voxels_changed, (size_t)rn.voxels_changed,
+                     dold == dnew ? "equal" : "differs");
+        std::exit(1);
+    }
+    std::printf("%s: last frame %zu voxels updated, %zu occupied\n", name,
+                (size_t)rn.voxels_updated, (size_t)rn.voxels_occupied);
+    ab(name, rounds, [&] { return proj_once(lib_old, fr, &ro, nullptr); },
+       [&] { return proj_once(lib_new, fr, &rn, nullptr); });
+}
+
+static std::vector<DepthFrame> load_tum_images(const char *dir)
+{
+    std::vector<DepthFrame> out;
+    occ_scan_frame_t *f = nullptr;
+    size_t n = 0;
+    char msg[256] = "";
+    if (occ_depth_read_tum_dir(dir, 1, 10, &f, &n, msg, sizeof msg) != OCC_OK) return out;
+    for (size_t i = 0; i < n; i++) {
+        DepthFrame fr;
+        char path[600];
+        std::snprintf(path, sizeof path, "%s/depth/%s", dir, f[i].name);
+        uint16_t *pix = nullptr;
+        if (occ_depth_read_png_image(path, &pix, &fr.w, &fr.h, msg, sizeof msg) != OCC_OK) {
+            std::fprintf(stderr, "ab_split: proj frames skipped: %s\n", msg);
+            out.clear();
+            break;
+        }
+        fr.pix.assign(pix, pix + (size_t)fr.w * fr.h);
+        std::free(pix);
+        fr.pose.p = occ_vec3_t{f[i].pose_t[0], f[i].pose_t[1], f[i].pose_t[2]};
+        occ_quat_normalize(occ_quat_t{f[i].pose_q[0], f[i].pose_q[1], f[i].pose_q[2], f[i].pose_q[3]},
+                           &fr.pose.q);
+        out.push_back(fr);
+    }
+    occ_scan_frames_free(f, n);
+    return out;
 }
 
 static std::vector<Scan> load_tum(const char *dir)
@@ -472,6 +589,7 @@ int main(int argc, char **argv)
     if (!queries_only) {
         const std::vector<Scan> tum = tum_dir != nullptr ? load_tum(tum_dir) : std::vector<Scan>();
         bench_inserts(scan, tum, rounds, filter);
+        if (tum_dir != nullptr) bench_proj(load_tum_images(tum_dir), rounds, filter);
     }
     if (!inserts_only) bench_queries(m, rounds);
     std::free(map_arena);
