@@ -19,14 +19,18 @@ static inline float lo_of(const float a, const float b)
 }
 
 /* One row: up, cur, down are padded candidate rows (index i + 1 is column i; a reading as
- * itself, no reading and the pads as +inf, so that the smallest of four is a plain min). */
+ * itself, no reading and the pads as +inf, so that the smallest of four is a plain min). The
+ * neighbours are read through offset pointers with one index: with cur[i + 2u] GCC must allow
+ * for a wrapping 32-bit index and loads those lanes one by one. */
 OCC_PROJ_LANES static void fill_lanes(const uint32_t w, const float *restrict up,
                                       const float *restrict cur, const float *restrict down,
                                       float *restrict out)
 {
-    for (uint32_t i = 0; i < w; i++) {
-        const float m = lo_of(lo_of(cur[i], cur[i + 2u]), lo_of(up[i + 1u], down[i + 1u]));
-        const float c = cur[i + 1u];
+    const float *const left = cur, *const mid = cur + 1, *const right = cur + 2;
+    const float *const above = up + 1, *const below = down + 1;
+    for (size_t i = 0; i < w; i++) {
+        const float m = lo_of(lo_of(left[i], right[i]), lo_of(above[i], below[i]));
+        const float c = mid[i];
         out[i] = c < INFINITY ? c : (m < INFINITY ? m : -INFINITY);
     }
 }
