@@ -29,8 +29,9 @@ static void axis_products(const occ_proj_t *const x, const uint32_t k[3], const 
 
 /* Camera-frame centres q[b][m] = (p[0][b][x] + p[1][b][y]) + p[2][b][z] of the voxels in
  * Morton lanes m (x = bits 0 and 3 of m, y = 1 and 4, z = 2 and 5). Four consecutive lanes
- * share z and the high bits while (x0, y0) runs (0,0) (1,0) (0,1) (1,1): per high x (y) bit a
- * row of four x (y) products, their sums shared by the four z. */
+ * share z and the high bits while (x0, y0) runs (0,0) (1,0) (0,1) (1,1): per high x and y bit
+ * a row of four x + y sums, shared by the four z. The groups of four in nested loops with
+ * constant trip counts: no index arithmetic per group, one vector add each. */
 static void centres(const float p[3][3][4], float q[3][OCC_PROJ_BULK])
 {
     for (unsigned b = 0; b < 3u; b++) {
@@ -49,12 +50,16 @@ static void centres(const float p[3][3][4], float q[3][OCC_PROJ_BULK])
             }
         }
         float *out = q[b];
-        for (unsigned g = 0; g < OCC_PROJ_BULK / 4u; g++, out += 4) {
-            /* group g = z0 | x1 << 1 | y1 << 2 | z1 << 3 */
-            const float *const s = xy[(g >> 2) & 1u][(g >> 1) & 1u];
-            const float z = p[2][b][(g & 1u) | ((g >> 2) & 2u)];
-            for (unsigned l = 0; l < 4u; l++) {
-                out[l] = s[l] + z;
+        for (unsigned z1 = 0; z1 < 2u; z1++) { /* group = z0 | x1 << 1 | y1 << 2 | z1 << 3 */
+            for (unsigned y1 = 0; y1 < 2u; y1++) {
+                for (unsigned x1 = 0; x1 < 2u; x1++) {
+                    for (unsigned z0 = 0; z0 < 2u; z0++, out += 4) {
+                        const float z = p[2][b][z0 | (z1 << 1)];
+                        for (unsigned l = 0; l < 4u; l++) {
+                            out[l] = xy[y1][x1][l] + z;
+                        }
+                    }
+                }
             }
         }
     }
