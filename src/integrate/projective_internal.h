@@ -31,9 +31,8 @@ typedef struct {
     float *ds;         /* the row's hit depths (0: the pixel marks nothing) */
     int32_t *kc[3];    /* this row's end-point key offsets from the camera's voxel (index -1 ok) */
     int32_t *kp[3];    /* the previous row's */
-    int32_t *nw;       /* this row's "new voxel" flags (0 / 1), padded to a multiple of 4 */
-    occ_code_t last_code; /* the last emitted end point's code (0: none) and key */
-    uint32_t last_key[3];
+    int32_t *nw;       /* this row's "new voxel" flags (0 / 1), padded to a multiple of 4;
+                        * then the flagged columns */
 } occ_proj_pixels_t;
 
 /* One level of the walk's explicit stack: a node being opened and its next child slot. */

@@ -169,7 +169,7 @@ OCC_PROJ_LANES static void key_lanes(const uint32_t n, const row_consts_t *const
 {
     uint32_t marked = 0;
     const float v0 = c->v[0], v1 = c->v[1], v2 = c->v[2], f0 = c->f[0], f1 = c->f[1], f2 = c->f[2];
-    const int32_t t0 = c->t[0], t1 = c->t[1], t2 = c->t[2], side = c->side;
+    const int32_t t0 = c->t[0], t1 = c->t[1], t2 = c->t[2], hi = -c->side;
     for (uint32_t i = 0; i < n; i++) {
         const float e0 = ds[i] * (u0[i] + v0) + f0, e1 = ds[i] * (u1[i] + v1) + f1,
                     e2 = ds[i] * (u2[i] + v2) + f2;
@@ -177,8 +177,10 @@ OCC_PROJ_LANES static void key_lanes(const uint32_t n, const row_consts_t *const
         q0 -= (int32_t)(e0 < (float)q0); /* truncation to floor */
         q1 -= (int32_t)(e1 < (float)q1);
         q2 -= (int32_t)(e2 < (float)q2);
-        const int32_t mark = (ds[i] > 0.0f) & (q0 + t0 >= 0) & (q0 + t0 < side) &
-                             (q1 + t1 >= 0) & (q1 + t1 < side) & (q2 + t2 >= 0) & (q2 + t2 < side);
+        /* on the map: every key in [0, side), side a power of two: no bit at or above it
+         * (a negative key has them all) */
+        const int32_t off = ((q0 + t0) | (q1 + t1) | (q2 + t2)) & hi;
+        const int32_t mark = (ds[i] > 0.0f) & (off == 0);
         marked += (uint32_t)mark;
         k0[i] = mark ? q0 : NO_VOXEL;
         k1[i] = q1;
@@ -246,45 +248,51 @@ static size_t filter_slot(const occ_code_t c)
     return (size_t)((c ^ (c >> 17) ^ (c >> 31)) & (OCC_PROJ_FILTER_N - 1u));
 }
 
-/* Morton code bits of axis 0 (axis a: shifted by a). */
-#define MORTON_AXIS0 0x1249249249249249ull
+/* Bit b of the index at bit 3 b: seven key bits spread for the Morton code (512 bytes of
+ * constants; three look-ups per axis of 21 bits replace the bit-spreading steps). */
+static const uint32_t spread7[128] = {
+    0x000000u, 0x000001u, 0x000008u, 0x000009u, 0x000040u, 0x000041u, 0x000048u, 0x000049u,
+    0x000200u, 0x000201u, 0x000208u, 0x000209u, 0x000240u, 0x000241u, 0x000248u, 0x000249u,
+    0x001000u, 0x001001u, 0x001008u, 0x001009u, 0x001040u, 0x001041u, 0x001048u, 0x001049u,
+    0x001200u, 0x001201u, 0x001208u, 0x001209u, 0x001240u, 0x001241u, 0x001248u, 0x001249u,
+    0x008000u, 0x008001u, 0x008008u, 0x008009u, 0x008040u, 0x008041u, 0x008048u, 0x008049u,
+    0x008200u, 0x008201u, 0x008208u, 0x008209u, 0x008240u, 0x008241u, 0x008248u, 0x008249u,
+    0x009000u, 0x009001u, 0x009008u, 0x009009u, 0x009040u, 0x009041u, 0x009048u, 0x009049u,
+    0x009200u, 0x009201u, 0x009208u, 0x009209u, 0x009240u, 0x009241u, 0x009248u, 0x009249u,
+    0x040000u, 0x040001u, 0x040008u, 0x040009u, 0x040040u, 0x040041u, 0x040048u, 0x040049u,
+    0x040200u, 0x040201u, 0x040208u, 0x040209u, 0x040240u, 0x040241u, 0x040248u, 0x040249u,
+    0x041000u, 0x041001u, 0x041008u, 0x041009u, 0x041040u, 0x041041u, 0x041048u, 0x041049u,
+    0x041200u, 0x041201u, 0x041208u, 0x041209u, 0x041240u, 0x041241u, 0x041248u, 0x041249u,
+    0x048000u, 0x048001u, 0x048008u, 0x048009u, 0x048040u, 0x048041u, 0x048048u, 0x048049u,
+    0x048200u, 0x048201u, 0x048208u, 0x048209u, 0x048240u, 0x048241u, 0x048248u, 0x048249u,
+    0x049000u, 0x049001u, 0x049008u, 0x049009u, 0x049040u, 0x049041u, 0x049048u, 0x049049u,
+    0x049200u, 0x049201u, 0x049208u, 0x049209u, 0x049240u, 0x049241u, 0x049248u, 0x049249u
+};
 
-/* The code of key k (hit bit set): from the last emitted voxel's when each axis moved by at
- * most one (a masked add or subtract on that axis' bits), else the full encode. */
-static occ_code_t code_of(occ_proj_t *const x, const uint32_t k[3])
+static occ_code_t spread21(const uint32_t k)
 {
-    occ_code_t c = x->px.last_code;
-    unsigned a = 0;
-    for (; a < 3u && c != 0u; a++) {
-        const occ_code_t m = (occ_code_t)MORTON_AXIS0 << a, one = (occ_code_t)1 << a;
-        if (k[a] == x->px.last_key[a] + 1u) {
-            c = (((c | ~m) + one) & m) | (c & ~m);
-        } else if (k[a] + 1u == x->px.last_key[a]) {
-            c = (((c & m) - one) & m) | (c & ~m);
-        } else if (k[a] != x->px.last_key[a]) {
-            break;
-        }
-    }
-    if (a < 3u || c == 0u) {
-        const occ_key_t key = {{k[0], k[1], k[2]}};
-        c = occ_morton_encode(key) | OCC_CODE_HIT_BIT;
-    }
-    x->px.last_code = c;
-    memcpy(x->px.last_key, k, sizeof x->px.last_key);
+    return (occ_code_t)spread7[k & 127u] | ((occ_code_t)spread7[(k >> 7) & 127u] << 21) |
+           ((occ_code_t)spread7[(k >> 14) & 127u] << 42);
+}
+
+/* The hit code of column i's end point (its key is on the map: 21 bits per axis at most). */
+static occ_code_t code_at(const occ_proj_t *const x, const uint32_t i)
+{
+    const uint32_t k[3] = {(uint32_t)(x->kcam[0] + x->px.kc[0][i]),
+                           (uint32_t)(x->kcam[1] + x->px.kc[1][i]),
+                           (uint32_t)(x->kcam[2] + x->px.kc[2][i])};
+    const occ_code_t c = spread21(k[0]) | (spread21(k[1]) << 1) | (spread21(k[2]) << 2) |
+                         OCC_CODE_HIT_BIT;
+    const occ_key_t key = {{k[0], k[1], k[2]}}; /* the check's only (tests) */
+    OCC_ASSERT(c == (occ_morton_encode(key) | OCC_CODE_HIT_BIT));
+    (void)key;
     return c;
 }
 
 /* One end point's code to the output (unless the repeat filter has it); false when the output
  * cannot hold it and the sort's temporary. */
-static bool emit(occ_proj_t *const x, const uint32_t i, size_t *const n)
+static bool emit(occ_proj_t *const x, const occ_code_t code, size_t *const n)
 {
-    const uint32_t k[3] = {(uint32_t)(x->kcam[0] + x->px.kc[0][i]),
-                           (uint32_t)(x->kcam[1] + x->px.kc[1][i]),
-                           (uint32_t)(x->kcam[2] + x->px.kc[2][i])};
-    const occ_code_t code = code_of(x, k);
-    const occ_key_t key = {{k[0], k[1], k[2]}}; /* the check's only (tests) */
-    OCC_ASSERT(code == (occ_morton_encode(key) | OCC_CODE_HIT_BIT));
-    (void)key;
     const size_t s = filter_slot(code);
     if (x->filter[s] == code) {
         return true;
@@ -297,24 +305,45 @@ static bool emit(occ_proj_t *const x, const uint32_t i, size_t *const n)
     return true;
 }
 
-/* The flagged pixels' codes to the output; false when it is full. */
+/* The flagged columns' indices to the front of nw, in order; their count. In place and
+ * branch-free (the flags fall at random): index n <= i is read before it is written. */
+static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < n4; i++) {
+        const int32_t f = nw[i];
+        nw[n] = (int32_t)i;
+        n += (uint32_t)f;
+    }
+    return n;
+}
+
+/* The flagged pixels' codes to the output; false when it is full. When the whole row surely
+ * fits, the repeat filter is branch-free: every code is written, and the count moves past the
+ * new ones only. */
 static bool emit_row(occ_proj_t *const x, size_t *const n)
 {
-    const int32_t *const nw = x->px.nw;
-    const uint32_t w4 = (x->im->width + 3u) & ~3u;
-    for (uint32_t i0 = 0; i0 < w4; i0 += 4u) {
-        uint64_t lo, hi;
-        memcpy(&lo, nw + i0, 8u); /* four flags at a time: most are 0 */
-        memcpy(&hi, nw + i0 + 2u, 8u);
-        if ((lo | hi) == 0u) {
-            continue;
-        }
-        for (uint32_t i = i0; i < i0 + 4u; i++) {
-            if (nw[i] != 0 && !emit(x, i, n)) {
+    int32_t *const nw = x->px.nw;
+    const uint32_t m = compact_flags(nw, (x->im->width + 3u) & ~3u);
+    if (2u * (*n + m) > x->cap) {
+        for (uint32_t j = 0; j < m; j++) { /* the exact order of the output running full */
+            if (!emit(x, code_at(x, (uint32_t)nw[j]), n)) {
                 return false;
             }
         }
+        return true;
     }
+    occ_code_t *const filter = x->filter, *const out = x->out;
+    size_t k = *n;
+    for (uint32_t j = 0; j < m; j++) {
+        const occ_code_t code = code_at(x, (uint32_t)nw[j]);
+        const size_t s = filter_slot(code);
+        const size_t fresh = filter[s] != code;
+        filter[s] = code;
+        out[k] = code;
+        k += fresh;
+    }
+    *n = k;
     return true;
 }
 
@@ -342,7 +371,6 @@ bool occi_proj_pixels(occ_proj_t *const x)
         x->px.kp[a]++; /* views from column 0: column -1 stays NO_VOXEL for every row */
         x->px.kc[a]++;
     }
-    x->px.last_code = 0u; /* none yet (a hit code always has bit 63) */
     columns(x);
     x->raw_lanes = raw_rows(x->im);
     bool fit = true;
