@@ -252,9 +252,10 @@ typedef struct {
  * OCC_ERR_ARG for NULL or level > depth_levels. O(nodes) (a walk for the bounding box, at
  * level 0 one more down to the voxels to count the mixed bricks), read only. */
 occ_err_t occ_lookup_index_need(const occ_map_t *map, unsigned level, size_t *bytes);
-/* The finest level whose table fits in `budget_bytes` (level 0 is smaller than level 1's 4 bytes
- * per 8 voxels: at most 4 + 128 bytes per 512 voxels). OCC_ERR_ARG for NULL, OCC_ERR_NOMEM when
- * not even the coarsest level fits (*level unchanged). O(nodes) per level tried. */
+/* The finest level whose table fits in `budget_bytes` (level 0, at most 4 + 128 bytes per 512
+ * voxels + 384, is below level 1's 256 bytes per 512 voxels but on the smallest maps). OCC_ERR_ARG
+ * for NULL, OCC_ERR_NOMEM when not even the coarsest level fits (*level unchanged). O(nodes) per
+ * level tried. */
 occ_err_t occ_lookup_index_pick(const occ_map_t *map, size_t budget_bytes, unsigned *level);
 /* Build the index at `level` on `mem` (any alignment: the table starts at the next 4-byte
  * boundary, so give occ_lookup_index_need()'s bytes + 3 unless mem is 4-aligned). Writes only
