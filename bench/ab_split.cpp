@@ -11,12 +11,17 @@
 //   los:        occ_line_of_sight between free points 1..10.8 m apart on geb079.bt;
 //   collide:    occ_collide_sphere (r 0.25 m), _capsule (1 m, r 0.3 m) and _obb (0.6 x 0.4 x
 //               0.2 m, random yaw) at the same free points, unknown unsafe;
-//   info gain:  occ_info_gain of a 115 x 60 deg, 6.5 m frustum (level 0) from free points.
+//   info gain:  occ_info_gain of a 115 x 60 deg, 6.5 m frustum (level 0) from free points;
+//   lookups:    the level-0 lookup index (occ_lookup_index_state) on geb079.bt and, with
+//               --fr079 PATH, fr_079: 200k random points in the map's box with warm caches
+//               (a pass over the same points first) and cold (before each 1,000 points, 8 MiB
+//               streamed through the caches, untimed), and 200k points of 5 cm trajectory
+//               steps; each side its own index, both equal to occ_map_state_at everywhere.
 // Prints, per case, each side's median and range (min..max) over the rounds and the median and
 // quartiles of the per-round ratio new / old (< 1: the new code is faster). Both sides must give
 // the same answers (checked on every input first).
-// usage: ab_split [--rounds N] [--queries-only | --inserts-only] [--case SUBSTR] [--tum DIR]
-//                 SCAN.dat MAP.bt
+// usage: ab_split [--rounds N] [--queries-only | --inserts-only | --lookup-only] [--case SUBSTR]
+//                 [--tum DIR] [--fr079 PATH] SCAN.dat MAP.bt
 // (--case runs only the insert cases whose name contains SUBSTR; --inserts-only under callgrind
 // with --toggle-collect=occ_map_insert_cloud profiles this tree's side alone; the proj case:
 // --case proj --toggle-collect=occ_map_insert_depth.)
@@ -48,6 +53,9 @@ extern "C" decltype(occ_collide_sphere) old_occ_collide_sphere;
 extern "C" decltype(occ_collide_capsule) old_occ_collide_capsule;
 extern "C" decltype(occ_collide_obb) old_occ_collide_obb;
 extern "C" decltype(occ_info_gain) old_occ_info_gain;
+extern "C" decltype(occ_lookup_index_need) old_occ_lookup_index_need;
+extern "C" decltype(occ_lookup_index_build) old_occ_lookup_index_build;
+extern "C" decltype(occ_lookup_index_state) old_occ_lookup_index_state;
 
 static double cpu_ms()
 {
@@ -543,11 +551,120 @@ static void bench_queries(const occ_map_t &m, int rounds)
     bench_info_gain(m, o, d, rounds);
 }
 
+// One side's lookup index: its own struct (the old library's may be laid out otherwise: a
+// buffer larger than this tree's struct, passed through) and table.
+struct IndexSide {
+    alignas(64) unsigned char raw[sizeof(occ_lookup_index_t) + 256];
+    std::vector<uint32_t> mem;
+    size_t bytes = 0;
+    decltype(occ_lookup_index_state) *state = nullptr;
+    const occ_lookup_index_t *idx() const { return reinterpret_cast<const occ_lookup_index_t *>(raw); }
+};
+
+static void index_side(IndexSide &s, const occ_map_t &m, bool old)
+{
+    decltype(occ_lookup_index_need) *need = old ? old_occ_lookup_index_need : occ_lookup_index_need;
+    decltype(occ_lookup_index_build) *build = old ? old_occ_lookup_index_build : occ_lookup_index_build;
+    s.state = old ? old_occ_lookup_index_state : occ_lookup_index_state;
+    if (need(&m, 0u, &s.bytes) != OCC_OK) std::abort();
+    s.mem.assign(s.bytes / 4 + 1, 0u);
+    const double t0 = cpu_ms();
+    if (build(reinterpret_cast<occ_lookup_index_t *>(s.raw), &m, 0u, s.mem.data(), s.mem.size() * 4) != OCC_OK) {
+        std::fprintf(stderr, "ab_split: lookup index build failed\n");
+        std::exit(1);
+    }
+    std::printf("  %s index level 0: %.3f MB, built in %.1f ms\n", old ? "old" : "new",
+                (double)s.bytes / 1e6, cpu_ms() - t0);
+}
+
+// Streams `bytes` through the caches (the cold case's eviction, not timed).
+static void evict_caches(size_t bytes)
+{
+    static std::vector<uint64_t> junk;
+    junk.resize(bytes / 8);
+    static uint64_t x = 1;
+    for (size_t i = 0; i < junk.size(); i += 8) junk[i] += x++;
+}
+
+// CPU ms of the lookups of pts[i0, i1).
+static double time_lookups(const IndexSide &s, const std::vector<occ_vec3_t> &pts, size_t i0, size_t i1)
+{
+    size_t sum = 0;
+    const double t0 = cpu_ms();
+    for (size_t i = i0; i < i1; i++) sum += (size_t)s.state(s.idx(), pts[i]);
+    const double t = cpu_ms() - t0;
+    if (sum > 2 * pts.size()) std::abort();
+    return t;
+}
+
+static double lookups_warm(const IndexSide &s, const std::vector<occ_vec3_t> &pts)
+{
+    (void)time_lookups(s, pts, 0, pts.size());
+    return time_lookups(s, pts, 0, pts.size());
+}
+
+static double lookups_cold(const IndexSide &s, const std::vector<occ_vec3_t> &pts)
+{
+    double t = 0;
+    for (size_t i = 0; i < pts.size(); i += 1000) {
+        evict_caches((size_t)8 << 20);
+        t += time_lookups(s, pts, i, std::min(pts.size(), i + 1000));
+    }
+    return t;
+}
+
+static void bench_lookups(const char *name, const occ_map_t &m, int rounds)
+{
+    std::printf("%s:\n", name);
+    IndexSide olds, news;
+    index_side(olds, m, true);
+    index_side(news, m, false);
+    const Box b = map_box(m);
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<float> ux(b.lo.x, b.hi.x), uy(b.lo.y, b.hi.y),
+        uz(b.lo.z, b.hi.z), u01(0, 1);
+    const size_t N = 200000;
+    std::vector<occ_vec3_t> pts(N), traj(N);
+    for (auto &p : pts) p = {ux(rng), uy(rng), uz(rng)};
+    // 5 cm steps in random directions, clamped to the box, from a random start every 200 steps.
+    for (size_t i = 0; i < N; i++) {
+        if (i % 200 == 0) {
+            traj[i] = {ux(rng), uy(rng), uz(rng)};
+            continue;
+        }
+        occ_vec3_t d = {2 * u01(rng) - 1, 2 * u01(rng) - 1, 2 * u01(rng) - 1};
+        if (d.x * d.x + d.y * d.y + d.z * d.z < 1e-6f) d = {1, 0, 0};
+        d = unit(d);
+        const occ_vec3_t q = traj[i - 1];
+        traj[i] = {std::min(std::max(q.x + 0.05f * d.x, b.lo.x), b.hi.x),
+                   std::min(std::max(q.y + 0.05f * d.y, b.lo.y), b.hi.y),
+                   std::min(std::max(q.z + 0.05f * d.z, b.lo.z), b.hi.z)};
+    }
+    for (const auto *v : {&pts, &traj}) {
+        for (const occ_vec3_t &p : *v) {
+            const occ_state_t want = occ_map_state_at(&m, p);
+            if (olds.state(olds.idx(), p) != want || news.state(news.idx(), p) != want) {
+                std::fprintf(stderr, "ab_split: %s: lookup at (%g %g %g) differs\n", name,
+                             (double)p.x, (double)p.y, (double)p.z);
+                std::exit(1);
+            }
+        }
+    }
+    char label[80];
+    std::snprintf(label, sizeof label, "lookup random warm %s (200k)", name);
+    ab(label, rounds, [&] { return lookups_warm(olds, pts); }, [&] { return lookups_warm(news, pts); });
+    std::snprintf(label, sizeof label, "lookup random cold %s (200k)", name);
+    ab(label, rounds, [&] { return lookups_cold(olds, pts); }, [&] { return lookups_cold(news, pts); });
+    std::snprintf(label, sizeof label, "lookup trajectory %s (200k)", name);
+    ab(label, rounds, [&] { return time_lookups(olds, traj, 0, N); },
+       [&] { return time_lookups(news, traj, 0, N); });
+}
+
 int main(int argc, char **argv)
 {
     int rounds = 15;
-    bool queries_only = false, inserts_only = false;
-    const char *filter = nullptr, *tum_dir = nullptr;
+    bool queries_only = false, inserts_only = false, lookup_only = false;
+    const char *filter = nullptr, *tum_dir = nullptr, *fr079 = nullptr;
     int a = 1;
     for (; a < argc && argv[a][0] == '-'; a++) {
         if (std::strcmp(argv[a], "--rounds") == 0 && a + 1 < argc) {
@@ -556,6 +673,10 @@ int main(int argc, char **argv)
             queries_only = true; /* e.g. under callgrind, where the inserts take minutes */
         } else if (std::strcmp(argv[a], "--inserts-only") == 0) {
             inserts_only = true;
+        } else if (std::strcmp(argv[a], "--lookup-only") == 0) {
+            lookup_only = true;
+        } else if (std::strcmp(argv[a], "--fr079") == 0 && a + 1 < argc) {
+            fr079 = argv[++a];
         } else if (std::strcmp(argv[a], "--case") == 0 && a + 1 < argc) {
             filter = argv[++a];
         } else if (std::strcmp(argv[a], "--tum") == 0 && a + 1 < argc) {
@@ -565,14 +686,14 @@ int main(int argc, char **argv)
         }
     }
     if (argc - a != 2) {
-        std::fprintf(stderr, "usage: ab_split [--rounds N] [--queries-only | --inserts-only] "
-                             "[--case SUBSTR] [--tum DIR] SCAN.dat MAP.bt\n");
+        std::fprintf(stderr, "usage: ab_split [--rounds N] [--queries-only | --inserts-only | "
+                             "--lookup-only] [--case SUBSTR] [--tum DIR] [--fr079 PATH] SCAN.dat MAP.bt\n");
         return 2;
     }
     char msg[256] = "";
     occ_vec3_t *pts = nullptr;
     size_t n = 0;
-    if (occ_scan_read_xyz(argv[a], &pts, &n, msg, sizeof msg) != OCC_OK) {
+    if (!lookup_only && occ_scan_read_xyz(argv[a], &pts, &n, msg, sizeof msg) != OCC_OK) {
         std::fprintf(stderr, "ab_split: %s\n", msg);
         return 1;
     }
@@ -586,6 +707,21 @@ int main(int argc, char **argv)
         return 1;
     }
     std::printf("A/B old (AB_BASE) vs new (this tree), %d interleaved rounds, CPU time\n", rounds);
+    if (lookup_only) {
+        bench_lookups("geb079", m, rounds);
+        std::free(map_arena);
+        if (fr079 != nullptr) {
+            void *fr_arena = nullptr;
+            occ_map_t fr;
+            if (occ_file_load_alloc(fr079, nullptr, &fr, 0, &fr_arena, nullptr, msg, sizeof msg) != OCC_OK) {
+                std::fprintf(stderr, "ab_split: %s\n", msg);
+                return 1;
+            }
+            bench_lookups("fr_079", fr, rounds);
+            std::free(fr_arena);
+        }
+        return 0;
+    }
     if (!queries_only) {
         const std::vector<Scan> tum = tum_dir != nullptr ? load_tum(tum_dir) : std::vector<Scan>();
         bench_inserts(scan, tum, rounds, filter);

@@ -1,16 +1,18 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # ab_split.mk - `make bench-ab-split` (in neither `make test` nor `make bench`): the library as
-# of AB_BASE (default: main before the long functions were split) against this tree's, linked
+# of AB_BASE (default: main as the last stop landed it) against this tree's, linked
 # into one program (bench/ab_split.cpp) with the old library's symbols renamed old_*, run in
 # interleaved rounds on scan.dat (SIMPLE, DISCRETE, super rays at 0.1 / 0.05 m), the 10 TUM
 # pioneer frames (SIMPLE, DISCRETE at 0.05 m; PROJECTIVE through occ_map_insert_depth, the
 # `proj` case) and geb079.bt (castRay, line of sight, collision).
 # Proves a refactor of a hot path costs nothing: `make bench-ab-split AB_BASE=<commit>`; AB_ARGS
-# passes options (e.g. AB_ARGS='--inserts-only --case simple').
-AB_BASE ?= 6e02855
+# passes options (e.g. AB_ARGS='--inserts-only --case simple'; AB_ARGS=--lookup-only times the
+# lookup index on geb079.bt and on fr_079 from ../shared/data/maps when present).
+AB_BASE ?= 72c2fec
 AB_DIR := $(BUILD)/ab
 AB_MAP := /usr/share/doc/liboctomap-dev/examples/data/geb079.bt
 AB_TUM := ../shared/data/depth/tum_fr2_pioneer_slam2
+AB_FR079 := $(wildcard ../shared/data/maps/fr_079_t1_model.ot)
 # The map modules and sensors (occ_map_insert_depth), no other front end, with the release
 # build's per-file flags (PROJ_VEC_CFLAGS on the projective files). Rebuilt when AB_BASE names
 # another commit or those flags change (kept in $(AB_DIR)/base).
@@ -38,6 +40,7 @@ $(BUILD)/bench/ab_split: bench/ab_split.cpp $(BUILD)/relhost/port/posix/file_io.
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++14 -O2 -g -Wall -Wextra -Werror $(INC) -o $@ $^ -lccd -lpng -lm
 bench-ab-split: $(BUILD)/bench/ab_split $(BUILD)/data/scan.dat
-	./$(BUILD)/bench/ab_split --rounds $(or $(AB_ROUNDS),15) --tum $(AB_TUM) $(AB_ARGS) \
+	./$(BUILD)/bench/ab_split --rounds $(or $(AB_ROUNDS),15) --tum $(AB_TUM) \
+	  $(if $(AB_FR079),--fr079 $(AB_FR079)) $(AB_ARGS) \
 	  $(BUILD)/data/scan.dat $(AB_MAP)
 .PHONY: bench-ab-split FORCE_AB

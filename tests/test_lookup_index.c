@@ -12,7 +12,11 @@
  *    OCC_ERR_STATE (a FREE voxel never reads FREE from a stale index);
  *  - memory: too small -> OCC_ERR_NOMEM with nothing written; the table ends within the bytes
  *    occ_lookup_index_need() gave (guard bytes after it untouched), unaligned memory works;
- *  - bad input: NULL, level > depth, NaN / Inf, off-map points, an unbuilt index, pick budgets.
+ *  - bad input: NULL, level > depth, NaN / Inf, off-map points, an unbuilt index, pick budgets;
+ *  - level 0's bricks, every voxel against occ_map_state_at: bricks of one state (one node, or
+ *    voxels of different log-odds) against mixed ones with their bytes by hand; bricks at the
+ *    map's faces (keys 0 and 2^depth - 1, depths 1 to 16: a map smaller than a brick too) and
+ *    a box not aligned to bricks (random, OCC_SEED); a map where every brick is mixed.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -28,6 +32,7 @@
 #include "occmap/occmap.h"
 #include "support/lookup_probes.h"
 #include "support/leak_check.h"
+#include "support/test_rng.h"
 
 /* Every probe through the index equals occ_map_state_at; the batch equals them too. */
 static void check_probes(const occ_map_t *map, const occ_lookup_index_t *idx, const occ_vec3_t *pts,
@@ -118,18 +123,19 @@ static void test_hand_map(void **state)
     (void)state;
     static lp_small_t s;
     lp_small_init(&s);
-    /* Bytes by hand: level 0: 16^3 cells / 16 per word x 4 = 1024; level 1: 8^3 x 4 = 2048;
-     * level 2: 4^3 x 4 = 256; level 3: 2^3 x 4 = 32; level 4 .. 16: one cell, 4 bytes. */
-    const size_t want[6] = {1024u, 2048u, 256u, 32u, 4u, 4u};
+    /* Bytes by hand: level 0: 2^3 bricks x 4 + 128 x (3 constant + 1 mixed: the occupied
+     * voxel's; the free node is a whole brick) = 544; level 1: 8^3 x 4 = 2048; level 2: 4^3 x 4
+     * = 256; level 3: 2^3 x 4 = 32; level 4 .. 16: one cell, 4 bytes. */
+    const size_t want[6] = {544u, 2048u, 256u, 32u, 4u, 4u};
     for (unsigned l = 0; l < 6u; l++) {
         size_t b = 0;
         assert_int_equal(occ_lookup_index_need(&s.map, l, &b), OCC_OK);
         assert_int_equal(b, want[l]);
     }
     unsigned level = 99u;
-    assert_int_equal(occ_lookup_index_pick(&s.map, 1024u, &level), OCC_OK);
+    assert_int_equal(occ_lookup_index_pick(&s.map, 544u, &level), OCC_OK);
     assert_int_equal(level, 0u);
-    assert_int_equal(occ_lookup_index_pick(&s.map, 1023u, &level), OCC_OK);
+    assert_int_equal(occ_lookup_index_pick(&s.map, 543u, &level), OCC_OK);
     assert_int_equal(level, 2u);
     assert_int_equal(occ_lookup_index_pick(&s.map, 31u, &level), OCC_OK);
     assert_int_equal(level, 4u);
@@ -283,12 +289,149 @@ static void test_bad_input(void **state)
     assert_int_equal(b, 4u);
     assert_int_equal(occ_lookup_index_need(&s.map, 0u, &b), OCC_OK);
 #if SIZE_MAX > UINT32_MAX
-    assert_true(b == (size_t)1 << 46); /* 2^48 voxels x 2 bits */
+    assert_true(b == ((size_t)1 << 41) + 384u); /* 2^39 bricks x 4 + the 3 constant bricks */
 #else
     assert_true(b == SIZE_MAX); /* does not fit a 32-bit size_t */
 #endif
     assert_int_equal(occ_lookup_index_pick(&s.map, 1024u, &l), OCC_OK);
     assert_int_equal(l, 14u); /* level 13: 8^3 cells x 4 = 2048 B, too big; 14: 4^3 x 4 = 256 */
+}
+
+/* Level 0 on `map`: every voxel key of xs x ys x zs (n keys per axis each) answers as
+ * occ_map_state_at at its centre. Returns the table's bytes. */
+static size_t check_voxels(const occ_map_t *map, const uint32_t *const keys, const size_t n)
+{
+    size_t bytes = 0;
+    assert_int_equal(occ_lookup_index_need(map, 0u, &bytes), OCC_OK);
+    void *const mem = malloc(bytes + 4u);
+    assert_non_null(mem);
+    occ_lookup_index_t idx;
+    assert_int_equal(occ_lookup_index_build(&idx, map, 0u, mem, bytes + 4u), OCC_OK);
+    assert_int_equal(idx.bytes, bytes);
+    size_t bad = 0;
+    for (size_t x = 0; x < n; x++) {
+        for (size_t y = 0; y < n; y++) {
+            for (size_t z = 0; z < n; z++) {
+                const occ_key_t k = {{keys[x], keys[y], keys[z]}};
+                const occ_vec3_t p = occ_map_key_center(map, k, 0u);
+                const occ_state_t want = occ_map_state_at(map, p);
+                const occ_state_t got = occ_lookup_index_state(&idx, p);
+                if (got != want && bad++ < 5u) {
+                    printf("key %u %u %u: want %d, index %d\n", (unsigned)k.k[0], (unsigned)k.k[1],
+                           (unsigned)k.k[2], (int)want, (int)got);
+                }
+            }
+        }
+    }
+    free(mem);
+    assert_int_equal(bad, 0u);
+    return bytes;
+}
+
+/* Keys lo .. lo + n - 1. */
+static size_t key_run(uint32_t *const keys, const uint32_t lo, const size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        keys[i] = lo + (uint32_t)i;
+    }
+    return n;
+}
+
+static void set_voxel(occ_map_t *map, const uint32_t x, const uint32_t y, const uint32_t z,
+                      const unsigned level, const float logodds)
+{
+    assert_int_equal(occ_map_set_key(map, (occ_key_t){{x, y, z}}, level, logodds), OCC_OK);
+}
+
+/* Bricks of keys 32768 + 8 i per axis: which are constant and which mixed, by hand. */
+static void test_bricks_by_hand(void **state)
+{
+    (void)state;
+    static occ_map_t map;
+    static uint8_t arena[OCC_ARENA_BYTES(256, 512)];
+    const occ_map_config_t cfg = occ_map_config_default();
+    assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+    const uint32_t o = 32768u;
+    set_voxel(&map, o, o, o, 3u, -1.0f); /* brick x 0: one free node: constant */
+    for (uint32_t i = 0; i < 512u; i++) { /* x 1: 512 free voxels, all different: constant */
+        set_voxel(&map, o + 8u + (i >> 6), o + ((i >> 3) & 7u), o + (i & 7u), 0u,
+                  -0.1f - 0.003f * (float)i);
+    }
+    set_voxel(&map, o + 16u, o, o, 3u, -1.0f); /* x 2: free with one occupied voxel: mixed */
+    set_voxel(&map, o + 21u, o + 2u, o + 7u, 0u, 2.0f);
+    set_voxel(&map, o + 27u, o + 7u, o + 7u, 0u, 2.0f); /* x 3: one voxel, the rest unknown */
+    set_voxel(&map, o + 32u, o, o, 4u, 3.0f); /* x 4, 5 (y, z 0, 1): one occupied node */
+    for (uint32_t i = 0; i < 511u; i++) { /* x 0, y 1: 511 free voxels, one unknown: mixed */
+        set_voxel(&map, o + (i >> 6), o + 8u + ((i >> 3) & 7u), o + (i & 7u), 0u, -1.0f);
+    }
+    uint32_t keys[64];
+    const size_t n = key_run(keys, o - 8u, 64u);
+    /* 6 x 2 x 2 bricks x 4 B + 128 B x (3 constant + 3 mixed). */
+    assert_int_equal(check_voxels(&map, keys, n), 96u + 128u * 6u);
+    assert_int_equal(leak_check(&map), 0);
+}
+
+/* Random voxels and small nodes of each state near both faces of the key space on every axis
+ * (near one face from depth 10 on, where a box across the map would be large): bricks cut by the
+ * map's faces (at depth < 3 the map is smaller than one brick) and a box that
+ * does not start or end on a brick. */
+static void test_bricks_at_faces(void **state)
+{
+    (void)state;
+    const char *const env = getenv("OCC_SEED");
+    const uint64_t seed = env != NULL ? strtoull(env, NULL, 0) : 22u;
+    printf("seed %llu (OCC_SEED)\n", (unsigned long long)seed);
+    static occ_map_t map;
+    static uint8_t arena[OCC_ARENA_BYTES(4096, 8192)];
+    for (unsigned depth = 1; depth <= 16u; depth++) {
+        rng_state = seed * 977u + depth;
+        occ_map_config_t cfg = occ_map_config_default();
+        cfg.depth_levels = (uint8_t)depth;
+        assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+        const uint32_t side = 1u << depth, near = side < 13u ? side : 13u;
+        for (unsigned i = 0; i < 300u; i++) {
+            uint32_t k[3];
+            const unsigned level = rnd_below(4u) == 0u && depth > 1u ? rnd_below(2u) + 1u : 0u;
+            for (unsigned a = 0; a < 3u; a++) {
+                const uint32_t off = rnd_below(near);
+                /* Both faces while the box's directory stays small, then one. */
+                const bool low = depth <= 9u ? rnd_below(2u) == 0u : (depth & 1u) == 0u;
+                k[a] = low ? off : side - 1u - off;
+            }
+            set_voxel(&map, k[0], k[1], k[2], level, rnd_below(2u) == 0u ? -1.0f : 2.0f);
+        }
+        /* Keys within 20 of each face; at depth <= 5 that is every key. */
+        uint32_t keys[40];
+        size_t n = key_run(keys, 0u, side < 20u ? side : 20u);
+        if (side > 20u) {
+            const uint32_t from = side >= 40u ? side - 20u : 20u;
+            n += key_run(keys + n, from, side - from);
+        }
+        (void)check_voxels(&map, keys, n);
+    }
+}
+
+/* Free and occupied alternate voxel by voxel: every brick is mixed, nothing prunes. */
+static void test_every_brick_mixed(void **state)
+{
+    (void)state;
+    static occ_map_t map;
+    static uint8_t arena[OCC_ARENA_BYTES(1024, 4096)];
+    occ_map_config_t cfg = occ_map_config_default();
+    cfg.depth_levels = 5u;
+    assert_int_equal(occ_map_init(&map, &cfg, arena, sizeof arena), OCC_OK);
+    for (uint32_t x = 0; x < 32u; x++) {
+        for (uint32_t y = 0; y < 32u; y++) {
+            for (uint32_t z = 0; z < 32u; z++) {
+                set_voxel(&map, x, y, z, 0u, ((x + y + z) & 1u) != 0u ? 2.0f : -1.0f);
+            }
+        }
+    }
+    uint32_t keys[32];
+    const size_t n = key_run(keys, 0u, 32u);
+    /* 4^3 bricks x 4 B + 128 B x (3 + 64 mixed). */
+    assert_int_equal(check_voxels(&map, keys, n), 256u + 128u * 67u);
+    assert_int_equal(leak_check(&map), 0);
 }
 
 int main(void)
@@ -298,6 +441,9 @@ int main(void)
         cmocka_unit_test(test_stale),
         cmocka_unit_test(test_memory),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_bricks_by_hand),
+        cmocka_unit_test(test_bricks_at_faces),
+        cmocka_unit_test(test_every_brick_mixed),
         cmocka_unit_test(test_geb079),
         cmocka_unit_test(test_fr079),
     };

@@ -207,11 +207,16 @@ occ_err_t occ_map_states_at(const occ_map_t *map, const occ_vec3_t *pts, size_t 
                             uint8_t *states_out);
 
 /* ---- Exact lookup index for random points (issue 22) ---------------------------------------------
- * A dense table over the key bounding box of the map's observed space, built by the caller into
- * caller-given memory (no heap), that answers occ_map_state_at exactly with one table load
+ * A table over the key bounding box of the map's observed space, built by the caller into
+ * caller-given memory (no heap), that answers occ_map_state_at exactly with two table loads
  * (level 0) or a table load plus `level` block loads (level >= 1) instead of a descent from the
  * root (depth_levels dependent loads).
- *  - level 0: 2 bits per voxel (its state): bytes ~ voxels of the box / 4.
+ *  - level 0: the box in bricks of 8x8x8 voxels (aligned to keys that are multiples of 8): a
+ *    directory of one 4-byte brick number per brick, then 3 constant bricks (all UNKNOWN, all
+ *    FREE, all OCCUPIED) and one 128-byte brick (2 bits per voxel: its state) per mixed brick,
+ *    a brick whose voxels do not all read the same state. A brick of one state (whatever the
+ *    log-odds of its voxels) costs only its directory entry:
+ *    bytes = 4 x bricks of the box + 128 x (3 + mixed bricks) (0 when nothing is observed).
  *  - level L >= 1: 4 bytes per level-L cell of the box (the cell's child block, or its state when
  *    the cell lies in a node without children): bytes ~ voxels / 8^L * 4; the lookup then walks
  *    the last L levels of the tree (<= L block reads).
@@ -226,13 +231,16 @@ occ_err_t occ_map_states_at(const occ_map_t *map, const occ_vec3_t *pts, size_t 
  * writers (as the map); concurrent readers of an unchanged map are fine (lookups only read). */
 typedef struct {
     const occ_map_t *map; /* the map it was built on (NULL: not built) */
-    uint8_t level;        /* table level: 0 = 2-bit voxel states, >= 1 = cell references */
-    uint32_t lo[3];       /* first voxel key of the box per axis (low `level` bits clear) */
-    uint32_t n[3];        /* cells per axis (0 when nothing is observed) */
+    uint8_t level;        /* table level: 0 = bricks of 2-bit voxel states, >= 1 = cell references */
+    uint32_t lo[3];       /* first voxel key of the box per axis (low max(level, 3 at level 0)
+                             bits clear) */
+    uint32_t n[3];        /* cells per axis, bricks at level 0 (0 when nothing is observed) */
     size_t bytes;         /* table bytes used of the caller's memory */
     struct {              /* internal: do not touch, layout may change */
-        const uint32_t *cells;   /* the table (in the caller's memory) */
+        const uint32_t *cells;   /* the table (in the caller's memory); level 0: the directory */
+        const uint32_t *bricks;  /* level 0: the bricks after the directory, else NULL */
         size_t stride_y, stride_x; /* cells per y step / per x step: n[2], n[1] * n[2] */
+        uint8_t shift;           /* a cell is 2^shift voxels per axis: 3 at level 0, else level */
         uint32_t gen;            /* map->write_gen at build */
         uint32_t root;           /* the map's root block at build */
         const void *arena;       /* the map's arena at build */
@@ -241,20 +249,23 @@ typedef struct {
 
 /* Table bytes for an index at `level` (0..depth_levels) over `map`'s observed space:
  * *bytes = 0 when nothing is observed, SIZE_MAX when the size does not fit a size_t.
- * OCC_ERR_ARG for NULL or level > depth_levels. O(nodes) (a walk for the bounding box),
- * read only. */
+ * OCC_ERR_ARG for NULL or level > depth_levels. O(nodes) (a walk for the bounding box, at
+ * level 0 one more down to the voxels to count the mixed bricks), read only. */
 occ_err_t occ_lookup_index_need(const occ_map_t *map, unsigned level, size_t *bytes);
-/* The finest level whose table fits in `budget_bytes` (level 0 is the smallest table below
- * level 2: its 2 bits per voxel are less than level 1's 4 bytes per 8 voxels). OCC_ERR_ARG for
- * NULL, OCC_ERR_NOMEM when not even the coarsest level fits (*level unchanged). O(nodes). */
+/* The finest level whose table fits in `budget_bytes` (level 0, at most 4 + 128 bytes per 512
+ * voxels + 384, is below level 1's 256 bytes per 512 voxels but on the smallest maps). OCC_ERR_ARG
+ * for NULL, OCC_ERR_NOMEM when not even the coarsest level fits (*level unchanged). O(nodes) per
+ * level tried. */
 occ_err_t occ_lookup_index_pick(const occ_map_t *map, size_t budget_bytes, unsigned *level);
 /* Build the index at `level` on `mem` (any alignment: the table starts at the next 4-byte
  * boundary, so give occ_lookup_index_need()'s bytes + 3 unless mem is 4-aligned). Writes only
  * [mem, mem + mem_bytes). OCC_ERR_ARG for NULL idx or map, level > depth_levels, or NULL mem
  * with a non-empty table; OCC_ERR_NOMEM when mem_bytes is too small (nothing written to mem);
  * OCC_ERR_UNSUPPORTED when a block index collides with the table's state tags (a pool of
- * > 4 G - 4 blocks). On error the index is left unbuilt (lookups answer UNKNOWN + OCC_ERR_STATE).
- * O(nodes + cells of the table). Stack: a fixed walk (<= depth_levels frames). */
+ * > 4 G - 4 blocks) or a level-0 table would hold >= 4 G - 3 mixed bricks. On error the index is
+ * left unbuilt (lookups answer UNKNOWN + OCC_ERR_STATE). O(nodes + cells of the table); level 0
+ * walks the tree down to the voxels twice (count, then fill) and writes every voxel of a mixed
+ * brick once. Stack: a fixed walk (<= depth_levels frames). */
 occ_err_t occ_lookup_index_build(occ_lookup_index_t *idx, const occ_map_t *map, unsigned level,
                                  void *mem, size_t mem_bytes);
 /* OCC_OK while the index matches its map, OCC_ERR_STATE when it was never built (or its build
@@ -437,13 +448,14 @@ occ_err_t occ_info_gain(const occ_map_t *map, const occ_volume_t *vol, unsigned 
  *   occ_info_gain: stack <= 1,024 / 1,024 B; work: the cells reported (x the ray length in voxels
  *       with OCC_GAIN_OCCLUSION)
  *   occ_lookup_index_state, occ_lookup_index_read: stack <= 192 / 256 B; work: one table load +
- *       <= level block reads
- *   occ_lookup_index_states: stack <= 320 / 384 B; work: per point one table load + <= level
- *       block reads
- *   occ_lookup_index_need: stack <= 384 / 384 B; work: every node down to the level once
- *   occ_lookup_index_pick: stack <= 384 / 384 B; work: every node once per level tried
- *   occ_lookup_index_build: stack <= 576 / 576 B; work: every node down to the level twice +
- *       every table cell once
+ *       one brick word (level 0) or <= level block reads
+ *   occ_lookup_index_states: stack <= 320 / 384 B; work: per point one table load + one brick
+ *       word (level 0) or <= level block reads
+ *   occ_lookup_index_need: stack <= 448 / 448 B; work: every node down to the level once (level
+ *       0: down to level 3, then every node)
+ *   occ_lookup_index_pick: stack <= 448 / 448 B; work: every node once per level tried
+ *   occ_lookup_index_build: stack <= 576 / 576 B; work: every node down to the level twice (level
+ *       0: down to level 3 once, every node twice) + every table cell once
  *   occ_lookup_index_status: stack <= 192 / 256 B; work: O(1)
  *   occ_lookup_read, occ_lookup_state: stack <= 256 / 256 B; work: the levels below the highest key
  *       bit that differs from the last lookup

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
  * lookup_index.c - point lookups through the lookup index (occ_query.h): the point's key (the
- * map's one conversion), one table load, and at level >= 1 the last `level` levels of the tree.
- * Built by lookup_index_build.c.
+ * map's one conversion), one table load, then at level 0 one brick word, at level >= 1 the last
+ * `level` levels of the tree. Built by lookup_index_build.c and lookup_index_bricks.c.
  */
 #include "lookup_internal.h"
 
@@ -19,8 +19,9 @@ occ_err_t occ_lookup_index_status(const occ_lookup_index_t *const idx)
     return OCC_OK;
 }
 
-/* The key of p and its cell; false for NaN / Inf, off the map or outside the box. (k - lo)
- * wraps for k < lo to >= 2^32 - 2^21, which stays >= n after the shift (n <= 2^(21 - level)). */
+/* The key of p and its cell (a brick's directory entry at level 0); false for NaN / Inf, off
+ * the map or outside the box. (k - lo) wraps for k < lo to >= 2^32 - 2^21, which stays >= n
+ * after the shift (n <= 2^(21 - shift)). */
 static inline bool cell_of(const occ_lookup_index_t *const ix, const occ_map_t *const m,
                            const occ_vec3_t p, occ_key_t *const k, size_t *const cell)
 {
@@ -28,7 +29,7 @@ static inline bool cell_of(const occ_lookup_index_t *const ix, const occ_map_t *
         !occ_coord_to_key(m, p.z, &k->k[2])) {
         return false;
     }
-    const unsigned L = ix->level;
+    const unsigned L = ix->priv.shift;
     const uint32_t ux = (k->k[0] - ix->lo[0]) >> L;
     const uint32_t uy = (k->k[1] - ix->lo[1]) >> L;
     const uint32_t uz = (k->k[2] - ix->lo[2]) >> L;
@@ -58,22 +59,19 @@ static inline occ_value_t walk_down(const occ_map_t *const m, const occ_key_t *c
     return occ_leaf_at(m, b)->value[occ_key_slot(k, 0u)];
 }
 
-/* The answer of a cell whose table entry (word or reference) was read as `w`. */
+/* The answer of a cell whose table entry (brick number or reference) was read as `w`. */
 static inline occ_state_t cell_answer(const occ_lookup_index_t *const ix, const occ_map_t *m,
-                                      const occ_key_t *const k, const size_t cell, const uint32_t w)
+                                      const occ_key_t *const k, const uint32_t w)
 {
     if (ix->level == 0u) {
-        return (occ_state_t)((w >> (2u * (cell % OCC_IDX_PER_WORD))) & 3u);
+        unsigned sh;
+        const size_t i = occi_idx_brick_word(w, k, &sh);
+        return (occ_state_t)((ix->priv.bricks[i] >> sh) & 3u);
     }
     if (w >= OCC_IDX_TAG) {
         return (occ_state_t)(w & 3u);
     }
     return occ_value_state(m, walk_down(m, k, ix->level, w));
-}
-
-static inline const uint32_t *cell_word(const occ_lookup_index_t *const ix, const size_t cell)
-{
-    return ix->level == 0u ? &ix->priv.cells[cell / OCC_IDX_PER_WORD] : &ix->priv.cells[cell];
 }
 
 /* The lookup of a valid index. */
@@ -85,7 +83,7 @@ static inline occ_state_t index_state(const occ_lookup_index_t *const ix, const 
     if (!cell_of(ix, m, p, &k, &cell)) {
         return OCC_STATE_UNKNOWN; /* NaN, off the map, or outside the observed box */
     }
-    return cell_answer(ix, m, &k, cell, *cell_word(ix, cell));
+    return cell_answer(ix, m, &k, ix->priv.cells[cell]);
 }
 
 occ_state_t occ_lookup_index_state(const occ_lookup_index_t *const idx, const occ_vec3_t p)
@@ -119,8 +117,8 @@ occ_err_t occ_lookup_index_read(const occ_lookup_index_t *const idx, const occ_v
 
 #define BATCH 8u
 
-/* Up to BATCH points: keys and cells first, each table word prefetched, then the answers (the
- * blocks of level >= 1 references prefetched before the walks), so the misses overlap. */
+/* Up to BATCH points: keys and cells first, each table entry prefetched, then the answers (the
+ * brick word, or the block of a level >= 1 reference, prefetched first), so the misses overlap. */
 static void batch_states(const occ_lookup_index_t *const ix, const occ_vec3_t *const pts,
                          const size_t n, occ_state_t *const out)
 {
@@ -132,19 +130,22 @@ static void batch_states(const occ_lookup_index_t *const ix, const occ_vec3_t *c
     for (size_t i = 0; i < n; i++) {
         in[i] = cell_of(ix, m, pts[i], &k[i], &cell[i]);
         if (in[i]) {
-            OCC_PREFETCH(cell_word(ix, cell[i]));
+            OCC_PREFETCH(&ix->priv.cells[cell[i]]);
         }
     }
     for (size_t i = 0; i < n; i++) {
-        w[i] = in[i] ? *cell_word(ix, cell[i]) : OCC_IDX_TAG;
-        if (ix->level == 1u && w[i] < OCC_IDX_TAG) {
+        w[i] = in[i] ? ix->priv.cells[cell[i]] : OCC_IDX_TAG;
+        if (ix->level == 0u && in[i]) {
+            unsigned sh;
+            OCC_PREFETCH(&ix->priv.bricks[occi_idx_brick_word(w[i], &k[i], &sh)]);
+        } else if (ix->level == 1u && w[i] < OCC_IDX_TAG) {
             OCC_PREFETCH(occ_leaf_at(m, w[i]));
         } else if (ix->level > 1u && w[i] < OCC_IDX_TAG) {
             OCC_PREFETCH(occ_inner_at(m, w[i]));
         }
     }
     for (size_t i = 0; i < n; i++) {
-        out[i] = in[i] ? cell_answer(ix, m, &k[i], cell[i], w[i]) : OCC_STATE_UNKNOWN;
+        out[i] = in[i] ? cell_answer(ix, m, &k[i], w[i]) : OCC_STATE_UNKNOWN;
     }
 }
 

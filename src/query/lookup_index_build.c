@@ -77,13 +77,13 @@ bool occi_idx_walk_next(occ_idx_walk_t *const w, const occ_map_t *const m, occ_i
     return false;
 }
 
-void occi_idx_box(const occ_map_t *const m, const unsigned level, uint32_t lo[3], uint32_t n[3])
+void occi_idx_box(const occ_map_t *const m, const unsigned shift, uint32_t lo[3], uint32_t n[3])
 {
     uint32_t mn[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX}, mx[3] = {0u, 0u, 0u};
     bool any = false;
     occ_idx_walk_t w;
     occ_idx_node_t nd;
-    occi_idx_walk_begin(&w, m, level);
+    occi_idx_walk_begin(&w, m, shift);
     while (occi_idx_walk_next(&w, m, &nd)) {
         any = true;
         for (unsigned a = 0; a < 3u; a++) {
@@ -93,19 +93,35 @@ void occi_idx_box(const occ_map_t *const m, const unsigned level, uint32_t lo[3]
         }
     }
     for (unsigned a = 0; a < 3u; a++) {
-        lo[a] = any ? (mn[a] >> level) << level : 0u;
-        n[a] = any ? (mx[a] >> level) - (mn[a] >> level) + 1u : 0u;
+        lo[a] = any ? (mn[a] >> shift) << shift : 0u;
+        n[a] = any ? (mx[a] >> shift) - (mn[a] >> shift) + 1u : 0u;
     }
 }
 
-size_t occi_idx_bytes(const unsigned level, const uint32_t n[3])
+size_t occi_idx_bytes(const unsigned level, const uint32_t n[3], const size_t mixed)
 {
     const size_t cells = occ_sat_mul(occ_sat_mul((size_t)n[0], (size_t)n[1]), (size_t)n[2]);
-    if (level == 0u) {
-        const size_t words = cells / OCC_IDX_PER_WORD + (cells % OCC_IDX_PER_WORD != 0u ? 1u : 0u);
-        return cells == SIZE_MAX ? SIZE_MAX : occ_sat_mul(words, sizeof(uint32_t));
+    if (level == 0u && cells != 0u) {
+        const size_t bricks = occ_sat_add(mixed, OCC_IDX_CONST_BRICKS);
+        return occ_sat_add(occ_sat_mul(cells, sizeof(uint32_t)),
+                           occ_sat_mul(bricks, OCC_IDX_BRICK_WORDS * sizeof(uint32_t)));
     }
     return occ_sat_mul(cells, sizeof(uint32_t));
+}
+
+/* Cells of 2^shift voxels per axis: 8x8x8 bricks at level 0. */
+static unsigned idx_shift(const unsigned level)
+{
+    return level == 0u ? OCC_IDX_BRICK_SHIFT : level;
+}
+
+/* Box and bytes of the table at `level`. */
+static size_t idx_size(const occ_map_t *const m, const unsigned level, uint32_t lo[3], uint32_t n[3],
+                       size_t *const mixed)
+{
+    occi_idx_box(m, idx_shift(level), lo, n);
+    *mixed = level == 0u && n[0] != 0u ? occi_idx_mixed(m) : 0u;
+    return occi_idx_bytes(level, n, *mixed);
 }
 
 occ_err_t occ_lookup_index_need(const occ_map_t *const map, const unsigned level, size_t *const bytes)
@@ -114,8 +130,8 @@ occ_err_t occ_lookup_index_need(const occ_map_t *const map, const unsigned level
         return OCC_ERR_ARG;
     }
     uint32_t lo[3], n[3];
-    occi_idx_box(map, level, lo, n);
-    *bytes = occi_idx_bytes(level, n);
+    size_t mixed;
+    *bytes = idx_size(map, level, lo, n, &mixed);
     return OCC_OK;
 }
 
@@ -144,7 +160,7 @@ static size_t cell_at(const occ_lookup_index_t *const ix, const uint32_t k[3])
            (size_t)((k[1] - ix->lo[1]) >> L) * ix->priv.stride_y + (size_t)((k[2] - ix->lo[2]) >> L);
 }
 
-/* Every cell of the uniform node nd (state s, inside the box) gets s. */
+/* Every cell of the uniform node nd (state s, inside the box) gets its tag. */
 static void fill_node(const occ_lookup_index_t *ix, uint32_t *cells, const occ_idx_node_t *nd,
                       const occ_state_t s)
 {
@@ -156,24 +172,19 @@ static void fill_node(const occ_lookup_index_t *ix, uint32_t *cells, const occ_i
         for (uint32_t y = 0; y < span; y++) {
             const size_t row = c0 + (size_t)x * ix->priv.stride_x + (size_t)y * ix->priv.stride_y;
             for (uint32_t z = 0; z < span; z++) {
-                const size_t c = row + z;
-                if (L == 0u) {
-                    cells[c / OCC_IDX_PER_WORD] |= (uint32_t)s << (2u * (c % OCC_IDX_PER_WORD));
-                } else {
-                    cells[c] = OCC_IDX_TAG | (uint32_t)s;
-                }
+                cells[row + z] = OCC_IDX_TAG | (uint32_t)s;
             }
         }
     }
 }
 
-/* The table: UNKNOWN everywhere, then every node the walk reports down to the level. */
+/* A level >= 1 table: UNKNOWN everywhere, then every node the walk reports down to the level. */
 static void fill_table(const occ_lookup_index_t *const ix, const occ_map_t *const m,
                        uint32_t *const cells)
 {
     const size_t words = ix->bytes / sizeof(uint32_t);
     for (size_t i = 0; i < words; i++) {
-        cells[i] = ix->level == 0u ? 0u : OCC_IDX_TAG | (uint32_t)OCC_STATE_UNKNOWN;
+        cells[i] = OCC_IDX_TAG | (uint32_t)OCC_STATE_UNKNOWN;
     }
     occ_idx_walk_t w;
     occ_idx_node_t nd;
@@ -204,9 +215,13 @@ occ_err_t occ_lookup_index_build(occ_lookup_index_t *const idx, const occ_map_t 
     if (map->inner.hwm >= OCC_IDX_TAG || map->leaf.hwm >= OCC_IDX_TAG) {
         return OCC_ERR_UNSUPPORTED;
     }
-    occi_idx_box(map, level, idx->lo, idx->n);
+    size_t mixed;
+    idx->bytes = idx_size(map, level, idx->lo, idx->n, &mixed);
     idx->level = (uint8_t)level;
-    idx->bytes = occi_idx_bytes(level, idx->n);
+    idx->priv.shift = (uint8_t)idx_shift(level);
+    if (mixed > (size_t)(UINT32_MAX - OCC_IDX_CONST_BRICKS)) {
+        return OCC_ERR_UNSUPPORTED; /* brick numbers are 32-bit */
+    }
     if (idx->bytes != 0u && mem == NULL) {
         return OCC_ERR_ARG;
     }
@@ -217,10 +232,15 @@ occ_err_t occ_lookup_index_build(occ_lookup_index_t *const idx, const occ_map_t 
     uint32_t *const cells = idx->bytes == 0u ? NULL : (uint32_t *)(void *)((uint8_t *)mem + pad);
     idx->priv.stride_y = idx->n[2];
     idx->priv.stride_x = (size_t)idx->n[1] * (size_t)idx->n[2];
-    if (cells != NULL) {
+    const size_t n_cells = (size_t)idx->n[0] * idx->priv.stride_x;
+    uint32_t *const bricks = cells == NULL || level != 0u ? NULL : cells + n_cells;
+    if (bricks != NULL) {
+        occi_idx_fill_bricks(idx, map, cells, bricks, mixed);
+    } else if (cells != NULL) {
         fill_table(idx, map, cells);
     }
     idx->priv.cells = cells;
+    idx->priv.bricks = bricks;
     idx->priv.gen = map->write_gen;
     idx->priv.root = map->priv.root_child;
     idx->priv.arena = map->priv.arena;

@@ -14,8 +14,24 @@
  * without children. Block indices stay below OCC_IDX_TAG (the build checks the pools). */
 #define OCC_IDX_TAG 0xFFFFFFFCu
 
-/* A level-0 table: 16 voxel states of 2 bits per 32-bit word, voxel i at bits 2 (i mod 16). */
+/* A level-0 table is a directory of 8x8x8-voxel bricks (one 32-bit brick number per brick of the
+ * box, x major) and the bricks it names: 512 voxel states of 2 bits = 32 words each, voxel
+ * (x, y, z) of the brick (low 3 key bits) at index 64 x + 8 y + z, 16 per word at bits 2 (i mod
+ * 16). Bricks 0, 1, 2 are constant (all UNKNOWN, FREE, OCCUPIED: brick number = state), so a
+ * brick of one state costs only its directory entry; the mixed bricks follow. */
+#define OCC_IDX_BRICK_SHIFT 3u
+#define OCC_IDX_BRICK_WORDS 32u
+#define OCC_IDX_CONST_BRICKS 3u
 #define OCC_IDX_PER_WORD 16u
+
+/* Word and shift of key k's voxel in brick b. */
+static inline size_t occi_idx_brick_word(const uint32_t b, const occ_key_t *const k,
+                                         unsigned *const shift)
+{
+    const uint32_t v = ((k->k[0] & 7u) << 6) | ((k->k[1] & 7u) << 3) | (k->k[2] & 7u);
+    *shift = 2u * (v % OCC_IDX_PER_WORD);
+    return (size_t)b * OCC_IDX_BRICK_WORDS + v / OCC_IDX_PER_WORD;
+}
 
 /* A node the walk reports: without children (observed only), or at the stop level. */
 typedef struct {
@@ -38,10 +54,17 @@ typedef struct {
 void occi_idx_walk_begin(occ_idx_walk_t *w, const occ_map_t *m, unsigned stop);
 bool occi_idx_walk_next(occ_idx_walk_t *w, const occ_map_t *m, occ_idx_node_t *out);
 
-/* Cells per axis and first keys of the table at `level` over the observed space (n = 0 when
- * nothing is observed). */
-void occi_idx_box(const occ_map_t *m, unsigned level, uint32_t lo[3], uint32_t n[3]);
-/* Table bytes for n cells per axis at `level` (SIZE_MAX when it does not fit). */
-size_t occi_idx_bytes(unsigned level, const uint32_t n[3]);
+/* Cells per axis and first keys of the table with cells of 2^shift voxels per axis over the
+ * observed space (n = 0 when nothing is observed). */
+void occi_idx_box(const occ_map_t *m, unsigned shift, uint32_t lo[3], uint32_t n[3]);
+/* Table bytes for n cells per axis at `level` (SIZE_MAX when it does not fit); `mixed` bricks at
+ * level 0. */
+size_t occi_idx_bytes(unsigned level, const uint32_t n[3], size_t mixed);
+
+/* Level 0 (lookup_index_bricks.c): the bricks that hold more than one state, and the fill of
+ * the directory (ix->priv.cells) and of `mixed` bricks after the constant ones. */
+size_t occi_idx_mixed(const occ_map_t *m);
+void occi_idx_fill_bricks(const occ_lookup_index_t *ix, const occ_map_t *m, uint32_t *dir,
+                          uint32_t *bricks, size_t mixed);
 
 #endif

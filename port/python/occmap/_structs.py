@@ -132,8 +132,9 @@ Lookup = _s("occ_lookup_t", [
     ("map", C.c_void_p), ("key", Key), ("lu", C.c_uint8), ("valid", C.c_bool), ("val", value_t),
     ("blk", C.c_uint32 * (MAX_DEPTH + 1)), ("gen", C.c_uint32)])
 LookupIndexPriv = _s("occ_lookup_index_priv", [
-    ("cells", C.c_void_p), ("stride_y", C.c_size_t), ("stride_x", C.c_size_t),
-    ("gen", C.c_uint32), ("root", C.c_uint32), ("arena", C.c_void_p)])
+    ("cells", C.c_void_p), ("bricks", C.c_void_p), ("stride_y", C.c_size_t),
+    ("stride_x", C.c_size_t), ("shift", C.c_uint8), ("gen", C.c_uint32), ("root", C.c_uint32),
+    ("arena", C.c_void_p)])
 LookupIndex = _s("occ_lookup_index_t", [
     ("map", C.c_void_p), ("level", C.c_uint8), ("lo", C.c_uint32 * 3), ("n", C.c_uint32 * 3),
     ("bytes", C.c_size_t), ("priv", LookupIndexPriv)])
