@@ -22,16 +22,21 @@ occ_key_t occ_morton_decode(const occ_code_t code)
     return key;
 }
 #else
-/* Spread the low 21 bits of v to every third bit (magic-bits method). */
+/* Seven bits spread to every third bit (bit b to bit 3 b), 512 bytes: three look-ups spread a
+ * 21-bit key, about a third of the magic-bits steps' instructions (two codes per ray walk). */
+#define SP7(v)                                                                                    \
+    ((uint32_t)(((v) & 1u) | (((v) & 2u) << 2) | (((v) & 4u) << 4) | (((v) & 8u) << 6) |          \
+                (((v) & 16u) << 8) | (((v) & 32u) << 10) | (((v) & 64u) << 12)))
+#define SP7_4(b) SP7(b), SP7((b) + 1u), SP7((b) + 2u), SP7((b) + 3u)
+#define SP7_16(b) SP7_4(b), SP7_4((b) + 4u), SP7_4((b) + 8u), SP7_4((b) + 12u)
+#define SP7_64(b) SP7_16(b), SP7_16((b) + 16u), SP7_16((b) + 32u), SP7_16((b) + 48u)
+static const uint32_t spread7[128] = {SP7_64(0u), SP7_64(64u)};
+
+/* Spread the low 21 bits of v to every third bit. */
 static uint64_t spread3(const uint32_t v)
 {
-    uint64_t x = v & 0x1FFFFFu;
-    x = (x | (x << 32)) & 0x001F00000000FFFFull;
-    x = (x | (x << 16)) & 0x001F0000FF0000FFull;
-    x = (x | (x << 8)) & 0x100F00F00F00F00Full;
-    x = (x | (x << 4)) & 0x10C30C30C30C30C3ull;
-    x = (x | (x << 2)) & 0x1249249249249249ull;
-    return x;
+    return (uint64_t)spread7[v & 127u] | ((uint64_t)spread7[(v >> 7) & 127u] << 21) |
+           ((uint64_t)spread7[(v >> 14) & 127u] << 42);
 }
 
 static uint32_t compact3(const uint64_t code)

@@ -319,6 +319,9 @@ static OCC_ALWAYS_INLINE void mark_walk(mwalk_t *const w, occ_vset_t *const vs, 
     }
 done:
     w->c = c;
+    w->n[0] = n0;
+    w->n[1] = n1;
+    w->n[2] = n2;
 }
 
 /* The eight octants' walks, out of line: one frame under occi_dda_mark's (make cross). */
@@ -371,9 +374,14 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     default: mark_nnn(&w, vs, cw); break;
     }
     /* Visits: the origin and one per step but the last (the end, or past the length), i.e. the
-     * steps; each moves one key by one toward the end, so they sum to the keys' distance. */
-    const occ_key_t kf = occ_morton_decode(w.c);
-    return occi_dda_bound(ko, kf.k) - 4u;
+     * steps, which the chunk countdowns and chunk moves count per axis (no decode). */
+    size_t visits = 0;
+    for (unsigned i = 0; i < 3u; i++) {
+        const uint32_t c0 = ko[i] >> 5;
+        const uint32_t moves = w.dd.step[i] < 0 ? c0 - w.cc[i] : w.cc[i] - c0;
+        visits += (size_t)chunk_countdown(ko[i], w.dd.step[i]) - w.n[i] + 32u * (size_t)moves;
+    }
+    return visits;
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */
