@@ -16,12 +16,18 @@ static void axis_products(const occ_proj_t *const x, const uint32_t k[3], const 
 {
     const occ_proj_camera_t *const cam = x->cam;
     const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
+    const uint32_t hi = level == 2u ? 2u : 0u; /* offsets 2, 3 (level 1: 0, 1 again) */
     for (unsigned a = 0; a < 3u; a++) {
-        for (unsigned o = 0; o < 4u; o++) {
-            const uint32_t off = level == 2u ? o : (o & 1u);
-            const float w = occi_raygeo_center(&x->g, k[a] + off) - t[a];
-            for (unsigned b = 0; b < 3u; b++) {
-                p[a][b][o] = cam->r[a][b] * w;
+        /* occi_raygeo_center's values, inline: a call per offset spilled every register */
+        const occ_real_t res = x->g.res;
+        const int32_t tmv = x->g.tmv;
+        const float w[4] = {(float)occ_geom_center_of(res, tmv, k[a], 0u) - t[a],
+                            (float)occ_geom_center_of(res, tmv, k[a] + 1u, 0u) - t[a],
+                            (float)occ_geom_center_of(res, tmv, k[a] + hi, 0u) - t[a],
+                            (float)occ_geom_center_of(res, tmv, k[a] + hi + 1u, 0u) - t[a]};
+        for (unsigned b = 0; b < 3u; b++) {
+            for (unsigned o = 0; o < 4u; o++) {
+                p[a][b][o] = cam->r[a][b] * w[o];
             }
         }
     }
