@@ -19,7 +19,9 @@ static bool key_in_range(const occ_map_t *const m, const occ_key_t key)
 }
 
 /* Max, indicator flags and "all eight equal" of a block's values, without data-dependent
- * branches (refresh runs once per written block: its compares would mispredict). */
+ * branches (refresh runs once per written block: its compares would mispredict). The flags
+ * from counts (occupied; free and not occupied; the rest unknown), so that the loop is only
+ * compares, sums and a max, which a host compiler turns into a few vector operations. */
 typedef struct {
     occ_value_t max;
     uint8_t flags;
@@ -28,15 +30,22 @@ typedef struct {
 
 static summary8_t summarize8(const occ_map_t *const m, const occ_value_t *const v)
 {
-    summary8_t s;
-    s.max = v[0];
-    s.flags = 0u;
-    s.same = true;
+    const occ_value_t occ_min = m->priv.q_occ_min, free_max = m->priv.q_free_max, v0 = v[0];
+    occ_value_t mx = v0;
+    unsigned n_occ = 0, n_free = 0, n_same = 0;
     for (unsigned i = 0; i < 8u; i++) {
-        s.max = v[i] > s.max ? v[i] : s.max;
-        s.flags = (uint8_t)(s.flags | occ_value_flags_nb(m, v[i]));
-        s.same = s.same & occ_value_eq(v[i], v[0]);
+        mx = v[i] > mx ? v[i] : mx;
+        n_occ += (unsigned)(v[i] >= occ_min);
+        n_free += (unsigned)occ_is_observed(v[i]) & (unsigned)(v[i] < free_max) &
+                  (unsigned)(v[i] < occ_min);
+        n_same += (unsigned)occ_value_eq(v[i], v0);
     }
+    summary8_t s;
+    s.max = mx;
+    s.flags = (uint8_t)((n_occ != 0u ? OCC_NODE_HAS_OCCUPIED : 0u) |
+                        (n_free != 0u ? OCC_NODE_HAS_FREE : 0u) |
+                        (n_occ + n_free < 8u ? OCC_NODE_HAS_UNKNOWN : 0u));
+    s.same = n_same == 8u;
     return s;
 }
 

@@ -259,15 +259,29 @@ static void node_step(occ_map_t *const m, path_t *const p, const entry_t *const 
     p->dirty[lv + 1u] = true;
 }
 
+/* Can the pools supply the blocks the pass may allocate? First a crude bound in O(1), above
+ * frame_need's (each voxel entry at most one leaf block, each entry at most depth - 1 inner
+ * ones): when the pools can supply it, the exact count (a pass over every entry) is not needed. */
+static bool frame_fits(const occ_map_t *const m, const occi_frame_t *const f)
+{
+    const uint64_t nvox = (uint64_t)f->nh + f->nv;
+    const uint64_t crude_inner = (nvox + f->nn) * (m->cfg.depth_levels - 1u);
+    if (crude_inner <= OCC_NONE && nvox <= OCC_NONE &&
+        occi_pool_can_supply(m, (uint32_t)crude_inner, (uint32_t)nvox)) {
+        return true;
+    }
+    uint64_t inner, leaf;
+    frame_need(m, f, &inner, &leaf);
+    return inner <= OCC_NONE && leaf <= OCC_NONE &&
+           occi_pool_can_supply(m, (uint32_t)inner, (uint32_t)leaf);
+}
+
 occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
                                 occi_frame_out_t *const out)
 {
     out->changed = 0u;
     out->dropped = 0u;
-    uint64_t inner, leaf;
-    frame_need(m, f, &inner, &leaf);
-    if (inner > OCC_NONE || leaf > OCC_NONE ||
-        !occi_pool_can_supply(m, (uint32_t)inner, (uint32_t)leaf)) {
+    if (!frame_fits(m, f)) {
         m->oom_count++;
         return OCC_ERR_NOMEM;
     }

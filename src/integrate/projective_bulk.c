@@ -16,22 +16,37 @@ static void axis_products(const occ_proj_t *const x, const uint32_t k[3], const 
 {
     const occ_proj_camera_t *const cam = x->cam;
     const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
+    const uint32_t hi = level == 2u ? 2u : 0u; /* offsets 2, 3 (level 1: 0, 1 again) */
     for (unsigned a = 0; a < 3u; a++) {
-        for (unsigned o = 0; o < 4u; o++) {
-            const uint32_t off = level == 2u ? o : (o & 1u);
-            const float w = occi_raygeo_center(&x->g, k[a] + off) - t[a];
-            for (unsigned b = 0; b < 3u; b++) {
-                p[a][b][o] = cam->r[a][b] * w;
+        /* occi_raygeo_center's values, inline: a call per offset spilled every register */
+        const occ_real_t res = x->g.res;
+        const int32_t tmv = x->g.tmv;
+        const float w[4] = {(float)occ_geom_center_of(res, tmv, k[a], 0u) - t[a],
+                            (float)occ_geom_center_of(res, tmv, k[a] + 1u, 0u) - t[a],
+                            (float)occ_geom_center_of(res, tmv, k[a] + hi, 0u) - t[a],
+                            (float)occ_geom_center_of(res, tmv, k[a] + hi + 1u, 0u) - t[a]};
+        for (unsigned b = 0; b < 3u; b++) {
+            for (unsigned o = 0; o < 4u; o++) {
+                p[a][b][o] = cam->r[a][b] * w[o];
             }
         }
+    }
+}
+
+/* Four lanes: a row of x + y sums plus a z term. */
+static void add4(float *const out, const float *const row, const float z)
+{
+    for (unsigned l = 0; l < 4u; l++) {
+        out[l] = row[l] + z;
     }
 }
 
 /* Camera-frame centres q[b][m] = (p[0][b][x] + p[1][b][y]) + p[2][b][z] of the voxels in
  * Morton lanes m (x = bits 0 and 3 of m, y = 1 and 4, z = 2 and 5). Four consecutive lanes
  * share z and the high bits while (x0, y0) runs (0,0) (1,0) (0,1) (1,1): per high x and y bit
- * a row of four x + y sums, shared by the four z. The groups of four in nested loops with
- * constant trip counts: no index arithmetic per group, one vector add each. */
+ * a row of four x + y sums, shared by the four z. The 16 groups of four written out (group
+ * g = z0 | x1 << 1 | y1 << 2 | z1 << 3 at lane 4 g): gcc leaves loops of two trips rolled,
+ * and their counting cost more than the adds. */
 static void centres(const float p[3][3][4], float q[3][OCC_PROJ_BULK])
 {
     for (unsigned b = 0; b < 3u; b++) {
@@ -49,19 +64,24 @@ static void centres(const float p[3][3][4], float q[3][OCC_PROJ_BULK])
                 }
             }
         }
-        float *out = q[b];
-        for (unsigned z1 = 0; z1 < 2u; z1++) { /* group = z0 | x1 << 1 | y1 << 2 | z1 << 3 */
-            for (unsigned y1 = 0; y1 < 2u; y1++) {
-                for (unsigned x1 = 0; x1 < 2u; x1++) {
-                    for (unsigned z0 = 0; z0 < 2u; z0++, out += 4) {
-                        const float z = p[2][b][z0 | (z1 << 1)];
-                        for (unsigned l = 0; l < 4u; l++) {
-                            out[l] = xy[y1][x1][l] + z;
-                        }
-                    }
-                }
-            }
-        }
+        const float *const z = p[2][b]; /* z[z0 | z1 << 1] */
+        float *const out = q[b];
+        add4(out + 0, xy[0][0], z[0]);
+        add4(out + 4, xy[0][0], z[1]);
+        add4(out + 8, xy[0][1], z[0]);
+        add4(out + 12, xy[0][1], z[1]);
+        add4(out + 16, xy[1][0], z[0]);
+        add4(out + 20, xy[1][0], z[1]);
+        add4(out + 24, xy[1][1], z[0]);
+        add4(out + 28, xy[1][1], z[1]);
+        add4(out + 32, xy[0][0], z[2]);
+        add4(out + 36, xy[0][0], z[3]);
+        add4(out + 40, xy[0][1], z[2]);
+        add4(out + 44, xy[0][1], z[3]);
+        add4(out + 48, xy[1][0], z[2]);
+        add4(out + 52, xy[1][0], z[3]);
+        add4(out + 56, xy[1][1], z[2]);
+        add4(out + 60, xy[1][1], z[3]);
     }
 }
 

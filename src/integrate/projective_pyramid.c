@@ -104,21 +104,51 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
     x->dmax = x->mx[l][0]; /* -inf: no reading at all */
 }
 
+/* floor(log2 w), w >= 1. */
+static uint32_t floor_log2(uint32_t w)
+{
+#if defined(__GNUC__)
+    return 31u - (uint32_t)__builtin_clz(w);
+#else
+    uint32_t f = 0;
+    while (w > 1u) {
+        w >>= 1;
+        f++;
+    }
+    return f;
+#endif
+}
+
+/* The lowest level at which pixels i0..i1 fall in at most 3 cells, without a loop whose exit
+ * mispredicts: with f = floor(log2 (i1 - i0)) they fall in at most 3 at level f and in at
+ * least 5 at f - 2 (a cell count is monotone in the level), so it is f - 1 or f. */
+static uint32_t span_level(const uint32_t i0, const uint32_t i1)
+{
+    const uint32_t w = i1 - i0;
+    const uint32_t f = floor_log2(w | 1u);
+    const uint32_t c = f > 0u ? f - 1u : 0u;
+    const uint32_t l = ((i1 >> c) - (i0 >> c)) <= 2u ? c : f;
+    return w <= 2u ? 0u : l;
+}
+
 void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_t i1,
                      const uint32_t j0, const uint32_t j1, float *const mn, float *const mx)
 {
-    unsigned l = 0;
-    while (((i1 >> l) - (i0 >> l)) > 2u || ((j1 >> l) - (j0 >> l)) > 2u) {
-        l++;
-    }
+    const uint32_t li = span_level(i0, i1), lj = span_level(j0, j1);
+    const unsigned l = li > lj ? li : lj;
     OCC_ASSERT(l < x->levels);
+    /* The 1..3 cells per axis as a fixed 3 x 3 window (the middle one repeated where a span
+     * has fewer: min and max do not mind), so that no loop bound depends on the footprint
+     * (their exits mispredicted). */
     const uint32_t a0 = i0 >> l, a1 = i1 >> l, b0 = j0 >> l, b1 = j1 >> l;
+    const uint32_t am = a0 + 1u < a1 ? a0 + 1u : a1, bm = b0 + 1u < b1 ? b0 + 1u : b1;
+    const uint32_t ac[3] = {a0, am, a1}, br[3] = {b0, bm, b1};
     const uint32_t lw = x->lw[l];
     const float *const pmn = x->mn[l], *const pmx = x->mx[l];
     float lo = INFINITY, hi = -INFINITY;
-    for (uint32_t b = b0; b <= b1; b++) {
-        for (uint32_t a = a0; a <= a1; a++) {
-            const size_t k = (size_t)b * lw + a;
+    for (unsigned b = 0; b < 3u; b++) {
+        for (unsigned a = 0; a < 3u; a++) {
+            const size_t k = (size_t)br[b] * lw + ac[a];
             lo = lo_of(lo, pmn[k]);
             hi = hi_of(hi, pmx[k]);
         }

@@ -301,6 +301,24 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
     }
 }
 
+/* A byte's voxels (bit j: code cc | j) to the output in code order, without a branch per
+ * voxel (the bits fall at random): all eight written, the count moving past the set ones. The
+ * caller checked room for them all; the slots written past the count (rewritten later) count
+ * in the high-water mark. */
+static void emit_byte(occ_proj_t *x, const occ_code_t cc, const unsigned byte)
+{
+    const size_t at = x->nh + x->nr + x->nv;
+    occ_code_t *const out = x->out + at;
+    size_t k = 0;
+    for (unsigned j = 0; j < 8u; j++) {
+        out[k] = cc | j;
+        k += (byte >> j) & 1u;
+    }
+    x->nv += k;
+    const size_t hi = at + 8u + x->nn;
+    x->hwm = x->hwm > hi ? x->hwm : hi;
+}
+
 /* The voxels of a MIXED node at level 1 or 2, by the rule (occi_proj_bulk; hits are
  * occi_proj_pixels'). Whole free nodes where every voxel below is free and holds no end point
  * (the same updates, fewer slots): the node itself (level 2; level 1 when may_merge) or its
@@ -327,15 +345,13 @@ static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code
         return;
     }
     for (unsigned c = 0; c < n / 8u; c++) {
-        unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
+        const unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
         const occ_code_t cc = code | ((occ_code_t)c << 3);
         if (byte == 0xFFu && (level == 2u || may_merge) && !holds_hit(x, cc, 1u)) {
             emit_node(x, cc, 1u);
             continue;
         }
-        for (; byte != 0u; byte &= byte - 1u) {
-            emit_voxel(x, cc | (occ_code_t)__builtin_ctz(byte));
-        }
+        emit_byte(x, cc, byte);
     }
 }
 
