@@ -1,6 +1,17 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* morton.c - 3 x 21-bit key <-> 63-bit Morton code (x in bit 0, y in bit 1, z in bit 2). */
 #include "occmap/occmap.h"
+#include "morton_internal.h"
+
+/* Bit b of the index at bit 3 b (the table behind occi_morton_spread21; also in BMI2 builds,
+ * where the projective pass still reads it). */
+#define SP7(v)                                                                                    \
+    ((uint32_t)(((v) & 1u) | (((v) & 2u) << 2) | (((v) & 4u) << 4) | (((v) & 8u) << 6) |          \
+                (((v) & 16u) << 8) | (((v) & 32u) << 10) | (((v) & 64u) << 12)))
+#define SP7_4(b) SP7(b), SP7((b) + 1u), SP7((b) + 2u), SP7((b) + 3u)
+#define SP7_16(b) SP7_4(b), SP7_4((b) + 4u), SP7_4((b) + 8u), SP7_4((b) + 12u)
+#define SP7_64(b) SP7_16(b), SP7_16((b) + 16u), SP7_16((b) + 32u), SP7_16((b) + 48u)
+const uint32_t occi_morton_spread7[128] = {SP7_64(0u), SP7_64(64u)};
 
 #if OCC_USE_BMI2
 #include <immintrin.h>
@@ -22,23 +33,6 @@ occ_key_t occ_morton_decode(const occ_code_t code)
     return key;
 }
 #else
-/* Seven bits spread to every third bit (bit b to bit 3 b), 512 bytes: three look-ups spread a
- * 21-bit key, about a third of the magic-bits steps' instructions (two codes per ray walk). */
-#define SP7(v)                                                                                    \
-    ((uint32_t)(((v) & 1u) | (((v) & 2u) << 2) | (((v) & 4u) << 4) | (((v) & 8u) << 6) |          \
-                (((v) & 16u) << 8) | (((v) & 32u) << 10) | (((v) & 64u) << 12)))
-#define SP7_4(b) SP7(b), SP7((b) + 1u), SP7((b) + 2u), SP7((b) + 3u)
-#define SP7_16(b) SP7_4(b), SP7_4((b) + 4u), SP7_4((b) + 8u), SP7_4((b) + 12u)
-#define SP7_64(b) SP7_16(b), SP7_16((b) + 16u), SP7_16((b) + 32u), SP7_16((b) + 48u)
-static const uint32_t spread7[128] = {SP7_64(0u), SP7_64(64u)};
-
-/* Spread the low 21 bits of v to every third bit. */
-static uint64_t spread3(const uint32_t v)
-{
-    return (uint64_t)spread7[v & 127u] | ((uint64_t)spread7[(v >> 7) & 127u] << 21) |
-           ((uint64_t)spread7[(v >> 14) & 127u] << 42);
-}
-
 static uint32_t compact3(const uint64_t code)
 {
     uint64_t x = code & 0x1249249249249249ull;
@@ -52,7 +46,8 @@ static uint32_t compact3(const uint64_t code)
 
 occ_code_t occ_morton_encode(const occ_key_t key)
 {
-    return spread3(key.k[0]) | (spread3(key.k[1]) << 1) | (spread3(key.k[2]) << 2);
+    return occi_morton_spread21(key.k[0]) | (occi_morton_spread21(key.k[1]) << 1) |
+           (occi_morton_spread21(key.k[2]) << 2);
 }
 
 occ_key_t occ_morton_decode(const occ_code_t code)

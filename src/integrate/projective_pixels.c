@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "projective_internal.h"
+#include "../core/morton_internal.h"
 
 /* A key offset no pixel gets (offsets are clamped to +-OCC_PROJ_KEY_LIM). */
 #define NO_VOXEL INT32_MIN
@@ -248,40 +249,14 @@ static size_t filter_slot(const occ_code_t c)
     return (size_t)((c ^ (c >> 17) ^ (c >> 31)) & (OCC_PROJ_FILTER_N - 1u));
 }
 
-/* Bit b of the index at bit 3 b: seven key bits spread for the Morton code (512 bytes of
- * constants; three look-ups per axis of 21 bits replace the bit-spreading steps). */
-static const uint32_t spread7[128] = {
-    0x000000u, 0x000001u, 0x000008u, 0x000009u, 0x000040u, 0x000041u, 0x000048u, 0x000049u,
-    0x000200u, 0x000201u, 0x000208u, 0x000209u, 0x000240u, 0x000241u, 0x000248u, 0x000249u,
-    0x001000u, 0x001001u, 0x001008u, 0x001009u, 0x001040u, 0x001041u, 0x001048u, 0x001049u,
-    0x001200u, 0x001201u, 0x001208u, 0x001209u, 0x001240u, 0x001241u, 0x001248u, 0x001249u,
-    0x008000u, 0x008001u, 0x008008u, 0x008009u, 0x008040u, 0x008041u, 0x008048u, 0x008049u,
-    0x008200u, 0x008201u, 0x008208u, 0x008209u, 0x008240u, 0x008241u, 0x008248u, 0x008249u,
-    0x009000u, 0x009001u, 0x009008u, 0x009009u, 0x009040u, 0x009041u, 0x009048u, 0x009049u,
-    0x009200u, 0x009201u, 0x009208u, 0x009209u, 0x009240u, 0x009241u, 0x009248u, 0x009249u,
-    0x040000u, 0x040001u, 0x040008u, 0x040009u, 0x040040u, 0x040041u, 0x040048u, 0x040049u,
-    0x040200u, 0x040201u, 0x040208u, 0x040209u, 0x040240u, 0x040241u, 0x040248u, 0x040249u,
-    0x041000u, 0x041001u, 0x041008u, 0x041009u, 0x041040u, 0x041041u, 0x041048u, 0x041049u,
-    0x041200u, 0x041201u, 0x041208u, 0x041209u, 0x041240u, 0x041241u, 0x041248u, 0x041249u,
-    0x048000u, 0x048001u, 0x048008u, 0x048009u, 0x048040u, 0x048041u, 0x048048u, 0x048049u,
-    0x048200u, 0x048201u, 0x048208u, 0x048209u, 0x048240u, 0x048241u, 0x048248u, 0x048249u,
-    0x049000u, 0x049001u, 0x049008u, 0x049009u, 0x049040u, 0x049041u, 0x049048u, 0x049049u,
-    0x049200u, 0x049201u, 0x049208u, 0x049209u, 0x049240u, 0x049241u, 0x049248u, 0x049249u
-};
-
-static occ_code_t spread21(const uint32_t k)
-{
-    return (occ_code_t)spread7[k & 127u] | ((occ_code_t)spread7[(k >> 7) & 127u] << 21) |
-           ((occ_code_t)spread7[(k >> 14) & 127u] << 42);
-}
-
 /* The hit code of column i's end point (its key is on the map: 21 bits per axis at most). */
 static occ_code_t code_at(const occ_proj_t *const x, const uint32_t i)
 {
     const uint32_t k[3] = {(uint32_t)(x->kcam[0] + x->px.kc[0][i]),
                            (uint32_t)(x->kcam[1] + x->px.kc[1][i]),
                            (uint32_t)(x->kcam[2] + x->px.kc[2][i])};
-    const occ_code_t c = spread21(k[0]) | (spread21(k[1]) << 1) | (spread21(k[2]) << 2) |
+    const occ_code_t c = occi_morton_spread21(k[0]) | (occi_morton_spread21(k[1]) << 1) |
+                         (occi_morton_spread21(k[2]) << 2) |
                          OCC_CODE_HIT_BIT;
     const occ_key_t key = {{k[0], k[1], k[2]}}; /* the check's only (tests) */
     OCC_ASSERT(c == (occ_morton_encode(key) | OCC_CODE_HIT_BIT));
