@@ -111,17 +111,8 @@ static void brick_add(brick_run_t *const r, const occ_idx_node_t *const nd, cons
 /* Every directory entry of a node at or above the brick level gets its constant brick. */
 static void dir_fill(const brick_run_t *const r, const occ_idx_node_t *const nd, const occ_state_t s)
 {
-    const occ_lookup_index_t *const ix = r->ix;
     const uint32_t span = 1u << (nd->level - OCC_IDX_BRICK_SHIFT);
-    const size_t d0 = dir_at(ix, nd->key.k);
-    for (uint32_t x = 0; x < span; x++) {
-        for (uint32_t y = 0; y < span; y++) {
-            const size_t row = d0 + (size_t)x * ix->priv.stride_x + (size_t)y * ix->priv.stride_y;
-            for (uint32_t z = 0; z < span; z++) {
-                r->dir[row + z] = (uint32_t)s;
-            }
-        }
-    }
+    occi_idx_fill_cube(r->ix, r->dir, dir_at(r->ix, nd->key.k), span, (uint32_t)s);
 }
 
 /* The walk down to the voxels: FREE and OCCUPIED nodes into their bricks (UNKNOWN is what an

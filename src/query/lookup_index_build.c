@@ -160,22 +160,27 @@ static size_t cell_at(const occ_lookup_index_t *const ix, const uint32_t k[3])
            (size_t)((k[1] - ix->lo[1]) >> L) * ix->priv.stride_y + (size_t)((k[2] - ix->lo[2]) >> L);
 }
 
+void occi_idx_fill_cube(const occ_lookup_index_t *const ix, uint32_t *const table, const size_t c0,
+                        const uint32_t span, const uint32_t word)
+{
+    for (uint32_t x = 0; x < span; x++) {
+        for (uint32_t y = 0; y < span; y++) {
+            const size_t row = c0 + (size_t)x * ix->priv.stride_x + (size_t)y * ix->priv.stride_y;
+            for (uint32_t z = 0; z < span; z++) {
+                table[row + z] = word;
+            }
+        }
+    }
+}
+
 /* Every cell of the uniform node nd (state s, inside the box) gets its tag. */
 static void fill_node(const occ_lookup_index_t *ix, uint32_t *cells, const occ_idx_node_t *nd,
                       const occ_state_t s)
 {
     const unsigned L = ix->level;
     OCC_ASSERT(nd->level >= L);
-    const uint32_t span = 1u << (nd->level - L);
-    const size_t c0 = cell_at(ix, nd->key.k);
-    for (uint32_t x = 0; x < span; x++) {
-        for (uint32_t y = 0; y < span; y++) {
-            const size_t row = c0 + (size_t)x * ix->priv.stride_x + (size_t)y * ix->priv.stride_y;
-            for (uint32_t z = 0; z < span; z++) {
-                cells[row + z] = OCC_IDX_TAG | (uint32_t)s;
-            }
-        }
-    }
+    occi_idx_fill_cube(ix, cells, cell_at(ix, nd->key.k), 1u << (nd->level - L),
+                       OCC_IDX_TAG | (uint32_t)s);
 }
 
 /* A level >= 1 table: UNKNOWN everywhere, then every node the walk reports down to the level. */

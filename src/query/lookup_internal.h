@@ -60,6 +60,10 @@ void occi_idx_box(const occ_map_t *m, unsigned shift, uint32_t lo[3], uint32_t n
 /* Table bytes for n cells per axis at `level` (SIZE_MAX when it does not fit); `mixed` bricks at
  * level 0. */
 size_t occi_idx_bytes(unsigned level, const uint32_t n[3], size_t mixed);
+/* The cube of span^3 table entries from entry c0 (the table's strides) set to `word`: a uniform
+ * node's cells, or its bricks' directory entries. */
+void occi_idx_fill_cube(const occ_lookup_index_t *ix, uint32_t *table, size_t c0, uint32_t span,
+                        uint32_t word);
 
 /* Level 0 (lookup_index_bricks.c): the bricks that hold more than one state, and the fill of
  * the directory (ix->priv.cells) and of `mixed` bricks after the constant ones. */
