@@ -255,6 +255,19 @@ static occ_value_t *path_leaf(const occ_map_t *const m, const path_t *const p)
                                                          : NULL;
 }
 
+/* path_start for a voxel in another leaf block of the level-2 node the path ends in (the path
+ * ends in a leaf block): only the level-1 node is finished. */
+static unsigned sibling_start(occ_map_t *const m, path_t *const p)
+{
+    if (p->dirty[1]) {
+        p->dirty[1] = false;
+        if (occi_tree_refresh(m, p->node[1], 1u)) {
+            p->dirty[2] = true;
+        }
+    }
+    return 2u;
+}
+
 /* One whole-node entry at level L >= 1: descend to it (expanding a uniform ancestor whose
  * value the delta changes), then the delta on every voxel below. */
 static void node_step(occ_map_t *const m, path_t *const p, const entry_t *const e,
@@ -325,7 +338,8 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
             prev = e.code;
             continue;
         }
-        const unsigned start = path_start(m, &p, e.code, prev, first);
+        const bool sibling = leaf != NULL && e.level == 0u && ((e.code ^ prev) >> 6) == 0u;
+        const unsigned start = sibling ? sibling_start(m, &p) : path_start(m, &p, e.code, prev, first);
         prev = e.code;
         first = false;
         if (e.level == 0u) {
