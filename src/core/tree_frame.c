@@ -232,6 +232,42 @@ static bool voxel_step(occ_map_t *const m, path_t *const p, const entry_t *const
     return true;
 }
 
+/* voxel_step for a voxel in the leaf block the path already ends in (the previous entry's):
+ * about half the entries, with no split level, no descent and no refresh to decide. */
+static bool leaf_step(occ_map_t *const m, path_t *const p, occ_value_t *const leaf,
+                      const entry_t *const e)
+{
+    occ_value_t *const slot = &leaf[occ_code_slot(e->code, 1u)];
+    const occ_value_t nv = occ_value_apply_delta(m, *slot, e->delta);
+    if (occ_value_eq(nv, *slot)) {
+        return false;
+    }
+    *slot = nv;
+    occi_shared_touch(m, slot, sizeof *slot);
+    p->dirty[1] = true;
+    return true;
+}
+
+/* The leaf block's values the path ends in after a voxel entry, else NULL (a uniform node). */
+static occ_value_t *path_leaf(const occ_map_t *const m, const path_t *const p)
+{
+    return p->low == 1u && *p->node[1].child != OCC_NONE ? occ_leaf_at(m, *p->node[1].child)->value
+                                                         : NULL;
+}
+
+/* path_start for a voxel in another leaf block of the level-2 node the path ends in (the path
+ * ends in a leaf block): only the level-1 node is finished. */
+static unsigned sibling_start(occ_map_t *const m, path_t *const p)
+{
+    if (p->dirty[1]) {
+        p->dirty[1] = false;
+        if (occi_tree_refresh(m, p->node[1], 1u)) {
+            p->dirty[2] = true;
+        }
+    }
+    return 2u;
+}
+
 /* One whole-node entry at level L >= 1: descend to it (expanding a uniform ancestor whose
  * value the delta changes), then the delta on every voxel below. */
 static void node_step(occ_map_t *const m, path_t *const p, const entry_t *const e,
@@ -293,16 +329,25 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
     entry_t e;
     occ_code_t prev = 0, end = 0; /* end: past the previous entry's voxels */
     bool first = true;
+    occ_value_t *leaf = NULL; /* the previous voxel's leaf block, while the path ends in it */
     while (next_entry(m, &c, &e)) {
         OCC_ASSERT(first || e.code >= end); /* nothing inside a whole node */
         end = e.code + ((occ_code_t)1 << (3u * e.level));
-        const unsigned start = path_start(m, &p, e.code, prev, first);
+        if (leaf != NULL && e.level == 0u && ((e.code ^ prev) >> 3) == 0u) {
+            out->changed += leaf_step(m, &p, leaf, &e) ? 1u : 0u;
+            prev = e.code;
+            continue;
+        }
+        const bool sibling = leaf != NULL && e.level == 0u && ((e.code ^ prev) >> 6) == 0u;
+        const unsigned start = sibling ? sibling_start(m, &p) : path_start(m, &p, e.code, prev, first);
         prev = e.code;
         first = false;
         if (e.level == 0u) {
             out->changed += voxel_step(m, &p, &e, start) ? 1u : 0u;
+            leaf = path_leaf(m, &p);
         } else {
             node_step(m, &p, &e, start);
+            leaf = NULL;
         }
     }
     refresh_up_to(m, &p, depth);
