@@ -82,7 +82,6 @@ typedef struct {
     size_t h, v, n;
     occ_code_t hc, vc, nc;
     unsigned nl;
-    size_t dropped; /* voxel updates that were hits */
 } cursor_t;
 
 typedef struct {
@@ -122,7 +121,6 @@ static void cursor_init(cursor_t *const c, const occi_frame_t *const f)
 {
     c->f = f;
     c->h = c->v = c->n = 0u;
-    c->dropped = 0u;
     load_hit(c);
     load_voxel(c);
     load_node(c);
@@ -130,11 +128,8 @@ static void cursor_init(cursor_t *const c, const occi_frame_t *const f)
 
 static bool next_entry(const occ_map_t *const m, cursor_t *const c, entry_t *const e)
 {
-    if (c->vc == c->hc && c->vc != NONE) {
-        c->v++; /* hits win */
-        c->dropped++;
-        load_voxel(c);
-    }
+    /* the walk emits no free voxel that is also a hit (hits win there) */
+    OCC_ASSERT(c->vc == NONE || c->vc != c->hc);
     OCC_ASSERT(c->nc == NONE || (c->nc != c->hc && c->nc != c->vc)); /* never at a voxel entry */
     if (c->nc < c->hc && c->nc < c->vc) {
         e->code = c->nc;
@@ -316,7 +311,6 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
                                 occi_frame_out_t *const out)
 {
     out->changed = 0u;
-    out->dropped = 0u;
     if (!frame_fits(m, f)) {
         m->oom_count++;
         return OCC_ERR_NOMEM;
@@ -351,7 +345,6 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
         }
     }
     refresh_up_to(m, &p, depth);
-    out->dropped = c.dropped;
     occi_shared_written(m);
     return OCC_OK;
 }

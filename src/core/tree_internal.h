@@ -336,7 +336,7 @@ bool occi_map_config_ok(const occ_map_config_t *cfg);
 void occi_tree_apply_subtree(occ_map_t *m, occ_nodep_t node, unsigned level, occ_delta_t delta);
 
 /* One frame's updates, each stream sorted by code: voxel hits (hit bit set, unique), voxel
- * updates by voxel_delta (unique; a code that is also a hit is a hit), and whole nodes, each
+ * updates by voxel_delta (unique; no code that is also a hit), and whole nodes, each
  * the code of its first voxel with the marker bit 3 level - 1 set (level >= 1), every voxel
  * below getting node_delta once. No entry may lie inside a whole node. */
 typedef struct {
@@ -345,10 +345,9 @@ typedef struct {
     occ_delta_t voxel_delta, node_delta;
 } occi_frame_t;
 
-/* Counters of occi_tree_apply_frame: voxel values changed, voxel updates dropped because the
- * voxel is a hit. */
+/* Counters of occi_tree_apply_frame: voxel values changed. */
 typedef struct {
-    size_t changed, dropped;
+    size_t changed;
 } occi_frame_out_t;
 
 /* Apply a frame in one pass (tree_frame.c): first a bound of the blocks it can allocate (as if

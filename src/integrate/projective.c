@@ -132,7 +132,7 @@ static occ_err_t apply(occ_proj_t *x)
         (void)occ_map_write_end(m);
     }
     occ_insert_result_t *const r = &x->r->insert;
-    r->voxels_free = x->nv - fo.dropped;
+    r->voxels_free = x->nv;
     r->voxels_updated = r->voxels_free + x->nh;
     r->voxels_changed = fo.changed;
     r->coarse_updated = e == OCC_OK ? x->nn : 0u;

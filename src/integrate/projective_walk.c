@@ -258,6 +258,20 @@ static bool holds_hit(occ_proj_t *x, const occ_code_t code, const unsigned l)
     return x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < end;
 }
 
+/* The end points inside the level-l node (l <= 2) at `code`, as bits of voxel offsets from
+ * code: those voxels are hits, and hits win, so the walk never emits them as free voxels
+ * (the tree pass's merge then meets no code in both streams). Same cursor as holds_hit. */
+static uint64_t hit_bits(occ_proj_t *x, const occ_code_t code, const unsigned l)
+{
+    const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
+    uint64_t bits = 0u;
+    (void)holds_hit(x, code, 0u);
+    for (size_t i = x->hit_cur; i < x->nh && (x->out[i] & ~OCC_CODE_HIT_BIT) < end; i++) {
+        bits |= (uint64_t)1 << ((x->out[i] & ~OCC_CODE_HIT_BIT) - code);
+    }
+    return bits;
+}
+
 /* The free voxels go after the hits and the near field's voxels. */
 static void emit_voxel(occ_proj_t *x, const occ_code_t code)
 {
@@ -272,7 +286,9 @@ static bool flush_near(occ_proj_t *x, const occ_code_t code)
         if (!room(x)) {
             return false;
         }
-        emit_voxel(x, x->near[x->near_cur]);
+        if (!holds_hit(x, x->near[x->near_cur], 0u)) { /* hits win */
+            emit_voxel(x, x->near[x->near_cur]);
+        }
     }
     return true;
 }
@@ -330,13 +346,14 @@ static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code
         return;
     }
     /* the rule's free voxels, and the near field's (free by its rays) */
-    const uint64_t mask = occi_proj_bulk(x, k, level) | take_near(x, code, level);
-    const unsigned n = 1u << (3u * level);
-    const uint64_t all = n == 64u ? ~(uint64_t)0 : (((uint64_t)1 << n) - 1u);
-    if (mask == 0u) {
+    const uint64_t cand = occi_proj_bulk(x, k, level) | take_near(x, code, level);
+    if (cand == 0u) {
         return;
     }
-    if (mask == all && may_merge && !holds_hit(x, code, level)) {
+    const uint64_t mask = cand & ~hit_bits(x, code, level); /* hits win */
+    const unsigned n = 1u << (3u * level);
+    const uint64_t all = n == 64u ? ~(uint64_t)0 : (((uint64_t)1 << n) - 1u);
+    if (mask == all && may_merge) {
         emit_node(x, code, level);
         return;
     }
@@ -347,7 +364,7 @@ static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code
     for (unsigned c = 0; c < n / 8u; c++) {
         const unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
         const occ_code_t cc = code | ((occ_code_t)c << 3);
-        if (byte == 0xFFu && (level == 2u || may_merge) && !holds_hit(x, cc, 1u)) {
+        if (byte == 0xFFu && (level == 2u || may_merge)) {
             emit_node(x, cc, 1u);
             continue;
         }
