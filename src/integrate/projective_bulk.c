@@ -110,11 +110,11 @@ OCC_PROJ_LANES static void project_lanes(const occ_proj_t *const x, const float 
 }
 
 /* Free where inside and in front of the pixel's surface by the margin (no reading: -inf),
- * as one byte (0 / 1) per lane. d and f: the lanes' depths and answers (workspace). */
+ * as one byte (0 / 1) per lane (one loop: a second pass over 32-bit answers cost a loop exit
+ * per call). d: the lanes' depths (workspace). */
 OCC_PROJ_LANES static void front_lanes(const occ_proj_t *const x, const float *restrict qc,
                                        const uint32_t *restrict pix, const int32_t *restrict in,
-                                       float *restrict d, int32_t *restrict f,
-                                       uint8_t *restrict free8)
+                                       float *restrict d, uint8_t *restrict free8)
 {
     const float keep = x->keep;
     const float *const d0 = x->d0;
@@ -122,10 +122,7 @@ OCC_PROJ_LANES static void front_lanes(const occ_proj_t *const x, const float *r
         d[m] = d0[pix[m]];
     }
     for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
-        f[m] = in[m] & (int32_t)(qc[m] < keep * d[m]);
-    }
-    for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
-        free8[m] = (uint8_t)f[m];
+        free8[m] = (uint8_t)(in[m] & (int32_t)(qc[m] < keep * d[m]));
     }
 }
 
@@ -153,7 +150,7 @@ uint64_t occi_proj_bulk(const occ_proj_t *const x, const uint32_t k[3], const un
     occ_proj_bulk_t *const b = x->bulk; /* the lanes' arrays: in the scratch, off the stack */
     centres((const float(*)[3][4])p, b->q);
     project_lanes(x, b->q[0], b->q[1], b->q[2], b->pix, b->in);
-    front_lanes(x, b->q[2], b->pix, b->in, b->d, b->f, b->free8);
+    front_lanes(x, b->q[2], b->pix, b->in, b->d, b->free8);
     uint64_t mask = 0u;
     const unsigned groups = level == 2u ? 8u : 1u;
     for (unsigned c = 0; c < groups; c++) {

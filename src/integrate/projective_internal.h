@@ -51,7 +51,7 @@ typedef struct {
     float q[3][OCC_PROJ_BULK];  /* camera-frame centres */
     float d[OCC_PROJ_BULK];     /* their pixels' depths */
     uint32_t pix[OCC_PROJ_BULK];
-    int32_t in[OCC_PROJ_BULK], f[OCC_PROJ_BULK];
+    int32_t in[OCC_PROJ_BULK];
     uint8_t free8[OCC_PROJ_BULK];
 } occ_proj_bulk_t;
 
