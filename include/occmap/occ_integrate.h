@@ -151,8 +151,9 @@ typedef enum {
      * 121.1 -> 118.9 ms, 1.02x, 1.2 points (two more runs: 1.56x / 1.12x / 1.02x and 1.56x /
      * 1.14x / 1.04x). Since SIMPLE's walk got faster (issue 22: per octant, Morton stepping,
      * the set to the tree by bricks) the gain is smaller: make bench on 29878c6 gave 1.39x
-     * [1.32, 1.48] at 0.2 m and 1.03x [0.95, 1.24] at 0.1 m (README, Performance).
-     * When not: at 0.05 m or finer, and for laser scans (scan.dat, spherical_scan.graph at
+     * [1.32, 1.48] at 0.2 m and 1.03x [0.95, 1.24] at 0.1 m, on 25a4548 1.24x [1.14, 1.27]
+     * and 0.98x [0.89, 1.09] (README, Performance).
+     * When not: at 0.1 m or finer, and for laser scans (scan.dat, spherical_scan.graph at
      * 0.2 / 0.1 / 0.05 m: 0.95x to 1.11x over three runs, 1.0 to 1.8 points per traversal),
      * it buys nothing over SIMPLE. If OctoMap's discretize = true map will do, DISCRETE is
      * faster still (TUM: 6.6 / 9.2 / 20.5 ms per frame at 0.2 / 0.1 / 0.05 m), and for depth
