@@ -329,22 +329,18 @@ static void emit_byte(occ_proj_t *x, const occ_code_t cc, const unsigned byte)
     occ_code_t *const out = x->out + at;
     size_t k = 0;
     /* written out: as a loop gcc -O2 keeps it rolled, its exit a branch per byte */
-    out[k] = cc;
-    k += byte & 1u;
-    out[k] = cc | 1u;
-    k += (byte >> 1) & 1u;
-    out[k] = cc | 2u;
-    k += (byte >> 2) & 1u;
-    out[k] = cc | 3u;
-    k += (byte >> 3) & 1u;
-    out[k] = cc | 4u;
-    k += (byte >> 4) & 1u;
-    out[k] = cc | 5u;
-    k += (byte >> 5) & 1u;
-    out[k] = cc | 6u;
-    k += (byte >> 6) & 1u;
-    out[k] = cc | 7u;
-    k += (byte >> 7) & 1u;
+#define EMIT_BIT(j)                                                                               \
+    out[k] = cc | (j);                                                                            \
+    k += (byte >> (j)) & 1u
+    EMIT_BIT(0u);
+    EMIT_BIT(1u);
+    EMIT_BIT(2u);
+    EMIT_BIT(3u);
+    EMIT_BIT(4u);
+    EMIT_BIT(5u);
+    EMIT_BIT(6u);
+    EMIT_BIT(7u);
+#undef EMIT_BIT
     x->nv += k;
     const size_t hi = at + 8u + x->nn;
     x->hwm = x->hwm > hi ? x->hwm : hi;
