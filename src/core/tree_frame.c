@@ -203,6 +203,16 @@ static void frame_need(const occ_map_t *const m, const occi_frame_t *const f,
     nodes_need(m, f->nodes, f->nn, inner);
 }
 
+/* Voxel `code`'s new value into the leaf block the path ends in. */
+static void leaf_write(occ_map_t *const m, path_t *const p, occ_value_t *const leaf,
+                       const occ_code_t code, const occ_value_t nv)
+{
+    occ_value_t *const slot = &leaf[occ_code_slot(code, 1u)];
+    *slot = nv;
+    occi_shared_touch(m, slot, sizeof *slot);
+    p->dirty[1] = true;
+}
+
 /* One voxel entry on the path (apply_batch's step): true when its value changed. */
 static bool voxel_step(occ_map_t *const m, path_t *const p, const entry_t *const e,
                        const unsigned start)
@@ -220,10 +230,7 @@ static bool voxel_step(occ_map_t *const m, path_t *const p, const entry_t *const
         }
     }
     p->low = 1u;
-    occ_value_t *const slot = &occ_leaf_at(m, *p->node[1].child)->value[occ_code_slot(e->code, 1u)];
-    *slot = nv;
-    occi_shared_touch(m, slot, sizeof *slot);
-    p->dirty[1] = true;
+    leaf_write(m, p, occ_leaf_at(m, *p->node[1].child)->value, e->code, nv);
     return true;
 }
 
@@ -232,14 +239,12 @@ static bool voxel_step(occ_map_t *const m, path_t *const p, const entry_t *const
 static bool leaf_step(occ_map_t *const m, path_t *const p, occ_value_t *const leaf,
                       const entry_t *const e)
 {
-    occ_value_t *const slot = &leaf[occ_code_slot(e->code, 1u)];
-    const occ_value_t nv = occ_value_apply_delta(m, *slot, e->delta);
-    if (occ_value_eq(nv, *slot)) {
+    const occ_value_t v = leaf[occ_code_slot(e->code, 1u)];
+    const occ_value_t nv = occ_value_apply_delta(m, v, e->delta);
+    if (occ_value_eq(nv, v)) {
         return false;
     }
-    *slot = nv;
-    occi_shared_touch(m, slot, sizeof *slot);
-    p->dirty[1] = true;
+    leaf_write(m, p, leaf, e->code, nv);
     return true;
 }
 

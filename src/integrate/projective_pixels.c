@@ -281,7 +281,7 @@ static bool emit(occ_proj_t *const x, const occ_code_t code, size_t *const n)
 }
 
 /* The flagged columns' indices to the front of nw, in order; their count. In place and
- * branch-free (the flags fall at random): index n <= i is read before it is written. */
+ * without branches, as the flags fall at random: index n <= i is read before it is written. */
 static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)
 {
     uint32_t n = 0;

@@ -104,28 +104,13 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
     x->dmax = x->mx[l][0]; /* -inf: no reading at all */
 }
 
-/* floor(log2 w), w >= 1. */
-static uint32_t floor_log2(uint32_t w)
-{
-#if defined(__GNUC__)
-    return 31u - (uint32_t)__builtin_clz(w);
-#else
-    uint32_t f = 0;
-    while (w > 1u) {
-        w >>= 1;
-        f++;
-    }
-    return f;
-#endif
-}
-
 /* The lowest level at which pixels i0..i1 fall in at most 3 cells, without a loop whose exit
  * mispredicts: with f = floor(log2 (i1 - i0)) they fall in at most 3 at level f and in at
  * least 5 at f - 2 (a cell count is monotone in the level), so it is f - 1 or f. */
 static uint32_t span_level(const uint32_t i0, const uint32_t i1)
 {
     const uint32_t w = i1 - i0;
-    const uint32_t f = floor_log2(w | 1u);
+    const uint32_t f = occ_bit_length32(w | 1u) - 1u; /* floor(log2 w), w >= 1 */
     const uint32_t c = f > 0u ? f - 1u : 0u;
     const uint32_t l = ((i1 >> c) - (i0 >> c)) <= 2u ? c : f;
     return w <= 2u ? 0u : l;

@@ -265,7 +265,7 @@ static uint64_t hit_bits(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
     const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
     uint64_t bits = 0u;
-    (void)holds_hit(x, code, 0u);
+    (void)holds_hit(x, code, 0u); /* the cursor to the first hit at or past code */
     size_t i = x->hit_cur;
     for (; i < x->nh && (x->out[i] & ~OCC_CODE_HIT_BIT) < end; i++) {
         bits |= (uint64_t)1 << ((x->out[i] & ~OCC_CODE_HIT_BIT) - code);
