@@ -454,7 +454,7 @@ bool occ_value_observed(occ_value_t v);
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_map_read, occ_map_read_key: stack <= 192 / 256 B; work: one descent, <= depth_levels blocks
+ *   occ_map_read, occ_map_read_key: stack <= 192 / 192 B; work: one descent, <= depth_levels blocks
  *       read
  *   occ_map_state_at: stack <= 128 / 192 B; work: one descent, <= depth_levels blocks read
  *   occ_map_update, occ_map_update_key: stack <= 768 / 768 B; work: one path: <= depth_levels

@@ -439,7 +439,7 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
  *       node's subtree); work: O(pixels) for the pixel pass, gap filling and pyramid, the near
  *       rays, the walk as stated above (at most every voxel of the frustum within max range),
  *       then one pass over the tree
- *   occ_ray_keys: stack <= 384 / 512 B; work: <= occ_ray_max_keys() keys, no map access
+ *   occ_ray_keys: stack <= 384 / 448 B; work: <= occ_ray_max_keys() keys, no map access
  *   occ_insert_scratch_bytes_scan: stack <= 256 / 320 B; work: O(n_points) (FAST_DISCRETE: + its
  *       coarse box)
  *   occ_insert_scratch_bytes: stack <= 256 / 320 B; work: O(1)
