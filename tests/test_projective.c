@@ -367,6 +367,31 @@ static void test_tof_8x8(void **state)
     }
 }
 
+/* Maps of one to four levels (a root of level 1 or 2 takes the walk's bricks directly): the
+ * ToF frame twice, the second time onto the first's voxels, equal to the oracle's. The camera
+ * sits near the map's -x face looking along +x, so that voxels of every map are in view. */
+static void test_tof_shallow_maps(void **state)
+{
+    (void)state;
+    fill_tof();
+    const occ_depth_image_t im = {tof, OCC_DEPTH_F32, 8u, 8u, sizeof tof[0], 1.0f};
+    occ_pose_t pose = tof_pose();
+    for (unsigned depth = 1; depth <= 4u; depth++) {
+        occ_map_config_t c = iotest_octomap_cfg();
+        c.resolution_m = 2.0f / (float)(1u << depth); /* the map spans [-1, 1) m */
+        c.depth_levels = (uint8_t)depth;
+        pose.p = (occ_vec3_t){-0.9f, 0.01f, 0.02f};
+        assert_int_equal(occ_map_init(&map_a, &c, arena_a, (size_t)1 << 20), OCC_OK);
+        assert_int_equal(occ_map_init(&map_b, &c, arena_b, (size_t)1 << 20), OCC_OK);
+        printf("depth %u, res %.3f m\n", depth, (double)c.resolution_m);
+        for (unsigned twice = 0; twice < 2u; twice++) {
+            occ_depth_result_t r;
+            frame_equals_oracle(&im, &tof_dp, &pose, &r);
+            assert_true(r.insert.voxels_updated + r.insert.coarse_updated > 0u);
+        }
+    }
+}
+
 /* ---- errors: the map unchanged --------------------------------------------------------------- */
 static occ_err_t tof_insert(const occ_depth_params_t *dp, const occ_pose_t *pose, size_t bytes,
                             occ_depth_result_t *r)
@@ -530,6 +555,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_tof_8x8),
+        cmocka_unit_test(test_tof_shallow_maps),
         cmocka_unit_test(test_errors_leave_map),
         cmocka_unit_test(test_full_pool),
         cmocka_unit_test(test_pioneer_equals_oracle),

@@ -153,7 +153,7 @@ occ_err_t occ_map_insert_depth(occ_map_t *map, const occ_depth_image_t *image,
  * Worst call-chain stack, Cortex-M4F / Cortex-M0+ (GCC 12 -Os, newlib nano; make cross checks
  * every line below against -fcallgraph-info), and the work per call. Callbacks (CAN tx, I/O
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
- *   occ_map_insert_depth: stack <= 1,536 / 1,536 B; work: ray-cast methods: pixels on the step
+ *   occ_map_insert_depth: stack <= 1,472 / 1,536 B; work: ray-cast methods: pixels on the step
  *       grid x <= 3 (ceil(max_range / res) + 2) + 2 voxels each, then the tree update (one path
  *       per distinct voxel); OCC_INSERT_PROJECTIVE: occ_map_insert_projective's (occ_integrate.h)
  *   occ_depth_scratch_bytes: stack <= 128 / 128 B; work: O(1)

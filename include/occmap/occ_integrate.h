@@ -348,14 +348,15 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells), 52 bytes per image column (the pixel
  * pass's per-column tables and row buffers, OCC_PROJ_COLUMN_BYTES) and the output, in 8-byte
  * slots: the end points' codes after the repeat filter (twice while they are sorted), the near
- * rays' voxels (twice while sorted; ~5,000 for a 640 x 480 Kinect frame), then one per voxel
- * update and one per whole free node. OCC_PROJ_SCRATCH_BYTES(w, h, n_out) sizes it
- * for n_out slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers the TUM frames in
- * `make bench` (bench/projective.cpp prints what they used) and an 8x8 ToF array at 0.05 m to
- * 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 11.4 bytes per pixel, of
- * which a frame of the pioneer sequence used at most 10.2. A frame that needs more slots is
- * refused with OCC_ERR_SCRATCH (map unchanged): pass more. out->insert.scratch_used says what
- * a call used.
+ * rays' voxels (twice while sorted; ~5,000 for a 640 x 480 Kinect frame), then the updates:
+ * 4 per level-2 node (4 x 4 x 4 voxels) holding a free voxel or an end point (its voxels by
+ * the miss and by the hit) and 1 per whole free node above level 2. OCC_PROJ_SCRATCH_BYTES(w,
+ * h, n_out) sizes it for n_out slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers
+ * the TUM frames in `make bench` (bench/projective.cpp prints what they used) and an 8x8 ToF
+ * array at 0.05 m to 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 11.4
+ * bytes per pixel, of which a frame of the pioneer sequence used at most 8.4. A frame that
+ * needs more slots is refused with OCC_ERR_SCRATCH (map unchanged): pass more.
+ * out->insert.scratch_used says what a call used.
  *
  * Work, bounded per call: O(pixels) for the pixel pass (depths, end points), the gap filling
  * and the pyramid; the near rays (about (32 w / f) (32 h / f) rays of at most 4 sqrt(3) + 3
@@ -434,7 +435,7 @@ occ_err_t occ_map_insert_projective(occ_map_t *map, const occ_proj_image_t *imag
  * sinks) add their own stack. Instruction counts on a real map: README, Firmware.
  *   occ_map_insert_cloud, occ_map_insert_rays: stack <= 1,408 / 1,472 B; work: n_points rays x <= 3
  *       (ceil(max_ray / res) + 2) + 2 voxels, then one path per distinct voxel
- *   occ_map_insert_projective: stack <= 1,152 / 1,152 B (its context, tables, walk stack and
+ *   occ_map_insert_projective: stack <= 1,088 / 1,152 B (its context, tables, walk stack and
  *       lane arrays are in the scratch; the deepest chain is the tree pass updating a whole
  *       node's subtree); work: O(pixels) for the pixel pass, gap filling and pyramid, the near
  *       rays, the walk as stated above (at most every voxel of the frustum within max range),

@@ -8,7 +8,12 @@
  * (occ_map_observe_codes on the set's codes): the voxels end with the same values, and a
  * refreshed tree is the one pruned tree of its voxels.
  */
+#include <string.h>
+
 #include "tree_path.h"
+#if defined(__SSE2__) && !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 16
+#include <emmintrin.h>
+#endif
 
 /* A uniform node takes `delta` on all its voxels: it stays uniform. */
 static void set_uniform(occ_map_t *const m, const occ_nodep_t n, const occ_value_t v)
@@ -21,13 +26,14 @@ static void set_uniform(occ_map_t *const m, const occ_nodep_t n, const occ_value
 /* A uniform level-1 node n (value v) whose voxels mb take the miss (vm) and hb the hit (vh),
  * some of them changing: its leaf block is written once with the three values, and the node's
  * summary follows from the values present (what expanding, updating and refreshing it gives);
- * eight equal values leave it uniform. Returns the voxels whose value changed. */
+ * eight equal values leave it uniform. Returns the voxels of cb whose value changed. */
 static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigned mb,
-                          const unsigned hb, const occ_value_t vm, const occ_value_t vh)
+                          const unsigned hb, const unsigned cb, const occ_value_t vm,
+                          const occ_value_t vh)
 {
     const occ_value_t v = *n.value;
-    const size_t changed = (occ_value_eq(vm, v) ? 0u : occ_popcount64(mb)) +
-                           (occ_value_eq(vh, v) ? 0u : occ_popcount64(hb));
+    const size_t changed = (occ_value_eq(vm, v) ? 0u : occ_popcount64(mb & cb)) +
+                           (occ_value_eq(vh, v) ? 0u : occ_popcount64(hb & cb));
     /* the values present: untouched (pu), missed (pm), hit (ph) */
     const bool pu = (mb | hb) != 0xFFu, pm = mb != 0u, ph = hb != 0u;
     const bool same = (!pu || occ_value_eq(v, ph ? vh : vm)) && (!pm || !ph || occ_value_eq(vm, vh));
@@ -55,10 +61,64 @@ static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigne
     return changed;
 }
 
+/* The eight values v of a leaf block with the miss on the voxels of mb and the hit on those of
+ * hb (disjoint) into nv, all lanes alike and without a branch (occ_value_apply_delta per lane);
+ * returns the lanes that moved. With SSE2 and 16-bit values the eight lanes are one register
+ * (a saturating add then the clamp: the same values as the 32-bit sum clamped). */
+#if defined(__SSE2__) && !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 16
+static OCC_ALWAYS_INLINE __m128i lanes_of(const unsigned bits)
+{
+    const __m128i lane = _mm_set_epi16(128, 64, 32, 16, 8, 4, 2, 1);
+    return _mm_cmpeq_epi16(_mm_and_si128(_mm_set1_epi16((short)bits), lane), lane);
+}
+
+static OCC_ALWAYS_INLINE __m128i select16(const __m128i mask, const __m128i a, const __m128i b)
+{
+    return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
+}
+
+static OCC_ALWAYS_INLINE unsigned leaf8_update(const occ_map_t *const m,
+                                               const occ_value_t *const v, const unsigned mb,
+                                               const unsigned hb, occ_value_t *const nv)
+{
+    const __m128i vv = _mm_loadu_si128((const __m128i *)(const void *)v);
+    const __m128i cmin = _mm_set1_epi16(m->priv.q_clamp_min);
+    const __m128i cmax = _mm_set1_epi16(m->priv.q_clamp_max);
+    const __m128i d = select16(lanes_of(hb), _mm_set1_epi16(m->priv.q_hit),
+                               _mm_set1_epi16(m->priv.q_miss));
+    const __m128i observed = _mm_cmpgt_epi16(vv, _mm_set1_epi16(OCC_VALUE_UNOBSERVED));
+    const __m128i up = _mm_andnot_si128(_mm_cmpgt_epi16(_mm_setzero_si128(), d),
+                                        _mm_cmpgt_epi16(vv, _mm_subs_epi16(cmax, _mm_set1_epi16(1))));
+    const __m128i down = _mm_andnot_si128(_mm_cmpgt_epi16(d, _mm_setzero_si128()),
+                                          _mm_cmpgt_epi16(_mm_adds_epi16(cmin, _mm_set1_epi16(1)), vv));
+    const __m128i keep = _mm_and_si128(observed, _mm_or_si128(up, down)); /* at a bound already */
+    const __m128i sum = _mm_adds_epi16(_mm_and_si128(observed, vv), d);
+    const __m128i moved_to = _mm_min_epi16(_mm_max_epi16(sum, cmin), cmax);
+    const __m128i r = select16(_mm_andnot_si128(keep, lanes_of(mb | hb)), moved_to, vv);
+    _mm_storeu_si128((__m128i *)(void *)nv, r);
+    const __m128i same = _mm_cmpeq_epi16(r, vv);
+    return ~(unsigned)_mm_movemask_epi8(_mm_packs_epi16(same, same)) & 0xFFu;
+}
+#else
+static OCC_ALWAYS_INLINE unsigned leaf8_update(const occ_map_t *const m,
+                                               const occ_value_t *const v, const unsigned mb,
+                                               const unsigned hb, occ_value_t *const nv)
+{
+    unsigned moved = 0;
+    for (unsigned k = 0; k < 8u; k++) {
+        const occ_delta_t d = ((hb >> k) & 1u) != 0u ? m->priv.q_hit : m->priv.q_miss;
+        const occ_value_t u = occ_value_apply_delta_nb(m, v[k], d);
+        nv[k] = (((mb | hb) >> k) & 1u) != 0u ? u : v[k];
+        moved |= (unsigned)!occ_value_eq(nv[k], v[k]) << k;
+    }
+    return moved;
+}
+#endif
+
 /* The voxels of level-1 node n named by the byte masks mb (miss) and hb (hit); returns the
- * voxels whose value changed, and sets *dirty when n's value, flags or block changed. */
-static size_t node1_step(occ_map_t *const m, const occ_nodep_t n, const unsigned mb,
-                         const unsigned hb, bool *const dirty)
+ * voxels of cb whose value changed, and sets *dirty when n's value, flags or block changed. */
+static OCC_ALWAYS_INLINE size_t node1_step(occ_map_t *const m, const occ_nodep_t n, const unsigned mb,
+                         const unsigned hb, const unsigned cb, bool *const dirty)
 {
     if (*n.child == OCC_NONE) {
         const occ_value_t v = *n.value;
@@ -68,32 +128,35 @@ static size_t node1_step(occ_map_t *const m, const occ_nodep_t n, const unsigned
             return 0u;
         }
         *dirty = true;
-        return node1_split(m, n, mb, hb, vm, vh);
+        return node1_split(m, n, mb, hb, cb, vm, vh);
     }
     occ_leaf_block_t *const lb = occ_leaf_at(m, *n.child);
-    size_t changed = 0;
-    for (unsigned all = mb | hb; all != 0u; all &= all - 1u) {
-        const unsigned k = occ_first_slot(all);
-        const occ_value_t v = lb->value[k];
-        const occ_value_t nv =
-            occ_value_apply_delta(m, v, ((hb >> k) & 1u) != 0u ? m->priv.q_hit : m->priv.q_miss);
-        if (!occ_value_eq(nv, v)) {
-            lb->value[k] = nv;
-            occi_shared_touch(m, &lb->value[k], sizeof nv);
-            changed++;
-        }
+    occ_value_t nv[8];
+    const unsigned moved = leaf8_update(m, lb->value, mb, hb, nv);
+    if (moved != 0u) {
+        memcpy(lb->value, nv, sizeof nv);
+        occi_shared_touch(m, lb, sizeof *lb);
     }
-    if (changed > 0u && occi_tree_refresh(m, n, 1u)) {
+    const size_t changed = occ_popcount64(moved & cb);
+    if (moved && occi_tree_refresh(m, n, 1u)) {
         *dirty = true;
     }
     return changed;
 }
 
-/* One brick from path level `start`: descend to its level-2 node or a uniform node above it,
- * split that only where a value moves, update. Returns the voxels whose value changed. */
-static size_t brick_step(occ_map_t *const m, path_t *const p, const occi_brick_t *const b,
-                         const unsigned start)
+/* occi_tree_brick_step, inline: the update by bricks counts every voxel (count all ones, which
+ * the compiler folds away on that path). */
+static OCC_ALWAYS_INLINE size_t brick_update(occ_map_t *const m, path_t *const p,
+                                             const occi_brick_t *const b, const unsigned start,
+                                             const uint64_t count)
 {
+    if (m->cfg.depth_levels < 2u) { /* the root is the one level-1 node: the brick's first byte */
+        OCC_ASSERT(b->code == 0u && ((b->miss | b->hit) >> 8) == 0u);
+        bool dirty = false;
+        p->low = 1u;
+        return node1_step(m, p->node[1], (unsigned)b->miss, (unsigned)b->hit,
+                          (unsigned)count & 0xFFu, &dirty);
+    }
     unsigned l = start;
     while (l > 2u && *p->node[l].child != OCC_NONE) {
         p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(b->code, l));
@@ -115,7 +178,7 @@ static size_t brick_step(occ_map_t *const m, path_t *const p, const occi_brick_t
         if (b->miss == ~(uint64_t)0) { /* the whole brick alike: it stays uniform */
             set_uniform(m, p->node[2], vm);
             p->dirty[3] = true;
-            return 64u;
+            return occ_popcount64(count);
         }
         occi_tree_expand(m, p->node[2], 2u);
     }
@@ -126,13 +189,20 @@ static size_t brick_step(occ_map_t *const m, path_t *const p, const occi_brick_t
         const unsigned mb = (unsigned)(b->miss >> (8u * j)) & 0xFFu;
         const unsigned hb = (unsigned)(b->hit >> (8u * j)) & 0xFFu;
         if ((mb | hb) != 0u) {
-            changed += node1_step(m, occ_inner_node(m, blk, j), mb, hb, &dirty);
+            const unsigned cb = (unsigned)(count >> (8u * j)) & 0xFFu;
+            changed += node1_step(m, occ_inner_node(m, blk, j), mb, hb, cb, &dirty);
         }
     }
     if (dirty && occi_tree_refresh(m, p->node[2], 2u)) {
         p->dirty[3] = true;
     }
     return changed;
+}
+
+size_t occi_tree_brick_step(occ_map_t *const m, path_t *const p, const occi_brick_t *const b,
+                            const unsigned start, const uint64_t count)
+{
+    return brick_update(m, p, b, start, count);
 }
 
 occ_err_t occi_tree_apply_dense(occ_map_t *const m, const occi_dense_t *const d,
@@ -160,7 +230,7 @@ occ_err_t occi_tree_apply_dense(occ_map_t *const m, const occi_dense_t *const d,
         const unsigned start = path_start(m, &p, b.code, prev, first);
         first = false;
         prev = b.code;
-        out->changed += brick_step(m, &p, &b, start);
+        out->changed += brick_update(m, &p, &b, start, ~(uint64_t)0);
     }
     refresh_up_to(m, &p, depth);
     occi_shared_written(m);

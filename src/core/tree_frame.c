@@ -1,9 +1,10 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /*
- * tree_frame.c - one frame's updates in a single pass over the tree: voxel hits, voxel misses
- * and whole nodes (every voxel below gets one delta), merged in Morton order so that each part
- * of the tree is descended, written and refreshed once (the projective integrator's output).
- * All-or-nothing: a bound of the blocks the pass can allocate is checked first.
+ * tree_frame.c - one frame's updates in a single pass over the tree: bricks (a level-2 node's
+ * voxels by the miss and by the hit, tree_dense.c's update) and whole nodes (every voxel below
+ * gets one delta) in one stream in Morton order, so that each part of the tree is descended,
+ * written and refreshed once (the projective integrator's output). All-or-nothing: a bound of
+ * the blocks the pass can allocate is checked first.
  */
 #include "tree_path.h"
 
@@ -70,25 +71,7 @@ void occi_tree_apply_subtree(occ_map_t *const m, const occ_nodep_t top, const un
     }
 }
 
-/* ---- the frame's entries in Morton order ------------------------------------------------------ */
-
-/* The three streams merged: the head of each (code with the hit bit cleared; NONE when done),
- * the next entry's code, level (0: a voxel) and delta. Voxels named by both hits and misses
- * are hits. */
-#define NONE (~(occ_code_t)0)
-
-typedef struct {
-    const occi_frame_t *f;
-    size_t h, v, n;
-    occ_code_t hc, vc, nc;
-    unsigned nl;
-} cursor_t;
-
-typedef struct {
-    occ_code_t code;
-    unsigned level;
-    occ_delta_t delta;
-} entry_t;
+/* ---- the frame's stream in Morton order ------------------------------------------------------- */
 
 /* Level of a whole-node entry: its lowest set bit is the marker 3 level - 1. */
 static unsigned node_level(const occ_code_t e)
@@ -96,214 +79,91 @@ static unsigned node_level(const occ_code_t e)
     return ((unsigned)__builtin_ctzll(e) + 1u) / 3u;
 }
 
-static void load_hit(cursor_t *const c)
+static occ_code_t node_code(const occ_code_t e, const unsigned level)
 {
-    c->hc = c->h < c->f->nh ? c->f->hits[c->h] & ~OCC_CODE_HIT_BIT : NONE;
+    return e & ~(((occ_code_t)1 << (3u * level)) - 1u);
 }
 
-static void load_voxel(cursor_t *const c)
+static bool is_brick(const occ_code_t e)
 {
-    c->vc = c->v < c->f->nv ? c->f->voxels[c->v] & ~OCC_CODE_HIT_BIT : NONE;
+    return (e & OCC_CODE_HIT_BIT) != 0u;
 }
 
-static void load_node(cursor_t *const c)
-{
-    if (c->n < c->f->nn) {
-        const occ_code_t raw = c->f->nodes[c->n];
-        c->nl = node_level(raw);
-        c->nc = raw & ~(((occ_code_t)1 << (3u * c->nl)) - 1u);
-    } else {
-        c->nc = NONE;
-    }
-}
-
-static void cursor_init(cursor_t *const c, const occi_frame_t *const f)
-{
-    c->f = f;
-    c->h = c->v = c->n = 0u;
-    load_hit(c);
-    load_voxel(c);
-    load_node(c);
-}
-
-static bool next_entry(const occ_map_t *const m, cursor_t *const c, entry_t *const e)
-{
-    /* the walk emits no free voxel that is also a hit (hits win there) */
-    OCC_ASSERT(c->vc == NONE || c->vc != c->hc);
-    OCC_ASSERT(c->nc == NONE || (c->nc != c->hc && c->nc != c->vc)); /* never at a voxel entry */
-    if (c->nc < c->hc && c->nc < c->vc) {
-        e->code = c->nc;
-        e->level = c->nl;
-        e->delta = c->f->node_delta;
-        c->n++;
-        load_node(c);
-    } else if (c->hc < c->vc) {
-        e->code = c->hc;
-        e->level = 0u;
-        e->delta = m->priv.q_hit;
-        c->h++;
-        load_hit(c);
-    } else if (c->vc != NONE) {
-        e->code = c->vc;
-        e->level = 0u;
-        e->delta = c->f->voxel_delta;
-        c->v++;
-        load_voxel(c);
-    } else {
-        return false;
-    }
-    return true;
-}
-
-/* Blocks one sorted stream's entries can allocate, as if no node existed: the entry that first
- * goes below a node on the union of their paths (its split from the previous entry is above
- * that node) counts the node's child block (a leaf block at level 1, else an inner block), for
- * the levels level + 1 .. split - 1. Voxels (level 0) here, whole nodes below. */
-static void voxels_need(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
-                        uint64_t *const inner, uint64_t *const leaf)
-{
-    if (n == 0u) {
-        return;
-    }
-    const unsigned top = m->cfg.depth_levels; /* the first entry splits above the root */
-    uint64_t in = top >= 2u ? top - 1u : 0u, lf = 1u;
-    for (size_t i = 1; i < n; i++) {
-        const unsigned s = split_level(codes[i], codes[i - 1u]);
-        OCC_ASSERT((codes[i] & ~OCC_CODE_HIT_BIT) > (codes[i - 1u] & ~OCC_CODE_HIT_BIT));
-        lf += s >= 2u ? 1u : 0u;
-        in += s >= 3u ? s - 2u : 0u;
-    }
-    *inner += in;
-    *leaf += lf;
-}
-
-static void nodes_need(const occ_map_t *const m, const occ_code_t *const codes, const size_t n,
-                       uint64_t *const inner)
-{
-    occ_code_t prev = 0;
-    for (size_t i = 0; i < n; i++) {
-        const unsigned lv = node_level(codes[i]);
-        const occ_code_t code = codes[i] & ~(((occ_code_t)1 << (3u * lv)) - 1u);
-        const unsigned s = i == 0u ? m->cfg.depth_levels + 1u : split_level(code, prev);
-        OCC_ASSERT(i == 0u || code > prev); /* sorted, unique */
-        *inner += s >= lv + 2u ? s - lv - 1u : 0u; /* inner blocks at levels lv + 1 .. s - 1 */
-        prev = code;
-    }
-}
-
-/* The three streams' bounds summed: each block the merged pass allocates is counted by at
- * least one stream. */
+/* Blocks the stream can allocate, as if no node existed, over-approximated by counting the
+ * bricks and the whole nodes as two sorted chains: the entry that first goes below a node on
+ * its chain's paths (its split from the chain's previous entry is above that node) counts the
+ * node's child block for the levels below the split; a brick its level-2 node's inner block
+ * and a leaf block per level-1 node it names (the update by bricks' rule, occi_dense_need). */
 static void frame_need(const occ_map_t *const m, const occi_frame_t *const f,
                        uint64_t *const inner, uint64_t *const leaf)
 {
+    const unsigned top = m->cfg.depth_levels + 1u; /* a chain's first entry splits above the root */
+    occ_code_t prev_b = 0, prev_n = 0;
+    bool first_b = true, first_n = true;
     *inner = 0u;
     *leaf = 0u;
-    voxels_need(m, f->hits, f->nh, inner, leaf);
-    voxels_need(m, f->voxels, f->nv, inner, leaf);
-    nodes_need(m, f->nodes, f->nn, inner);
-}
-
-/* Voxel `code`'s new value into the leaf block the path ends in. */
-static void leaf_write(occ_map_t *const m, path_t *const p, occ_value_t *const leaf,
-                       const occ_code_t code, const occ_value_t nv)
-{
-    occ_value_t *const slot = &leaf[occ_code_slot(code, 1u)];
-    *slot = nv;
-    occi_shared_touch(m, slot, sizeof *slot);
-    p->dirty[1] = true;
-}
-
-/* One voxel entry on the path (apply_batch's step): true when its value changed. */
-static bool voxel_step(occ_map_t *const m, path_t *const p, const entry_t *const e,
-                       const unsigned start)
-{
-    unsigned stop;
-    const occ_value_t v = descend(m, p, e->code, start, &stop);
-    const occ_value_t nv = occ_value_apply_delta(m, v, e->delta);
-    if (occ_value_eq(nv, v)) {
-        return false;
-    }
-    for (unsigned l = stop; l >= 1u; l--) {
-        occi_tree_expand(m, p->node[l], l);
-        if (l > 1u) {
-            p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(e->code, l));
+    for (size_t i = 0; i < f->n;) {
+        const occ_code_t e = f->s[i];
+        if (is_brick(e)) {
+            const occ_code_t code = e & ~OCC_CODE_HIT_BIT;
+            const unsigned s = first_b ? top : split_level(code, prev_b);
+            uint64_t any = f->s[i + 1u] | f->s[i + 2u];
+            any |= any >> 4;
+            any |= any >> 2;
+            any |= any >> 1;
+            *leaf += occ_popcount64(any & 0x0101010101010101ull);
+            *inner += s - 2u;
+            prev_b = code;
+            first_b = false;
+            i += OCC_FRAME_BRICK_SLOTS;
+        } else {
+            const unsigned lv = node_level(e);
+            const occ_code_t code = node_code(e, lv);
+            const unsigned s = first_n ? top : split_level(code, prev_n);
+            *inner += s >= lv + 2u ? s - lv - 1u : 0u; /* inner blocks at levels lv + 1 .. s - 1 */
+            prev_n = code;
+            first_n = false;
+            i++;
         }
     }
-    p->low = 1u;
-    leaf_write(m, p, occ_leaf_at(m, *p->node[1].child)->value, e->code, nv);
-    return true;
 }
 
-/* voxel_step for a voxel in the leaf block the path already ends in (the previous entry's):
- * about half the entries, with no split level, no descent and no refresh to decide. */
-static bool leaf_step(occ_map_t *const m, path_t *const p, occ_value_t *const leaf,
-                      const entry_t *const e)
-{
-    const occ_value_t v = leaf[occ_code_slot(e->code, 1u)];
-    const occ_value_t nv = occ_value_apply_delta(m, v, e->delta);
-    if (occ_value_eq(nv, v)) {
-        return false;
-    }
-    leaf_write(m, p, leaf, e->code, nv);
-    return true;
-}
-
-/* The leaf block's values the path ends in after a voxel entry, else NULL (a uniform node). */
-static occ_value_t *path_leaf(const occ_map_t *const m, const path_t *const p)
-{
-    return p->low == 1u && *p->node[1].child != OCC_NONE ? occ_leaf_at(m, *p->node[1].child)->value
-                                                         : NULL;
-}
-
-/* path_start for a voxel in another leaf block of the level-2 node the path ends in (the path
- * ends in a leaf block): only the level-1 node is finished. */
-static unsigned sibling_start(occ_map_t *const m, path_t *const p)
-{
-    if (p->dirty[1]) {
-        p->dirty[1] = false;
-        if (occi_tree_refresh(m, p->node[1], 1u)) {
-            p->dirty[2] = true;
-        }
-    }
-    return 2u;
-}
-
-/* One whole-node entry at level L >= 1: descend to it (expanding a uniform ancestor whose
+/* One whole-node entry at level L >= 3: descend to it (expanding a uniform ancestor whose
  * value the delta changes), then the delta on every voxel below. */
-static void node_step(occ_map_t *const m, path_t *const p, const entry_t *const e,
-                      const unsigned start)
+static void node_step(occ_map_t *const m, path_t *const p, const occ_code_t code,
+                      const unsigned lv, const occ_delta_t delta, const unsigned start)
 {
-    const unsigned lv = e->level;
     unsigned l = start;
     while (l > lv && *p->node[l].child != OCC_NONE) {
-        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(e->code, l));
+        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
         l--;
     }
     p->low = l;
     if (l > lv) { /* a uniform ancestor: split it only when the value moves */
         const occ_value_t v = *p->node[l].value;
-        if (occ_value_eq(occ_value_apply_delta(m, v, e->delta), v)) {
+        if (occ_value_eq(occ_value_apply_delta(m, v, delta), v)) {
             return;
         }
         for (; l > lv; l--) {
             occi_tree_expand(m, p->node[l], l);
-            p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(e->code, l));
+            p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
         }
         p->low = lv;
     }
-    occi_tree_apply_subtree(m, p->node[lv], lv, e->delta);
+    occi_tree_apply_subtree(m, p->node[lv], lv, delta);
     p->dirty[lv + 1u] = true;
 }
 
 /* Can the pools supply the blocks the pass may allocate? First a crude bound in O(1), above
- * frame_need's (each voxel entry at most one leaf block, each entry at most depth - 1 inner
- * ones): when the pools can supply it, the exact count (a pass over every entry) is not needed. */
+ * frame_need's (each slot at most depth - 1 inner blocks, each brick slot at most 2 leaf
+ * blocks: a brick is 4 slots naming at most 8 level-1 nodes): when the pools can supply it,
+ * the exact count (a pass over every entry) is not needed. */
 static bool frame_fits(const occ_map_t *const m, const occi_frame_t *const f)
 {
-    const uint64_t nvox = (uint64_t)f->nh + f->nv;
-    const uint64_t crude_inner = (nvox + f->nn) * (m->cfg.depth_levels - 1u);
-    if (crude_inner <= OCC_NONE && nvox <= OCC_NONE &&
-        occi_pool_can_supply(m, (uint32_t)crude_inner, (uint32_t)nvox)) {
+    const uint64_t crude_inner = (uint64_t)f->n * (m->cfg.depth_levels - 1u);
+    const uint64_t crude_leaf = 2u * (uint64_t)f->n;
+    if (crude_inner <= OCC_NONE && crude_leaf <= OCC_NONE &&
+        occi_pool_can_supply(m, (uint32_t)crude_inner, (uint32_t)crude_leaf)) {
         return true;
     }
     uint64_t inner, leaf;
@@ -322,34 +182,33 @@ occ_err_t occi_tree_apply_frame(occ_map_t *const m, const occi_frame_t *const f,
     }
     path_t p;
     path_begin(m, &p);
-    const unsigned depth = m->cfg.depth_levels;
-    cursor_t c;
-    cursor_init(&c, f);
-    entry_t e;
     occ_code_t prev = 0, end = 0; /* end: past the previous entry's voxels */
     bool first = true;
-    occ_value_t *leaf = NULL; /* the previous voxel's leaf block, while the path ends in it */
-    while (next_entry(m, &c, &e)) {
-        OCC_ASSERT(first || e.code >= end); /* nothing inside a whole node */
-        end = e.code + ((occ_code_t)1 << (3u * e.level));
-        if (leaf != NULL && e.level == 0u && ((e.code ^ prev) >> 3) == 0u) {
-            out->changed += leaf_step(m, &p, leaf, &e) ? 1u : 0u;
-            prev = e.code;
-            continue;
-        }
-        const bool sibling = leaf != NULL && e.level == 0u && ((e.code ^ prev) >> 6) == 0u;
-        const unsigned start = sibling ? sibling_start(m, &p) : path_start(m, &p, e.code, prev, first);
-        prev = e.code;
-        first = false;
-        if (e.level == 0u) {
-            out->changed += voxel_step(m, &p, &e, start) ? 1u : 0u;
-            leaf = path_leaf(m, &p);
+    for (size_t i = 0; i < f->n;) {
+        const occ_code_t e = f->s[i];
+        if (is_brick(e)) {
+            OCC_ASSERT(i + OCC_FRAME_BRICK_SLOTS <= f->n);
+            const occi_brick_t b = {e & ~OCC_CODE_HIT_BIT, f->s[i + 1u], f->s[i + 2u]};
+            OCC_ASSERT((b.code & 63u) == 0u && (b.miss & b.hit) == 0u);
+            OCC_ASSERT(first || b.code >= end); /* in code order, nothing inside a whole node */
+            const unsigned start = path_start(m, &p, b.code, prev, first);
+            out->changed += occi_tree_brick_step(m, &p, &b, start, ~f->s[i + 3u]);
+            prev = b.code;
+            end = b.code + 64u;
+            i += OCC_FRAME_BRICK_SLOTS;
         } else {
-            node_step(m, &p, &e, start);
-            leaf = NULL;
+            const unsigned lv = node_level(e);
+            const occ_code_t code = node_code(e, lv);
+            OCC_ASSERT(lv >= 3u && (first || code >= end));
+            const unsigned start = path_start(m, &p, code, prev, first);
+            node_step(m, &p, code, lv, f->node_delta, start);
+            prev = code;
+            end = code + ((occ_code_t)1 << (3u * lv));
+            i++;
         }
+        first = false;
     }
-    refresh_up_to(m, &p, depth);
+    refresh_up_to(m, &p, m->cfg.depth_levels);
     occi_shared_written(m);
     return OCC_OK;
 }

@@ -298,6 +298,23 @@ static inline occ_value_t occ_value_apply_delta(const occ_map_t *const m, const 
     }
     return (occ_value_t)nv;
 }
+/* occ_value_apply_delta without branches (for loops over a block's values): the same value. */
+static inline occ_value_t occ_value_apply_delta_nb(const occ_map_t *const m, const occ_value_t v,
+                                                   const occ_delta_t delta)
+{
+    const bool observed = occ_is_observed(v);
+    const bool keep = observed & (((delta >= 0) & (v >= m->priv.q_clamp_max)) |
+                                  ((delta <= 0) & (v <= m->priv.q_clamp_min)));
+#if OCC_VALUE_FLOAT
+    float nv = (observed ? v : 0.0f) + delta;
+#else
+    int32_t nv = (int32_t)(observed ? v : 0) + (int32_t)delta;
+#endif
+    nv = nv < m->priv.q_clamp_min ? m->priv.q_clamp_min : nv;
+    nv = nv > m->priv.q_clamp_max ? m->priv.q_clamp_max : nv;
+    return keep ? v : (occ_value_t)nv;
+}
+
 /* Equality of raw values (also for the float build, where -Wfloat-equal forbids ==). */
 static inline bool occ_value_eq(occ_value_t a, occ_value_t b)
 {
@@ -335,14 +352,18 @@ bool occi_map_config_ok(const occ_map_config_t *cfg);
  * O(1), else its subtree, refreshed bottom-up (values, flags, pruning). Allocates nothing. */
 void occi_tree_apply_subtree(occ_map_t *m, occ_nodep_t node, unsigned level, occ_delta_t delta);
 
-/* One frame's updates, each stream sorted by code: voxel hits (hit bit set, unique), voxel
- * updates by voxel_delta (unique; no code that is also a hit), and whole nodes, each
- * the code of its first voxel with the marker bit 3 level - 1 set (level >= 1), every voxel
- * below getting node_delta once. No entry may lie inside a whole node. */
+/* One frame's updates (the projective integrator's walk), one stream in code order: a brick
+ * is OCC_FRAME_BRICK_SLOTS slots: the code of a level-2 node's first voxel with
+ * OCC_CODE_HIT_BIT set (the tag), then masks of its 64 voxels (bit = offset in Morton order)
+ * updated by the miss (q_miss), by the hit (q_hit; disjoint from the miss: hits win), and
+ * those of the miss that whole free nodes cover (not counted as changed voxels); a whole node
+ * at level >= 3 is one slot: the code of its first voxel with the marker bit 3 level - 1 set,
+ * every voxel below getting node_delta once. No entry lies inside an earlier one. */
+#define OCC_FRAME_BRICK_SLOTS 4u
 typedef struct {
-    const occ_code_t *hits, *voxels, *nodes;
-    size_t nh, nv, nn;
-    occ_delta_t voxel_delta, node_delta;
+    const occ_code_t *s;
+    size_t n; /* slots */
+    occ_delta_t node_delta;
 } occi_frame_t;
 
 /* Counters of occi_tree_apply_frame: voxel values changed. */

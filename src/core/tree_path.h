@@ -39,6 +39,12 @@ static inline unsigned split_level(const occ_code_t a, const occ_code_t b)
         x >>= 1;
         h++;
     }
+/* One brick (tree_dense.c) from path level `start`: descend to its level-2 node or a uniform
+ * node above it, split that only where a value moves, update its voxels (miss: q_miss, hit:
+ * q_hit). Returns the voxels of `count` whose value changed. */
+size_t occi_tree_brick_step(occ_map_t *m, path_t *p, const occi_brick_t *b, unsigned start,
+                            uint64_t count);
+
 #endif
     return h / 3u + 1u;
 }
@@ -102,5 +108,11 @@ static inline unsigned path_start(occ_map_t *const m, path_t *const p, const occ
     }
     return p->low;
 }
+
+/* One brick (tree_dense.c) from path level `start`: descend to its level-2 node or a uniform
+ * node above it, split that only where a value moves, update its voxels (miss: q_miss, hit:
+ * q_hit). Returns the voxels of `count` whose value changed. */
+size_t occi_tree_brick_step(occ_map_t *m, path_t *p, const occi_brick_t *b, unsigned start,
+                            uint64_t count);
 
 #endif

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* projective.c - occ_map_insert_projective(): check the call, lay out the scratch, build the
- * pyramid, walk, then the all-or-nothing pool check and the writes (whole free nodes through
- * the core's frame pass: hits, free voxels and whole nodes merged in one walk of the tree). */
+ * pyramid, walk, then the all-or-nothing pool check and the writes (the walk's stream of
+ * bricks and whole free nodes through the core's frame pass: one walk of the tree). */
 #include <math.h>
 #include <string.h>
 
@@ -98,33 +98,16 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     return true;
 }
 
-/* The whole free nodes came from the back of the output in walk order: reversed in place they
- * are sorted by code. */
-static const occ_code_t *sorted_nodes(occ_proj_t *x)
-{
-    occ_code_t *const n = x->out + x->cap - x->nn;
-    for (size_t i = 0, j = x->nn; i + 1u < j; i++, j--) {
-        const occ_code_t t = n[i];
-        n[i] = n[j - 1u];
-        n[j - 1u] = t;
-    }
-    return n;
-}
-
-/* The writes: hits, free voxels and whole free nodes in one pass over the tree (its pool check
- * first: a bound as if no node on the paths existed), one version of a shared map. */
+/* The writes: the walk's stream of bricks (free voxels and hits) and whole free nodes in one
+ * pass over the tree (its pool check first: a bound as if no node on the paths existed), one
+ * version of a shared map. */
 static occ_err_t apply(occ_proj_t *x)
 {
     occ_map_t *const m = x->map;
     occi_frame_t f;
-    f.hits = x->out;
-    f.nh = x->nh;
-    f.voxels = x->out + x->nh + x->nr;
-    f.nv = x->nv;
-    f.nodes = sorted_nodes(x);
-    f.nn = x->nn;
-    f.voxel_delta = occi_delta_from_logodds(m->cfg.miss);
-    f.node_delta = f.voxel_delta;
+    f.s = x->out + x->nh + x->nr;
+    f.n = x->ns;
+    f.node_delta = occi_delta_from_logodds(m->cfg.miss);
     const bool shared = m->priv.shared != NULL && occ_map_write_begin(m) == OCC_OK;
     occi_frame_out_t fo;
     const occ_err_t e = occi_tree_apply_frame(m, &f, &fo);
@@ -196,7 +179,7 @@ static occ_err_t run(occ_proj_t *x, void *rest, const size_t rest_bytes)
     if (fit) {
         occi_proj_walk(x);
     }
-    const size_t slots = x->nh + x->nr + x->nv + x->nn;
+    const size_t slots = x->nh + x->nr + x->ns;
     x->r->insert.scratch_used += 8u * (slots > x->hwm ? slots : x->hwm);
     if (!fit || x->overflow) {
         return OCC_ERR_SCRATCH;

@@ -92,10 +92,15 @@ typedef struct {
     float peps0;            /* 1e-5 (fx + fy + |cx| + |cy| + w + h) */
     occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
     uint32_t *hist;         /* the radix sort's histograms */
-    /* The output: sorted hit codes (nh), then the walk's free voxel codes (nv) from out + nh,
-     * whole free nodes from the back (code with bit 3 level - 1 set: the level). */
+    /* The output: sorted hit codes (nh), the near field's voxels (nr), then the walk's stream
+     * (ns slots, tree_internal.h's occi_frame_t: bricks and whole nodes in code order), the
+     * brick being gathered in bcode / bmiss / bhit / bwhole until the walk moves past it. nv:
+     * free voxels decided one by one; nn: whole free nodes (the call's counters). */
     occ_code_t *out;
-    size_t cap, nh, nv, nn, hwm;
+    size_t cap, nh, nv, nn, ns, hwm;
+    occ_code_t bcode;
+    uint64_t bmiss, bhit, bwhole;
+    bool bopen;
     size_t hit_cur;         /* the walk's cursor over the sorted hits */
     /* The near field's free voxels (projective_near.c): sorted codes after the hits, merged
      * into the walk's output in code order by its cursor. */
@@ -154,7 +159,8 @@ bool occi_proj_near(occ_proj_t *x);
  * k: bit m of the result is set when the voxel in Morton slot m (below the node) is free. */
 uint64_t occi_proj_bulk(const occ_proj_t *x, const uint32_t k[3], unsigned level);
 
-/* The walk: fills x->out / nv / nn, or sets x->overflow. */
+/* The walk: the stream after the hits and near voxels (x->ns slots), the counters nv and nn;
+ * or sets x->overflow. */
 void occi_proj_walk(occ_proj_t *x);
 
 #endif

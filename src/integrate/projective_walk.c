@@ -1,10 +1,12 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* projective_walk.c - the top-down walk of a virtual octree over the camera frustum: each
- * node's box is projected (8 corners) and compared with the pyramid over its footprint; whole
- * free nodes and voxel updates are written to the output in Morton order. No tree reads. */
+ * node's box is projected (8 corners) and compared with the pyramid over its footprint; the
+ * updates go to the output in Morton order, a level-2 node's voxels as one brick (free voxels
+ * and end points), bigger whole free nodes one slot each. No tree reads. */
 #include <math.h>
 
 #include "projective_internal.h"
+#include "../core/tree_internal.h"
 
 /* Finite operands only (no NaN here): plain compares, no libm call. */
 static inline float lo_of(const float a, const float b)
@@ -237,62 +239,101 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
     return NODE_MIXED;
 }
 
-/* Is there an output slot left? (Else the call ends with OCC_ERR_SCRATCH.) */
-static bool room(occ_proj_t *x)
+/* ---- the output: bricks and whole nodes in code order (tree_internal.h, occi_frame_t) -----------
+ * The free voxels, the end points (hits) and the near field's voxels of a level-2 node are
+ * gathered in one open brick, written out when the walk moves past the node; whole free nodes
+ * at level 1 and 2 are bits of their brick, higher ones one slot each. The walk emits in code
+ * order, and before anything at a code it catches up with the hits and near voxels below it,
+ * so the stream stays sorted. */
+#define NONE (~(occ_code_t)0)
+
+/* Is there room for k more stream slots? (Else the call ends with OCC_ERR_SCRATCH.) */
+static bool room(occ_proj_t *x, const size_t k)
 {
-    if (x->nh + x->nr + x->nv + x->nn >= x->cap) {
+    if (x->cap - x->nh - x->nr - x->ns < k) {
         x->overflow = true;
         return false;
     }
     return true;
 }
 
-/* Does the level-l node starting at `code` hold an end point? The walk asks in increasing code
- * order, so one cursor over the sorted hits serves the whole walk. */
+/* The open brick to the stream (hits win over the miss). */
+static void brick_flush(occ_proj_t *x)
+{
+    if (!x->bopen) {
+        return;
+    }
+    x->bopen = false;
+    if (!room(x, OCC_FRAME_BRICK_SLOTS)) {
+        return;
+    }
+    occ_code_t *const s = x->out + x->nh + x->nr + x->ns;
+    s[0] = x->bcode | OCC_CODE_HIT_BIT;
+    s[1] = x->bmiss & ~x->bhit;
+    s[2] = x->bhit;
+    s[3] = x->bwhole;
+    x->ns += OCC_FRAME_BRICK_SLOTS;
+}
+
+/* Open the brick of the level-2 node holding `code` (the walk only moves forward). */
+static void brick_at(occ_proj_t *x, const occ_code_t code)
+{
+    const occ_code_t base = code & ~(occ_code_t)63u;
+    if (x->bopen && x->bcode == base) {
+        return;
+    }
+    OCC_ASSERT(!x->bopen || base > x->bcode);
+    brick_flush(x);
+    x->bopen = true;
+    x->bcode = base;
+    x->bmiss = x->bhit = x->bwhole = 0u;
+}
+
+/* The hits and the near field's voxels below `code` into their bricks, in code order (a near
+ * voxel that is also a hit is a hit). */
+static void catch_up(occ_proj_t *x, const occ_code_t code)
+{
+    for (;;) {
+        const occ_code_t h = x->hit_cur < x->nh ? x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT : NONE;
+        const occ_code_t v = x->near_cur < x->nr ? x->near[x->near_cur] : NONE;
+        const occ_code_t c = h < v ? h : v;
+        if (c >= code) {
+            return;
+        }
+        brick_at(x, c);
+        if (c == h) {
+            x->bhit |= (uint64_t)1 << (c & 63u);
+            x->hit_cur++;
+            x->near_cur += c == v ? 1u : 0u;
+        } else {
+            x->bmiss |= (uint64_t)1 << (c & 63u);
+            x->nv++;
+            x->near_cur++;
+        }
+    }
+}
+
+/* Does the level-l node starting at `code` hold an end point? (The hits below it are caught
+ * up with first: the walk is at `code`.) */
 static bool holds_hit(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
+    catch_up(x, code);
     const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
-    while (x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < code) {
-        x->hit_cur++;
-    }
     return x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < end;
 }
 
 /* The end points inside the level-l node (l <= 2) at `code`, as bits of voxel offsets from
- * code: those voxels are hits, and hits win, so the walk never emits them as free voxels
- * (the tree pass's merge then meets no code in both streams). Same cursor as holds_hit. */
+ * code (hits win over its free voxels); the cursor moves past them. */
 static uint64_t hit_bits(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
     const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
     uint64_t bits = 0u;
-    (void)holds_hit(x, code, 0u); /* the cursor to the first hit at or past code */
     size_t i = x->hit_cur;
     for (; i < x->nh && (x->out[i] & ~OCC_CODE_HIT_BIT) < end; i++) {
         bits |= (uint64_t)1 << ((x->out[i] & ~OCC_CODE_HIT_BIT) - code);
     }
-    x->hit_cur = i; /* past them: the walk asks about no code below end again */
+    x->hit_cur = i;
     return bits;
-}
-
-/* The free voxels go after the hits and the near field's voxels. */
-static void emit_voxel(occ_proj_t *x, const occ_code_t code)
-{
-    x->out[x->nh + x->nr + x->nv++] = code;
-}
-
-/* The near field's voxels below `code` to the output (the walk emits in code order, so the
- * output stays sorted); false when it is full. */
-static bool flush_near(occ_proj_t *x, const occ_code_t code)
-{
-    for (; x->near_cur < x->nr && x->near[x->near_cur] < code; x->near_cur++) {
-        if (!room(x)) {
-            return false;
-        }
-        if (!holds_hit(x, x->near[x->near_cur], 0u)) { /* hits win */
-            emit_voxel(x, x->near[x->near_cur]);
-        }
-    }
-    return true;
 }
 
 /* Skip the near field's voxels inside the level-l node at `code`; returns their bits (voxel
@@ -302,84 +343,71 @@ static uint64_t take_near(occ_proj_t *x, const occ_code_t code, const unsigned l
     const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
     uint64_t bits = 0u;
     for (; x->near_cur < x->nr && x->near[x->near_cur] < end; x->near_cur++) {
-        const occ_code_t off = x->near[x->near_cur] - code;
-        bits |= l <= 2u ? (uint64_t)1 << off : 0u;
+        bits |= l <= 2u ? (uint64_t)1 << (x->near[x->near_cur] - code) : 0u;
     }
     return bits;
 }
 
-/* Record a whole free node at level l >= 1 (from the back of the output), after the near
- * voxels before it; the near voxels inside it are covered by it. */
-static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
+/* A whole free node at level l >= 1 whose hits and near voxels below were caught up with:
+ * bits of its brick (level <= 2) or a slot of its own. */
+static void put_whole(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
-    if (flush_near(x, code) && room(x)) {
-        x->nn++;
-        x->out[x->cap - x->nn] = code | ((occ_code_t)1 << (3u * l - 1u)); /* level marker */
-        (void)take_near(x, code, l);
+    x->nn++;
+    if (l <= 2u) {
+        const uint64_t bits = l == 2u ? ~(uint64_t)0 : (uint64_t)0xFFu << (code & 63u);
+        brick_at(x, code);
+        x->bmiss |= bits;
+        x->bwhole |= bits;
+        return;
+    }
+    brick_flush(x);
+    if (room(x, 1u)) {
+        x->out[x->nh + x->nr + x->ns++] = code | ((occ_code_t)1 << (3u * l - 1u)); /* marker */
     }
 }
 
-/* A byte's voxels (bit j: code cc | j) to the output in code order, without a branch per
- * voxel (the bits fall at random): all eight written, the count moving past the set ones. The
- * caller checked room for them all; the slots written past the count (rewritten later) count
- * in the high-water mark. */
-static void emit_byte(occ_proj_t *x, const occ_code_t cc, const unsigned byte)
+/* A whole free node found by the walk: the near voxels inside it are covered by it. */
+static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
-    const size_t at = x->nh + x->nr + x->nv;
-    occ_code_t *const out = x->out + at;
-    size_t k = 0;
-    /* written out: as a loop gcc -O2 keeps it rolled, its exit a branch per byte */
-#define EMIT_BIT(j)                                                                               \
-    out[k] = cc | (j);                                                                            \
-    k += (byte >> (j)) & 1u
-    EMIT_BIT(0u);
-    EMIT_BIT(1u);
-    EMIT_BIT(2u);
-    EMIT_BIT(3u);
-    EMIT_BIT(4u);
-    EMIT_BIT(5u);
-    EMIT_BIT(6u);
-    EMIT_BIT(7u);
-#undef EMIT_BIT
-    x->nv += k;
-    const size_t hi = at + 8u + x->nn;
-    x->hwm = x->hwm > hi ? x->hwm : hi;
+    catch_up(x, code);
+    put_whole(x, code, l);
+    (void)take_near(x, code, l);
 }
 
 /* The voxels of a MIXED node at level 1 or 2, by the rule (occi_proj_bulk; hits are
  * occi_proj_pixels'). Whole free nodes where every voxel below is free and holds no end point
- * (the same updates, fewer slots): the node itself (level 2; level 1 when may_merge) or its
- * level-1 children; the other free voxels one by one. */
+ * (the same updates, counted as nodes): the node itself (level 2; level 1 when may_merge) or
+ * its level-1 children; the other free voxels one by one. */
 static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
                        const unsigned level, const bool may_merge)
 {
-    if (!flush_near(x, code)) {
-        return;
-    }
+    catch_up(x, code);
     /* the rule's free voxels, and the near field's (free by its rays) */
     const uint64_t cand = occi_proj_bulk(x, k, level) | take_near(x, code, level);
-    if (cand == 0u) {
-        return;
-    }
-    const uint64_t mask = cand & ~hit_bits(x, code, level); /* hits win */
+    const uint64_t hits = hit_bits(x, code, level);
+    const uint64_t mask = cand & ~hits; /* offsets from code */
     const unsigned n = 1u << (3u * level);
     const uint64_t all = n == 64u ? ~(uint64_t)0 : (((uint64_t)1 << n) - 1u);
+    if ((cand | hits) == 0u) {
+        return;
+    }
     if (mask == all && may_merge) {
-        emit_node(x, code, level);
+        put_whole(x, code, level);
         return;
     }
-    if (x->cap - x->nh - x->nr - x->nv - x->nn < n) { /* room for every voxel, checked once */
-        x->overflow = true;
-        return;
-    }
+    brick_at(x, code);
+    const unsigned off = (unsigned)(code & 63u);
+    x->bhit |= hits << off;
     for (unsigned c = 0; c < n / 8u; c++) {
-        const unsigned byte = (unsigned)(mask >> (8u * c)) & 0xFFu;
-        const occ_code_t cc = code | ((occ_code_t)c << 3);
+        const uint64_t byte = (mask >> (8u * c)) & 0xFFu;
+        const uint64_t at = byte << (off + 8u * c);
         if (byte == 0xFFu && (level == 2u || may_merge)) {
-            emit_node(x, cc, 1u);
-            continue;
+            x->nn++;
+            x->bwhole |= at;
+        } else {
+            x->nv += occ_popcount64(byte);
         }
-        emit_byte(x, cc, byte);
+        x->bmiss |= at;
     }
 }
 
@@ -394,7 +422,8 @@ void occi_proj_walk(occ_proj_t *const x)
         if (test_node(x, k0, 1u, x->dmax, &f) != NODE_SKIP) {
             visit_bulk(x, k0, 0u, 1u, false); /* the root is no coarse node */
         }
-        (void)flush_near(x, ~(occ_code_t)0);
+        catch_up(x, NONE);
+        brick_flush(x);
         return;
     }
     unsigned sp = 1;
@@ -436,6 +465,7 @@ void occi_proj_walk(occ_proj_t *const x)
         }
     }
     if (!x->overflow) {
-        (void)flush_near(x, ~(occ_code_t)0); /* the near voxels after the walk's last output */
+        catch_up(x, NONE); /* the hits and near voxels after the walk's last output */
+        brick_flush(x);
     }
 }
