@@ -13,7 +13,7 @@
 static void apply_uniform(occ_map_t *const m, const occ_nodep_t node, const occ_delta_t delta)
 {
     *node.value = occ_value_apply_delta(m, *node.value, delta);
-    *node.flags = occ_value_flags(m, *node.value);
+    occ_node_set_flags(node, occ_value_flags(m, *node.value));
     occ_touch_node(m, node);
 }
 
@@ -21,7 +21,7 @@ void occi_tree_apply_subtree(occ_map_t *const m, const occ_nodep_t top, const un
                              const occ_delta_t delta)
 {
     OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
-    if (*top.child == OCC_NONE) {
+    if (occ_node_child(top) == OCC_NONE) {
         apply_uniform(m, top, delta);
         return;
     }
@@ -32,7 +32,7 @@ void occi_tree_apply_subtree(occ_map_t *const m, const occ_nodep_t top, const un
         uint8_t level, owner_slot, next; /* level: the owner's */
     } st[OCC_MAX_DEPTH + 1u];
     unsigned sp = 1;
-    st[0].block = *top.child;
+    st[0].block = occ_node_child(top);
     st[0].owner_block = OCC_NONE;
     st[0].level = (uint8_t)level;
     st[0].owner_slot = 0u;
@@ -56,12 +56,12 @@ void occi_tree_apply_subtree(occ_map_t *const m, const occ_nodep_t top, const un
         }
         const unsigned s = st[t].next++;
         const occ_nodep_t c = occ_inner_node(m, st[t].block, s);
-        if (*c.child == OCC_NONE) {
+        if (occ_node_child(c) == OCC_NONE) {
             apply_uniform(m, c, delta);
             continue;
         }
         OCC_ASSERT(sp <= OCC_MAX_DEPTH);
-        st[sp].block = *c.child;
+        st[sp].block = occ_node_child(c);
         st[sp].owner_block = st[t].block;
         st[sp].level = (uint8_t)(st[t].level - 1u);
         st[sp].owner_slot = (uint8_t)s;
@@ -226,11 +226,11 @@ static bool voxel_step(occ_map_t *const m, path_t *const p, const entry_t *const
     for (unsigned l = stop; l >= 1u; l--) {
         occi_tree_expand(m, p->node[l], l);
         if (l > 1u) {
-            p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(e->code, l));
+            p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(e->code, l));
         }
     }
     p->low = 1u;
-    leaf_write(m, p, occ_leaf_at(m, *p->node[1].child)->value, e->code, nv);
+    leaf_write(m, p, occ_leaf_at(m, occ_node_child(p->node[1]))->value, e->code, nv);
     return true;
 }
 
@@ -251,8 +251,9 @@ static bool leaf_step(occ_map_t *const m, path_t *const p, occ_value_t *const le
 /* The leaf block's values the path ends in after a voxel entry, else NULL (a uniform node). */
 static occ_value_t *path_leaf(const occ_map_t *const m, const path_t *const p)
 {
-    return p->low == 1u && *p->node[1].child != OCC_NONE ? occ_leaf_at(m, *p->node[1].child)->value
-                                                         : NULL;
+    return p->low == 1u && occ_node_child(p->node[1]) != OCC_NONE
+               ? occ_leaf_at(m, occ_node_child(p->node[1]))->value
+               : NULL;
 }
 
 /* path_start for a voxel in another leaf block of the level-2 node the path ends in (the path
@@ -275,8 +276,8 @@ static void node_step(occ_map_t *const m, path_t *const p, const entry_t *const 
 {
     const unsigned lv = e->level;
     unsigned l = start;
-    while (l > lv && *p->node[l].child != OCC_NONE) {
-        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(e->code, l));
+    while (l > lv && occ_node_child(p->node[l]) != OCC_NONE) {
+        p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(e->code, l));
         l--;
     }
     p->low = l;
@@ -287,7 +288,7 @@ static void node_step(occ_map_t *const m, path_t *const p, const entry_t *const 
         }
         for (; l > lv; l--) {
             occi_tree_expand(m, p->node[l], l);
-            p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(e->code, l));
+            p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(e->code, l));
         }
         p->low = lv;
     }
