@@ -79,7 +79,7 @@ endef
 $(eval $(call FOUNDATION_VARIANT,float,-DOCC_VALUE_FLOAT=1,test_tree_shadow test_tree_octomap test_pool test_corrupt))
 # Issue 22: the compact 8-bit value mode runs the core suite too (tests comparing against OctoMap
 # compare occupancy states / values within the 8-bit step there), plus its own arithmetic test.
-V8_TESTS := test_value test_tree_shadow test_tree_octomap test_pool test_corrupt
+V8_TESTS := test_value test_tree_shadow test_tree_octomap test_pool test_corrupt test_packed
 $(eval $(call FOUNDATION_VARIANT,v8,-DOCC_VALUE_BITS=8,$(V8_TESTS)))
 # The firmware's float-only key arithmetic, against OctoMap within the documented border bound.
 $(eval $(call FOUNDATION_VARIANT,rayf,-DOCC_RAY_DOUBLE=0,test_tree_octomap))

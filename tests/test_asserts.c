@@ -230,10 +230,10 @@ static void test_pool_alloc_inner_without_free_mark(void **state)
 {
     (void)state;
     /* The inner free list's head does not carry the free mark: a used block is on the list. */
-    occ_inner_at(&map, map.inner.priv.free_head)->flags[7] = 0u;
+    occ_inner_mark_used(occ_inner_at(&map, map.inner.priv.free_head));
     assert_int_equal(occ_map_check(&map), OCC_ERR_CORRUPT);
     expect_assert_on(occi_pool_alloc_inner(&map),
-                     "occ_inner_at(m, idx)->flags[7] == OCC_INNER_FREE_MARK");
+                     "occ_inner_is_free(occ_inner_at(m, idx))");
 }
 
 static void test_pool_alloc_counters_broken(void **state)

@@ -18,6 +18,14 @@
 #include "support/leak_check.h"
 
 #define ARENA_SIZE OCC_ARENA_BYTES(64, 64)
+/* Indices past every pool that a child field can still hold (24 bits in the 8-bit mode). */
+#if OCC_INNER_PACKED
+#define BAD_LINK 0x7FFFFFu
+#define BAD_INDEX 0xFFFFFEu
+#else
+#define BAD_LINK 0x7FFFFFFFu
+#define BAD_INDEX (OCC_NONE - 1u)
+#endif
 static uint8_t arena[ARENA_SIZE];
 static uint8_t arena_copy[ARENA_SIZE];
 static occ_map_t map;
@@ -96,8 +104,8 @@ static occ_nodep_t node_at(const occ_key_t key, const unsigned level)
     occ_nodep_t n = occ_root(&map);
     const occ_code_t code = occ_morton_encode(key);
     for (unsigned l = map.cfg.depth_levels; l > level; l--) {
-        assert_true(*n.child != OCC_NONE);
-        n = occ_inner_node(&map, *n.child, occ_code_slot(code, l));
+        assert_true(occ_node_child(n) != OCC_NONE);
+        n = occ_inner_node(&map, occ_node_child(n), occ_code_slot(code, l));
     }
     return n;
 }
@@ -114,9 +122,9 @@ static void test_undamaged(void **state)
     (void)state;
     assert_int_equal(occ_map_check(&map), OCC_OK);
     /* The fixture has what the damage cases need. */
-    assert_true(*node_at(mk(0, 0, 0), 1u).child != OCC_NONE);
-    assert_true(*node_at(mk(8, 8, 8), 2u).child == OCC_NONE);
-    assert_true(*node_at(mk(0, 8, 0), 1u).child == OCC_NONE);
+    assert_true(occ_node_child(node_at(mk(0, 0, 0), 1u)) != OCC_NONE);
+    assert_true(occ_node_child(node_at(mk(8, 8, 8), 2u)) == OCC_NONE);
+    assert_true(occ_node_child(node_at(mk(0, 8, 0), 1u)) == OCC_NONE);
     occ_node_info_t info;
     assert_int_equal(occ_map_read_key(&map, mk(9, 9, 9), 0u, &info), OCC_OK);
     assert_int_equal(info.state, OCC_STATE_FREE);
@@ -130,11 +138,11 @@ static void test_free_list_cycles(void **state)
     uint32_t i = map.inner.priv.free_head, last = i;
     while (i != OCC_NONE) {
         last = i;
-        i = occ_inner_at(&map, i)->child[0];
+        i = occ_inner_child(occ_inner_at(&map, i), 0);
     }
-    occ_inner_at(&map, last)->child[0] = map.inner.priv.free_head;
+    occ_inner_set_child(occ_inner_at(&map, last), 0, map.inner.priv.free_head);
     expect_corrupt("inner free-list cycle (tail -> head)");
-    occ_inner_at(&map, map.inner.priv.free_head)->child[0] = map.inner.priv.free_head;
+    occ_inner_set_child(occ_inner_at(&map, map.inner.priv.free_head), 0, map.inner.priv.free_head);
     expect_corrupt("inner free-list self loop");
     /* Leaf: the same. */
     i = map.leaf.priv.free_head;
@@ -157,13 +165,13 @@ static void test_free_list_foreign(void **state)
     expect_corrupt("inner free head beyond the high-water mark");
     map.leaf.priv.free_head = map.leaf.hwm;
     expect_corrupt("leaf free head at the high-water mark");
-    occ_inner_at(&map, map.inner.priv.free_head)->child[0] = 0x7FFFFFFFu;
+    occ_inner_set_child(occ_inner_at(&map, map.inner.priv.free_head), 0, BAD_LINK);
     expect_corrupt("inner free-list link to a foreign index");
     const uint32_t bad = map.leaf.hwm + 1u;
     memcpy(occ_leaf_at(&map, map.leaf.priv.free_head)->value, &bad, sizeof bad);
     expect_corrupt("leaf free-list link to a foreign index");
     /* The inner free mark cleared on a free block (looks used). */
-    occ_inner_at(&map, map.inner.priv.free_head)->flags[7] = 0u;
+    occ_inner_mark_used(occ_inner_at(&map, map.inner.priv.free_head));
     expect_corrupt("inner free block without its free mark");
 }
 
@@ -226,7 +234,7 @@ static void test_leaked_block(void **state)
     expect_corrupt("free list dropped: blocks neither used nor free");
     /* A subtree unlinked: the node claims no children but the block is still counted used. */
     const occ_nodep_t n = node_at(mk(0, 0, 0), 1u);
-    *n.child = OCC_NONE;
+    occ_node_set_child(n, OCC_NONE);
     expect_corrupt("child link cut, block leaked");
 }
 
@@ -243,7 +251,7 @@ static void test_wrong_values(void **state)
     expect_corrupt("root max wrong");
     /* A voxel raised above its parent's max. */
     n = node_at(mk(0, 0, 0), 1u);
-    occ_leaf_at(&map, *n.child)->value[1] = (occ_value_t)(*n.value + 1);
+    occ_leaf_at(&map, occ_node_child(n))->value[1] = (occ_value_t)(*n.value + 1);
     expect_corrupt("voxel above its parent's max");
     /* A pruned node's value changed: its parent's max or flags no longer agree. */
     n = node_at(mk(0, 8, 0), 1u);
@@ -257,15 +265,15 @@ static void test_wrong_indicators(void **state)
     static const uint8_t bits[] = {OCC_NODE_HAS_FREE, OCC_NODE_HAS_UNKNOWN, OCC_NODE_HAS_OCCUPIED};
     for (size_t b = 0; b < sizeof bits; b++) {
         occ_nodep_t n = node_at(mk(0, 0, 0), 1u);
-        *n.flags ^= bits[b];
+        occ_node_set_flags(n, (uint8_t)(occ_node_flags(n) ^ bits[b]));
         expect_corrupt("level-1 indicator flipped");
         n = node_at(mk(8, 8, 8), 3u);
-        *n.flags ^= bits[b];
+        occ_node_set_flags(n, (uint8_t)(occ_node_flags(n) ^ bits[b]));
         expect_corrupt("level-3 indicator flipped");
         n = node_at(mk(8, 8, 8), 2u); /* pruned: flags follow from the value */
-        *n.flags ^= bits[b];
+        occ_node_set_flags(n, (uint8_t)(occ_node_flags(n) ^ bits[b]));
         expect_corrupt("pruned node indicator flipped");
-        map.priv.root_flags ^= bits[b];
+        occ_root_set_flags(&map, (uint8_t)(occ_root_flags(&map) ^ bits[b]));
         expect_corrupt("root indicator flipped");
     }
 }
@@ -283,12 +291,12 @@ static void test_unpruned_equal_block(void **state)
     expect_corrupt("level-1 node expanded into a leaf block of 8 equal voxels");
     /* Make a real leaf block all equal by hand. */
     n = node_at(mk(0, 0, 0), 1u);
-    occ_leaf_block_t *const b = occ_leaf_at(&map, *n.child);
+    occ_leaf_block_t *const b = occ_leaf_at(&map, occ_node_child(n));
     for (unsigned i = 0; i < 8u; i++) {
         b->value[i] = b->value[0];
     }
     *n.value = b->value[0];
-    *n.flags = occ_value_flags(&map, b->value[0]);
+    occ_node_set_flags(n, occ_value_flags(&map, b->value[0]));
     expect_corrupt("leaf block of 8 equal voxels left unpruned");
 }
 
@@ -296,19 +304,19 @@ static void test_child_index_out_of_range(void **state)
 {
     (void)state;
     occ_nodep_t n = node_at(mk(0, 0, 0), 1u);
-    *n.child = map.leaf.hwm;
+    occ_node_set_child(n, map.leaf.hwm);
     expect_corrupt("leaf child index == leaf hwm");
     n = node_at(mk(0, 0, 0), 1u);
-    *n.child = OCC_NONE - 1u;
-    expect_corrupt("leaf child index 0xFFFFFFFE");
+    occ_node_set_child(n, BAD_INDEX);
+    expect_corrupt("leaf child index just below OCC_NONE");
     n = node_at(mk(0, 0, 0), 2u);
-    *n.child = map.inner.hwm + 5u;
+    occ_node_set_child(n, map.inner.hwm + 5u);
     expect_corrupt("inner child index beyond inner hwm");
-    map.priv.root_child = map.inner.hwm;
+    occ_root_set_child(&map, map.inner.hwm);
     expect_corrupt("root child index == inner hwm");
     /* A child index that names a block on the free list. */
     n = node_at(mk(0, 0, 0), 2u);
-    *n.child = map.inner.priv.free_head;
+    occ_node_set_child(n, map.inner.priv.free_head);
     expect_corrupt("child index of a free inner block");
 }
 
@@ -320,14 +328,14 @@ static void test_shared_and_freed_blocks(void **state)
     const occ_nodep_t p = node_at(mk(0, 0, 0), 2u);
     (void)p;
     const occ_nodep_t b = node_at(mk(0, 8, 0), 1u); /* pruned: no block of its own */
-    *b.child = *a.child;
+    occ_node_set_child(b, occ_node_child(a));
     *b.value = *a.value;
-    *b.flags = *a.flags;
+    occ_node_set_flags(b, occ_node_flags(a));
     expect_corrupt("leaf block owned by two nodes");
     /* A block in the tree and on the free list (freed while still linked). */
-    assert_true(occi_pool_free_leaf(&map, *node_at(mk(0, 0, 0), 1u).child));
+    assert_true(occi_pool_free_leaf(&map, occ_node_child(node_at(mk(0, 0, 0), 1u))));
     expect_corrupt("linked leaf block on the free list");
-    assert_true(occi_pool_free_inner(&map, *node_at(mk(0, 0, 0), 2u).child));
+    assert_true(occi_pool_free_inner(&map, occ_node_child(node_at(mk(0, 0, 0), 2u))));
     expect_corrupt("linked inner block on the free list");
 }
 

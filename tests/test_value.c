@@ -33,7 +33,7 @@
 #define Q_CMIN (-72)  /* -72.001 */
 #define Q_CMAX 126    /* 126.397 */
 #define LEAF_B 8u
-#define INNER_B 48u
+#define INNER_B 35u
 #define STEP_ERR 0.0140f /* |31/36 - 0.8473| = 0.0138, |15/36 - 0.4055| = 0.0112 */
 #else
 #define SCALE 1024

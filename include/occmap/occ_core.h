@@ -56,7 +56,9 @@ extern "C" {
  *                      not the public structs' field names.
  * OCC_VALUE_BITS   16: (with OCC_VALUE_FLOAT 0) the fixed-point width above (default).
  *                   8: compact int8 log-odds, step 1/OCC_FIXED_ONE = 1/36 (0.0278). Leaf block
- *                      8 B, inner block 48 B. Raw range [-127, +127] = [-3.53, +3.53] log-odds,
+ *                      8 B, inner block 35 B (24-bit child indices: a pool holds at most
+ *                      OCC_POOL_MAX_BLOCKS = 2^24 - 1 blocks, the map uses at most 128 MiB of
+ *                      arena). Raw range [-127, +127] = [-3.53, +3.53] log-odds,
  *                      -128 is reserved for "unobserved". OctoMap's defaults land exactly or
  *                      nearly on the grid: clamp_min -2.0 -> -72 (exact), clamp_max 3.511 ->
  *                      126 (3.500, -0.011), occupancy threshold 0 -> 0 (exact, so the occupied /
@@ -188,7 +190,17 @@ occ_map_config_t occ_map_config_default(void);
 
 /* ---- Pools and the map ------------------------------------------------------------------------ */
 #define OCC_LEAF_BLOCK_BYTES ((size_t)(8u * sizeof(occ_value_t)))
+#if OCC_VALUE_BITS == 8
+/* 8 x (3-byte child index + value) + 3 bytes of indicator bits (3 per entry). */
+#define OCC_INNER_BLOCK_BYTES ((size_t)35u)
+/* Blocks one pool can hold: the 24-bit indices keep 0xFFFFFF for "no child". occ_map_init()
+ * uses at most OCC_POOL_MAX_BLOCKS * OCC_LEAF_BLOCK_BYTES (128 MiB) of a larger arena. */
+#define OCC_POOL_MAX_BLOCKS 0xFFFFFFu
+#else
 #define OCC_INNER_BLOCK_BYTES ((size_t)(8u * (4u + sizeof(occ_value_t) + 1u)))
+/* Blocks one pool can hold (an index is a uint32_t, OCC_NONE is "no child"). */
+#define OCC_POOL_MAX_BLOCKS 0xFFFFFFFEu
+#endif
 #define OCC_ARENA_ALIGN 8u
 /* Bytes of arena that hold at least n_inner inner blocks and n_leaf leaf blocks at once
  * (plus alignment slack, so any pointer the caller passes works). */
@@ -238,9 +250,16 @@ typedef struct {
         double geo_res, geo_inv;
         float geo_res_f, geo_inv_f;
         /* The root node (level depth_levels) lives here, not in a block. */
+#if OCC_VALUE_BITS == 8
+        /* Packed as in an inner block: a 24-bit index, the indicator bits one per byte. */
+        uint8_t root_child[3];
+        occ_value_t root_value;
+        uint8_t root_flags[3];
+#else
         uint32_t root_child;
         occ_value_t root_value;
         uint8_t root_flags;
+#endif
         void *shared;             /* occ_shared.h state once occ_map_share() ran, else NULL */
     } priv;                   /* internal: do not touch, layout may change */
 } occ_map_t;

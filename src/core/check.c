@@ -37,9 +37,9 @@ static bool tally_complete(const tally_t *const t, const uint32_t hwm)
 static bool check_free_lists(const occ_map_t *const m, tally_t *const inner, tally_t *const leaf)
 {
     uint32_t n = 0u;
-    for (uint32_t i = m->inner.priv.free_head; i != OCC_NONE; i = occ_inner_at(m, i)->child[0]) {
+    for (uint32_t i = m->inner.priv.free_head; i != OCC_NONE; i = occ_inner_child(occ_inner_at(m, i), 0)) {
         if (i >= m->inner.hwm || n++ > m->inner.hwm ||
-            occ_inner_at(m, i)->flags[7] != OCC_INNER_FREE_MARK) {
+            !occ_inner_is_free(occ_inner_at(m, i))) {
             return false; /* foreign index, cycle, or a used block on the list */
         }
         tally_add(inner, i);
@@ -75,14 +75,14 @@ static bool check_block(const occ_map_t *const m, const uint32_t child, const un
         }
     } else {
         const occ_inner_block_t *const b = occ_inner_at(m, child);
-        if (b->flags[7] == OCC_INNER_FREE_MARK) {
+        if (occ_inner_is_free(b)) {
             return false;
         }
         for (unsigned s = 0; s < 8u; s++) {
             mx = b->value[s] > mx ? b->value[s] : mx;
-            f = (uint8_t)(f | b->flags[s]);
-            prunable = prunable && b->child[s] == OCC_NONE && occ_value_eq(b->value[s], b->value[0]);
-            if (b->child[s] == OCC_NONE && b->flags[s] != occ_value_flags(m, b->value[s])) {
+            f = (uint8_t)(f | occ_inner_flags(b, s));
+            prunable = prunable && occ_inner_child(b, s) == OCC_NONE && occ_value_eq(b->value[s], b->value[0]);
+            if (occ_inner_child(b, s) == OCC_NONE && occ_inner_flags(b, s) != occ_value_flags(m, b->value[s])) {
                 return false;
             }
         }
@@ -127,7 +127,7 @@ static bool check_subtree(const occ_map_t *const m, const unsigned depth, tally_
     uint32_t blk[OCC_MAX_DEPTH + 1];
     uint8_t lvl[OCC_MAX_DEPTH + 1], next[OCC_MAX_DEPTH + 1];
     unsigned sp = 0;
-    blk[0] = m->priv.root_child;
+    blk[0] = occ_root_child(m);
     lvl[0] = (uint8_t)(depth - 1u);
     next[0] = 0u;
     for (;;) {
@@ -140,12 +140,12 @@ static bool check_subtree(const occ_map_t *const m, const unsigned depth, tally_
         }
         const occ_inner_block_t *const b = occ_inner_at(m, blk[sp]);
         const unsigned s = next[sp]++;
-        const uint32_t c = b->child[s];
+        const uint32_t c = occ_inner_child(b, s);
         if (c == OCC_NONE) {
             continue;
         }
         const unsigned l = lvl[sp];
-        if (!check_child(m, c, l, b->value[s], b->flags[s], inner, leaf)) {
+        if (!check_child(m, c, l, b->value[s], occ_inner_flags(b, s), inner, leaf)) {
             return false;
         }
         if (l > 1u) {
@@ -164,15 +164,15 @@ static bool check_subtree(const occ_map_t *const m, const unsigned depth, tally_
 static bool check_tree(const occ_map_t *const m, tally_t *const inner, tally_t *const leaf)
 {
     const unsigned depth = m->cfg.depth_levels;
-    if (m->priv.root_child == OCC_NONE) {
-        return m->priv.root_flags == occ_value_flags(m, m->priv.root_value);
+    if (occ_root_child(m) == OCC_NONE) {
+        return occ_root_flags(m) == occ_value_flags(m, m->priv.root_value);
     }
     /* The auditor survives any bytes: depth, counters and every index are range-checked here
      * before they are followed, so the accessors' asserts never see a bad one from this walk. */
     if (depth < 1u || depth > OCC_MAX_DEPTH) {
         return false;
     }
-    if (!check_child(m, m->priv.root_child, depth, m->priv.root_value, m->priv.root_flags, inner, leaf)) {
+    if (!check_child(m, occ_root_child(m), depth, m->priv.root_value, occ_root_flags(m), inner, leaf)) {
         return false;
     }
     return depth == 1u || check_subtree(m, depth, inner, leaf);
@@ -190,7 +190,7 @@ occ_err_t occ_map_check(const occ_map_t *const m)
     }
     /* Every block below the high-water marks owned exactly once, by the tree or a free list;
      * an empty tree owns none (its blocks are all free). */
-    if (m->priv.root_child != OCC_NONE && (inner.count - m->inner.free_count != m->inner.used ||
+    if (occ_root_child(m) != OCC_NONE && (inner.count - m->inner.free_count != m->inner.used ||
                                       leaf.count - m->leaf.free_count != m->leaf.used)) {
         return OCC_ERR_CORRUPT;
     }

@@ -59,7 +59,13 @@ occ_err_t occ_map_init(occ_map_t *const map, const occ_map_config_t *const cfg, 
         start += adj;
     }
     map->priv.arena = (uint8_t *)start;
+#if OCC_INNER_PACKED
+    /* 24-bit indices cap the arena; the size stays unrounded: a 35-byte block from the end is
+     * byte-aligned anyway, and OCC_ARENA_BYTES has only the start's slack. */
+    map->arena_bytes = bytes < OCC_ARENA_CAP_BYTES ? bytes : OCC_ARENA_CAP_BYTES;
+#else
     map->arena_bytes = bytes - bytes % OCC_ARENA_ALIGN;
+#endif
     map->priv.block_budget = (uint32_t)(map->arena_bytes / OCC_LEAF_BLOCK_BYTES);
     map->write_gen = 0u; /* occ_map_clear() makes it 1 */
     map->priv.shared = NULL; /* a fresh map is not shared (occ_shared.h) */
@@ -76,9 +82,9 @@ void occ_map_clear(occ_map_t *const map)
     map->inner = empty;
     map->leaf = empty;
     map->oom_count = 0u;
-    map->priv.root_child = OCC_NONE;
+    occ_root_set_child(map, OCC_NONE);
     map->priv.root_value = OCC_VALUE_UNOBSERVED;
-    map->priv.root_flags = (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    occ_root_set_flags(map, (uint8_t)OCC_NODE_HAS_UNKNOWN);
     map->write_gen++; /* every handle on the old content is stale */
     occi_shared_written(map);
 }

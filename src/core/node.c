@@ -28,7 +28,7 @@ void occ_map_node_root(const occ_map_t *const map, occ_node_t *const out)
     out->key = zero;
     out->level = map->cfg.depth_levels;
     out->gen = map->write_gen;
-    fill(map, out, map->priv.root_value, map->priv.root_flags, map->priv.root_child);
+    fill(map, out, map->priv.root_value, occ_root_flags(map), occ_root_child(map));
 }
 
 /* What a failed child call leaves: nothing observed, no children to follow. */

@@ -53,8 +53,8 @@ uint32_t occi_pool_alloc_inner(occ_map_t *const m)
     OCC_ASSERT(pools_fit(m));
     if (idx != OCC_NONE) {
         OCC_ASSERT(m->inner.free_count > 0u);
-        OCC_ASSERT(occ_inner_at(m, idx)->flags[7] == OCC_INNER_FREE_MARK);
-        m->inner.priv.free_head = occ_inner_at(m, idx)->child[0];
+        OCC_ASSERT(occ_inner_is_free(occ_inner_at(m, idx)));
+        m->inner.priv.free_head = occ_inner_child(occ_inner_at(m, idx), 0);
         OCC_ASSERT(m->inner.priv.free_head == OCC_NONE || m->inner.priv.free_head < m->inner.hwm);
         m->inner.free_count--;
     } else if (gap_bytes(m) >= sizeof(occ_inner_block_t)) {
@@ -62,7 +62,7 @@ uint32_t occi_pool_alloc_inner(occ_map_t *const m)
     } else {
         return OCC_NONE;
     }
-    occ_inner_at(m, idx)->flags[7] = 0u;
+    occ_inner_mark_used(occ_inner_at(m, idx));
     occi_shared_touch(m, occ_inner_at(m, idx), sizeof(occ_inner_block_t)); /* the caller fills it */
     note_alloc(&m->inner);
     return idx;
@@ -93,11 +93,11 @@ bool occi_pool_free_inner(occ_map_t *const m, const uint32_t idx)
         return false;
     }
     occ_inner_block_t *const b = occ_inner_at(m, idx);
-    if (b->flags[7] == OCC_INNER_FREE_MARK) {
+    if (occ_inner_is_free(b)) {
         return false;  /* already free */
     }
-    b->flags[7] = OCC_INNER_FREE_MARK;
-    b->child[0] = m->inner.priv.free_head;
+    occ_inner_mark_free(b);
+    occ_inner_set_child(b, 0, m->inner.priv.free_head);
     occi_shared_touch(m, b, sizeof *b);
     m->inner.priv.free_head = idx;
     m->inner.free_count++;
@@ -132,11 +132,16 @@ uint32_t occ_arena_blocks_for_bytes(const size_t arena_bytes, const uint32_t n_i
     if (arena_bytes < OCC_ARENA_ALIGN) {
         return 0u;
     }
+#if OCC_INNER_PACKED
+    const size_t all = arena_bytes - OCC_ARENA_ALIGN;
+    const size_t usable = all < OCC_ARENA_CAP_BYTES ? all : OCC_ARENA_CAP_BYTES; /* as map.c */
+#else
     const size_t usable = arena_bytes - OCC_ARENA_ALIGN;
+#endif
     const size_t inner_bytes = occ_sat_mul(n_inner, sizeof(occ_inner_block_t));
     if (inner_bytes > usable) {
         return 0u;
     }
     const size_t n = (usable - inner_bytes) / sizeof(occ_leaf_block_t);
-    return n > (size_t)(OCC_NONE - 1u) ? OCC_NONE - 1u : (uint32_t)n;
+    return n > (size_t)OCC_POOL_MAX_BLOCKS ? OCC_POOL_MAX_BLOCKS : (uint32_t)n;
 }

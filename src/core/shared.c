@@ -261,9 +261,9 @@ occ_err_t occ_map_share(occ_map_t *const map, void *const mem, const size_t mem_
 /* What a view that holds nothing reads: an empty, unobserved map (fail closed). */
 static void view_close(occ_view_t *const view)
 {
-    view->map.priv.root_child = OCC_NONE;
+    occ_root_set_child(&view->map, OCC_NONE);
     view->map.priv.root_value = OCC_VALUE_UNOBSERVED;
-    view->map.priv.root_flags = (uint8_t)OCC_NODE_HAS_UNKNOWN;
+    occ_root_set_flags(&view->map, (uint8_t)OCC_NODE_HAS_UNKNOWN);
     view->map.priv.shared = NULL;
     view->map.inner.hwm = 0u;
     view->map.leaf.hwm = 0u;

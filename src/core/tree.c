@@ -51,7 +51,7 @@ static summary8_t summarize8(const occ_map_t *const m, const occ_value_t *const 
 
 void occi_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
-    OCC_ASSERT(level >= 1u && *node.child == OCC_NONE);
+    OCC_ASSERT(level >= 1u && occ_node_child(node) == OCC_NONE);
     OCC_ASSERT(level <= m->cfg.depth_levels);
     const occ_value_t v = *node.value;
     if (level == 1u) {
@@ -61,26 +61,21 @@ void occi_tree_expand(occ_map_t *const m, const occ_nodep_t node, const unsigned
         for (unsigned i = 0; i < 8u; i++) {
             b->value[i] = v;
         }
-        *node.child = idx;
-        occi_shared_touch(m, node.child, sizeof *node.child);
+        occ_node_set_child(node, idx);
+        occ_touch_child(m, node);
     } else {
         const uint32_t idx = occi_pool_alloc_inner(m);
         OCC_ASSERT(idx != OCC_NONE);
         occ_inner_block_t *const b = occ_inner_at(m, idx);
-        const uint8_t f = occ_value_flags(m, v);
-        for (unsigned i = 0; i < 8u; i++) {
-            b->child[i] = OCC_NONE;
-            b->value[i] = v;
-            b->flags[i] = f;
-        }
-        *node.child = idx;
-        occi_shared_touch(m, node.child, sizeof *node.child);
+        occ_inner_fill(b, v, occ_value_flags(m, v));
+        occ_node_set_child(node, idx);
+        occ_touch_child(m, node);
     }
 }
 
 bool occi_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
-    const uint32_t child = *node.child;
+    const uint32_t child = occ_node_child(node);
     if (child == OCC_NONE) {
         return false;
     }
@@ -101,22 +96,32 @@ bool occi_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigne
         const occ_inner_block_t *const b = occ_inner_at(m, child);
         nv = b->value[0];
         prunable = true;
+#if OCC_INNER_PACKED
+        /* Flags and children a byte test each, not eight unpackings. */
         for (unsigned i = 0; i < 8u; i++) {
             nv = b->value[i] > nv ? b->value[i] : nv;
-            nf = (uint8_t)(nf | b->flags[i]);
-            prunable = prunable & (b->child[i] == OCC_NONE) & occ_value_eq(b->value[i], b->value[0]);
+            prunable = prunable & occ_value_eq(b->value[i], b->value[0]);
         }
+        nf = occ_inner_flags_or(b);
+        prunable = prunable & occ_inner_childless(b);
+#else
+        for (unsigned i = 0; i < 8u; i++) {
+            nv = b->value[i] > nv ? b->value[i] : nv;
+            nf = (uint8_t)(nf | occ_inner_flags(b, i));
+            prunable = prunable & (occ_inner_child(b, i) == OCC_NONE) & occ_value_eq(b->value[i], b->value[0]);
+        }
+#endif
         if (prunable) {
             const bool freed = occi_pool_free_inner(m, child);
             OCC_ASSERT(freed);
         }
     }
     if (prunable) {
-        *node.child = OCC_NONE;
+        occ_node_set_child(node, OCC_NONE);
     }
-    const bool changed = prunable || !occ_value_eq(nv, *node.value) || nf != *node.flags;
+    const bool changed = prunable || !occ_value_eq(nv, *node.value) || nf != occ_node_flags(node);
     *node.value = nv;
-    *node.flags = nf;
+    occ_node_set_flags(node, nf);
     if (changed) {
         occ_touch_node(m, node);
     }
@@ -125,15 +130,15 @@ bool occi_tree_refresh(occ_map_t *const m, const occ_nodep_t node, const unsigne
 
 void occi_tree_release_children(occ_map_t *const m, const occ_nodep_t node, const unsigned level)
 {
-    if (*node.child == OCC_NONE) {
+    if (occ_node_child(node) == OCC_NONE) {
         return;
     }
     OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
     if (level == 1u) {
-        const bool freed = occi_pool_free_leaf(m, *node.child);
+        const bool freed = occi_pool_free_leaf(m, occ_node_child(node));
         OCC_ASSERT(freed);
-        *node.child = OCC_NONE;
-        occi_shared_touch(m, node.child, sizeof *node.child);
+        occ_node_set_child(node, OCC_NONE);
+        occ_touch_child(m, node);
         return;
     }
     /* Iterative post-order over inner blocks; frame i holds the block whose children sit at
@@ -142,16 +147,16 @@ void occi_tree_release_children(occ_map_t *const m, const occ_nodep_t node, cons
     uint8_t lvl[OCC_MAX_DEPTH + 1];
     uint8_t next[OCC_MAX_DEPTH + 1];
     unsigned sp = 0;
-    blk[0] = *node.child;
+    blk[0] = occ_node_child(node);
     lvl[0] = (uint8_t)(level - 1u); /* level of the nodes inside blk[0] */
     next[0] = 0u;
-    *node.child = OCC_NONE;
-    occi_shared_touch(m, node.child, sizeof *node.child);
+    occ_node_set_child(node, OCC_NONE);
+    occ_touch_child(m, node);
     for (;;) {
         occ_inner_block_t *const b = occ_inner_at(m, blk[sp]);
         if (next[sp] < 8u) {
             const unsigned slot = next[sp]++;
-            const uint32_t c = b->child[slot];
+            const uint32_t c = occ_inner_child(b, slot);
             if (c == OCC_NONE) {
                 continue;
             }
@@ -202,9 +207,9 @@ occ_err_t occ_map_read_key(const occ_map_t *const map, const occ_key_t key, cons
     }
     const occ_code_t code = occ_morton_encode(key);
     unsigned l = map->cfg.depth_levels;
-    uint32_t child = map->priv.root_child;
+    uint32_t child = occ_root_child(map);
     occ_value_t v = map->priv.root_value;
-    uint8_t f = map->priv.root_flags;
+    uint8_t f = occ_root_flags(map);
     while (l > level && child != OCC_NONE) {
         const unsigned slot = occ_code_slot(code, l);
         l--;
@@ -286,12 +291,22 @@ static void count_blocks(const occ_map_t *const m, path_t *const p, const occ_co
 {
     const unsigned depth = m->cfg.depth_levels;
     /* Read only: the path starts at a copy of the root, so the map can stay const. */
+#if OCC_INNER_PACKED
+    memcpy(p->root_child, m->priv.root_child, sizeof p->root_child);
+    memcpy(p->root_flags, m->priv.root_flags, sizeof p->root_flags);
+    p->node[depth].child = p->root_child;
+    p->node[depth].flags = p->root_flags;
+    p->node[depth].bit = 1u;
+    p->root_value = m->priv.root_value;
+    p->node[depth].value = &p->root_value;
+#else
     p->root_child = m->priv.root_child;
     p->root_value = m->priv.root_value;
     p->root_flags = m->priv.root_flags;
     p->node[depth].child = &p->root_child;
     p->node[depth].value = &p->root_value;
     p->node[depth].flags = &p->root_flags;
+#endif
     occ_code_t prev = 0, last_changing = 0;
     bool have_changing = false;
     *n_inner = 0u;
@@ -381,11 +396,11 @@ static occ_err_t apply_batch(occ_map_t *const m, const occ_code_t *const codes, 
         for (unsigned l = stop; l >= 1u; l--) {
             occi_tree_expand(m, p.node[l], l);
             if (l > 1u) {
-                p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(c, l));
+                p.node[l - 1u] = occ_inner_node(m, occ_node_child(p.node[l]), occ_code_slot(c, l));
             }
         }
         p.low = 1u;
-        occ_value_t *const slot_v = &occ_leaf_at(m, *p.node[1].child)->value[occ_code_slot(c, 1u)];
+        occ_value_t *const slot_v = &occ_leaf_at(m, occ_node_child(p.node[1]))->value[occ_code_slot(c, 1u)];
         *slot_v = nv;
         occi_shared_touch(m, slot_v, sizeof *slot_v);
         p.dirty[1] = true;
@@ -484,17 +499,17 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
     p.node[depth] = occ_root(m);
     /* Descend to the target level or to a uniform node above it. */
     unsigned l = depth;
-    while (l > level && l > 1u && *p.node[l].child != OCC_NONE) {
-        p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(code, l));
+    while (l > level && l > 1u && occ_node_child(p.node[l]) != OCC_NONE) {
+        p.node[l - 1u] = occ_inner_node(m, occ_node_child(p.node[l]), occ_code_slot(code, l));
         l--;
     }
     occ_leaf_block_t *leaf = NULL;
-    if (level == 0u && l == 1u && *p.node[1].child != OCC_NONE) {
-        leaf = occ_leaf_at(m, *p.node[1].child);
+    if (level == 0u && l == 1u && occ_node_child(p.node[1]) != OCC_NONE) {
+        leaf = occ_leaf_at(m, occ_node_child(p.node[1]));
         if (occ_value_eq(leaf->value[occ_code_slot(code, 1u)], v)) {
             return OCC_OK;
         }
-    } else if (*p.node[l].child == OCC_NONE && occ_value_eq(*p.node[l].value, v)) {
+    } else if (occ_node_child(p.node[l]) == OCC_NONE && occ_value_eq(*p.node[l].value, v)) {
         return OCC_OK; /* the uniform node already holds v everywhere */
     }
     if (leaf == NULL && l > level) {
@@ -508,12 +523,12 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
         while (l > level) {
             occi_tree_expand(m, p.node[l], l);
             if (l - 1u >= 1u) {
-                p.node[l - 1u] = occ_inner_node(m, *p.node[l].child, occ_code_slot(code, l));
+                p.node[l - 1u] = occ_inner_node(m, occ_node_child(p.node[l]), occ_code_slot(code, l));
             }
             l--;
         }
         if (level == 0u) {
-            leaf = occ_leaf_at(m, *p.node[1].child);
+            leaf = occ_leaf_at(m, occ_node_child(p.node[1]));
         }
     }
     m->write_gen++; /* set and forget write from here (the expansion above, too) */
@@ -525,7 +540,7 @@ static occ_err_t set_raw(occ_map_t *const m, const occ_key_t key, const unsigned
     } else {
         occi_tree_release_children(m, p.node[level], level);
         *p.node[level].value = v;
-        *p.node[level].flags = occ_value_flags(m, v);
+        occ_node_set_flags(p.node[level], occ_value_flags(m, v));
         occ_touch_node(m, p.node[level]);
         first_dirty = level + 1u;
     }

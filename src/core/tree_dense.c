@@ -19,7 +19,7 @@
 static void set_uniform(occ_map_t *const m, const occ_nodep_t n, const occ_value_t v)
 {
     *n.value = v;
-    *n.flags = occ_value_flags(m, v);
+    occ_node_set_flags(n, occ_value_flags(m, v));
     occ_touch_node(m, n);
 }
 
@@ -54,9 +54,9 @@ static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigne
         const occ_value_t vk = ((mb >> k) & 1u) != 0u ? vm : v;
         lb->value[k] = ((hb >> k) & 1u) != 0u ? vh : vk;
     }
-    *n.child = idx;
+    occ_node_set_child(n, idx);
     *n.value = mx;
-    *n.flags = f;
+    occ_node_set_flags(n, f);
     occ_touch_node(m, n);
     return changed;
 }
@@ -120,7 +120,7 @@ static OCC_ALWAYS_INLINE unsigned leaf8_update(const occ_map_t *const m,
 static OCC_ALWAYS_INLINE size_t node1_step(occ_map_t *const m, const occ_nodep_t n, const unsigned mb,
                          const unsigned hb, const unsigned cb, bool *const dirty)
 {
-    if (*n.child == OCC_NONE) {
+    if (occ_node_child(n) == OCC_NONE) {
         const occ_value_t v = *n.value;
         const occ_value_t vm = occ_value_apply_delta(m, v, m->priv.q_miss);
         const occ_value_t vh = occ_value_apply_delta(m, v, m->priv.q_hit);
@@ -130,7 +130,7 @@ static OCC_ALWAYS_INLINE size_t node1_step(occ_map_t *const m, const occ_nodep_t
         *dirty = true;
         return node1_split(m, n, mb, hb, cb, vm, vh);
     }
-    occ_leaf_block_t *const lb = occ_leaf_at(m, *n.child);
+    occ_leaf_block_t *const lb = occ_leaf_at(m, occ_node_child(n));
     occ_value_t nv[8];
     const unsigned moved = leaf8_update(m, lb->value, mb, hb, nv);
     if (moved != 0u) {
@@ -158,12 +158,12 @@ static OCC_ALWAYS_INLINE size_t brick_update(occ_map_t *const m, path_t *const p
                           (unsigned)count & 0xFFu, &dirty);
     }
     unsigned l = start;
-    while (l > 2u && *p->node[l].child != OCC_NONE) {
-        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(b->code, l));
+    while (l > 2u && occ_node_child(p->node[l]) != OCC_NONE) {
+        p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(b->code, l));
         l--;
     }
     p->low = l;
-    if (*p->node[l].child == OCC_NONE) {
+    if (occ_node_child(p->node[l]) == OCC_NONE) {
         const occ_value_t v = *p->node[l].value;
         const occ_value_t vm = occ_value_apply_delta(m, v, m->priv.q_miss);
         const bool cm = b->miss != 0u && !occ_value_eq(vm, v);
@@ -172,7 +172,7 @@ static OCC_ALWAYS_INLINE size_t brick_update(occ_map_t *const m, path_t *const p
         }
         for (; l > 2u; l--) {
             occi_tree_expand(m, p->node[l], l);
-            p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(b->code, l));
+            p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(b->code, l));
         }
         p->low = 2u;
         if (b->miss == ~(uint64_t)0) { /* the whole brick alike: it stays uniform */
@@ -182,7 +182,7 @@ static OCC_ALWAYS_INLINE size_t brick_update(occ_map_t *const m, path_t *const p
         }
         occi_tree_expand(m, p->node[2], 2u);
     }
-    const uint32_t blk = *p->node[2].child;
+    const uint32_t blk = occ_node_child(p->node[2]);
     size_t changed = 0;
     bool dirty = false;
     for (unsigned j = 0; j < 8u; j++) {

@@ -14,7 +14,7 @@
 static void apply_uniform(occ_map_t *const m, const occ_nodep_t node, const occ_delta_t delta)
 {
     *node.value = occ_value_apply_delta(m, *node.value, delta);
-    *node.flags = occ_value_flags(m, *node.value);
+    occ_node_set_flags(node, occ_value_flags(m, *node.value));
     occ_touch_node(m, node);
 }
 
@@ -22,7 +22,7 @@ void occi_tree_apply_subtree(occ_map_t *const m, const occ_nodep_t top, const un
                              const occ_delta_t delta)
 {
     OCC_ASSERT(level >= 1u && level <= m->cfg.depth_levels);
-    if (*top.child == OCC_NONE) {
+    if (occ_node_child(top) == OCC_NONE) {
         apply_uniform(m, top, delta);
         return;
     }
@@ -33,7 +33,7 @@ void occi_tree_apply_subtree(occ_map_t *const m, const occ_nodep_t top, const un
         uint8_t level, owner_slot, next; /* level: the owner's */
     } st[OCC_MAX_DEPTH + 1u];
     unsigned sp = 1;
-    st[0].block = *top.child;
+    st[0].block = occ_node_child(top);
     st[0].owner_block = OCC_NONE;
     st[0].level = (uint8_t)level;
     st[0].owner_slot = 0u;
@@ -57,12 +57,12 @@ void occi_tree_apply_subtree(occ_map_t *const m, const occ_nodep_t top, const un
         }
         const unsigned s = st[t].next++;
         const occ_nodep_t c = occ_inner_node(m, st[t].block, s);
-        if (*c.child == OCC_NONE) {
+        if (occ_node_child(c) == OCC_NONE) {
             apply_uniform(m, c, delta);
             continue;
         }
         OCC_ASSERT(sp <= OCC_MAX_DEPTH);
-        st[sp].block = *c.child;
+        st[sp].block = occ_node_child(c);
         st[sp].owner_block = st[t].block;
         st[sp].level = (uint8_t)(st[t].level - 1u);
         st[sp].owner_slot = (uint8_t)s;
@@ -134,8 +134,8 @@ static void node_step(occ_map_t *const m, path_t *const p, const occ_code_t code
                       const unsigned lv, const occ_delta_t delta, const unsigned start)
 {
     unsigned l = start;
-    while (l > lv && *p->node[l].child != OCC_NONE) {
-        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
+    while (l > lv && occ_node_child(p->node[l]) != OCC_NONE) {
+        p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(code, l));
         l--;
     }
     p->low = l;
@@ -146,7 +146,7 @@ static void node_step(occ_map_t *const m, path_t *const p, const occ_code_t code
         }
         for (; l > lv; l--) {
             occi_tree_expand(m, p->node[l], l);
-            p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
+            p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(code, l));
         }
         p->low = lv;
     }

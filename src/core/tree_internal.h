@@ -17,11 +17,28 @@
 #include "../geom/geom_internal.h"
 #include "shared_internal.h"
 
+/* The 8-bit mode packs inner blocks (35 B, byte-aligned): child s is bytes 3s..3s+2 of child,
+ * little-endian, 0xFFFFFF for OCC_NONE; bit s of flags[j] is indicator bit j (1 << j) of
+ * entry s. Only the accessors below know the layout. */
+#if OCC_VALUE_BITS == 8
+#define OCC_INNER_PACKED 1
+#else
+#define OCC_INNER_PACKED 0
+#endif
+
+#if OCC_INNER_PACKED
+typedef struct {
+    uint8_t child[24];
+    occ_value_t value[8];
+    uint8_t flags[3];
+} occ_inner_block_t;
+#else
 typedef struct {
     uint32_t child[8];
     occ_value_t value[8];
     uint8_t flags[8];
 } occ_inner_block_t;
+#endif
 
 typedef struct {
     occ_value_t value[8];
@@ -46,26 +63,252 @@ typedef char occ_leaf_block_bytes_match[sizeof(occ_leaf_block_t) == OCC_LEAF_BLO
 #define OCC_VALUE_MIN (INT16_MIN + 1)
 #define OCC_VALUE_MAX INT16_MAX
 #endif
-#if !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 8
-/* The compact mode's blocks really shrink: 8 x (child 4 + value 1 + flags 1), 8 x value 1. */
-typedef char occ_inner_block_is_48[sizeof(occ_inner_block_t) == 48u ? 1 : -1];
+#if OCC_INNER_PACKED
+/* The compact mode's blocks really shrink: 8 x (child 3 + value 1) + 3 flag bytes, 8 x value 1. */
+typedef char occ_inner_block_is_35[sizeof(occ_inner_block_t) == 35u ? 1 : -1];
 typedef char occ_leaf_block_is_8[sizeof(occ_leaf_block_t) == 8u ? 1 : -1];
 #endif
 
-/* Pointers to one node's fields, wherever it lives. */
+/* Pointers to one node's fields, wherever it lives (packed: flags points at the 3 flag bytes
+ * and bit is 1 << slot). Read and write them through occ_node_*() only. */
+#if OCC_INNER_PACKED
+typedef struct {
+    uint8_t *child;
+    occ_value_t *value;
+    uint8_t *flags;
+    unsigned bit;
+} occ_nodep_t;
+#define OCC_CHILD_BYTES 3u
+#define OCC_FLAG_BYTES 3u
+/* The arena bytes a map uses at most: no pool can then pass OCC_POOL_MAX_BLOCKS (the leaf
+ * block is the smaller one). */
+#define OCC_ARENA_CAP_BYTES ((size_t)OCC_POOL_MAX_BLOCKS * OCC_LEAF_BLOCK_BYTES)
+#else
 typedef struct {
     uint32_t *child;
     occ_value_t *value;
     uint8_t *flags;
 } occ_nodep_t;
+#define OCC_CHILD_BYTES sizeof(uint32_t)
+#define OCC_FLAG_BYTES 1u
+#endif
+
+/* ---- Field accessors: in the 16-bit and float modes plain array and pointer accesses. ---- */
+#if OCC_INNER_PACKED
+static inline uint32_t occ_child_load(const uint8_t *const p)
+{
+    const uint32_t c = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16;
+    return c == 0xFFFFFFu ? OCC_NONE : c;
+}
+
+static inline void occ_child_store(uint8_t *const p, const uint32_t c)
+{
+    OCC_ASSERT(c == OCC_NONE || c < 0xFFFFFFu); /* pools hold < 2^24 blocks (map.c) */
+    p[0] = (uint8_t)c;
+    p[1] = (uint8_t)(c >> 8);
+    p[2] = (uint8_t)(c >> 16);
+}
+
+static inline uint8_t occ_flags_load(const uint8_t *const p, const unsigned bit)
+{
+    return (uint8_t)(((p[0] & bit) != 0u ? 1u : 0u) | ((p[1] & bit) != 0u ? 2u : 0u) |
+                     ((p[2] & bit) != 0u ? 4u : 0u));
+}
+
+static inline void occ_flags_store(uint8_t *const p, const unsigned bit, const uint8_t f)
+{
+    OCC_ASSERT(f <= 7u);
+    for (unsigned j = 0; j < 3u; j++) {
+        p[j] = (uint8_t)((p[j] & ~bit) | (((f >> j) & 1u) != 0u ? bit : 0u));
+    }
+}
+
+static inline uint32_t occ_inner_child(const occ_inner_block_t *const b, const unsigned s)
+{
+    return occ_child_load(&b->child[3u * s]);
+}
+
+static inline void occ_inner_set_child(occ_inner_block_t *const b, const unsigned s,
+                                       const uint32_t c)
+{
+    occ_child_store(&b->child[3u * s], c);
+}
+
+static inline uint8_t occ_inner_flags(const occ_inner_block_t *const b, const unsigned s)
+{
+    return occ_flags_load(b->flags, 1u << s);
+}
+
+static inline void occ_inner_set_flags(occ_inner_block_t *const b, const unsigned s,
+                                       const uint8_t f)
+{
+    occ_flags_store(b->flags, 1u << s, f);
+}
+
+static inline uint32_t occ_node_child(const occ_nodep_t n)
+{
+    return occ_child_load(n.child);
+}
+
+static inline void occ_node_set_child(const occ_nodep_t n, const uint32_t c)
+{
+    occ_child_store(n.child, c);
+}
+
+static inline uint8_t occ_node_flags(const occ_nodep_t n)
+{
+    return occ_flags_load(n.flags, n.bit);
+}
+
+static inline void occ_node_set_flags(const occ_nodep_t n, const uint8_t f)
+{
+    occ_flags_store(n.flags, n.bit, f);
+}
+
+static inline uint32_t occ_root_child(const occ_map_t *const m)
+{
+    return occ_child_load(m->priv.root_child);
+}
+
+static inline uint8_t occ_root_flags(const occ_map_t *const m)
+{
+    return occ_flags_load(m->priv.root_flags, 1u);
+}
+
+static inline void occ_root_set_child(occ_map_t *const m, const uint32_t c)
+{
+    occ_child_store(m->priv.root_child, c);
+}
+
+static inline void occ_root_set_flags(occ_map_t *const m, const uint8_t f)
+{
+    occ_flags_store(m->priv.root_flags, 1u, f);
+}
+
+/* A free inner block has no indicator bit at all: every used entry has one (tree invariant). */
+static inline bool occ_inner_is_free(const occ_inner_block_t *const b)
+{
+    return (b->flags[0] | b->flags[1] | b->flags[2]) == 0u;
+}
+
+static inline void occ_inner_mark_free(occ_inner_block_t *const b)
+{
+    b->flags[0] = b->flags[1] = b->flags[2] = 0u;
+}
+
+static inline void occ_inner_mark_used(occ_inner_block_t *const b)
+{
+    b->flags[1] = 0xFFu; /* every entry "has unknown" until the caller fills the block */
+}
+
+/* Whole-block forms for refresh and expand: a byte test or store per flag bit instead of eight
+ * unpackings (the 8-bit mode's updates were ~50% slower without them). */
+static inline uint8_t occ_inner_flags_or(const occ_inner_block_t *const b)
+{
+    return (uint8_t)((b->flags[0] != 0u ? 1u : 0u) | (b->flags[1] != 0u ? 2u : 0u) |
+                     (b->flags[2] != 0u ? 4u : 0u));
+}
+
+static inline bool occ_inner_childless(const occ_inner_block_t *const b)
+{
+    unsigned all = 0xFFu;
+    for (unsigned i = 0; i < sizeof b->child; i++) {
+        all &= b->child[i];
+    }
+    return all == 0xFFu; /* only OCC_NONE is stored as 0xFFFFFF */
+}
+
+/* Eight uniform entries of value v and flags f, without children. */
+static inline void occ_inner_fill(occ_inner_block_t *const b, const occ_value_t v, const uint8_t f)
+{
+    OCC_ASSERT(f <= 7u);
+    for (unsigned i = 0; i < sizeof b->child; i++) {
+        b->child[i] = 0xFFu;
+    }
+    for (unsigned i = 0; i < 8u; i++) {
+        b->value[i] = v;
+    }
+    for (unsigned j = 0; j < 3u; j++) {
+        b->flags[j] = ((f >> j) & 1u) != 0u ? 0xFFu : 0u;
+    }
+}
+#else
+static inline uint32_t occ_inner_child(const occ_inner_block_t *const b, const unsigned s)
+{
+    return b->child[s];
+}
+
+static inline void occ_inner_set_child(occ_inner_block_t *const b, const unsigned s,
+                                       const uint32_t c)
+{
+    b->child[s] = c;
+}
+
+static inline uint8_t occ_inner_flags(const occ_inner_block_t *const b, const unsigned s)
+{
+    return b->flags[s];
+}
+
+static inline void occ_inner_set_flags(occ_inner_block_t *const b, const unsigned s,
+                                       const uint8_t f)
+{
+    b->flags[s] = f;
+}
+
+/* Macros here: the node and root accessors expand to the plain dereferences this build was
+ * written with, so its code stays the same (inline functions taking the struct by value moved
+ * loads and inlining decisions in tree.c, tree_frame.c and map.c). */
+#define occ_node_child(n) (*(n).child)
+#define occ_node_set_child(n, c) ((void)(*(n).child = (c)))
+#define occ_node_flags(n) (*(n).flags)
+#define occ_node_set_flags(n, f) ((void)(*(n).flags = (f)))
+
+#define occ_root_child(m) ((m)->priv.root_child)
+#define occ_root_flags(m) ((m)->priv.root_flags)
+#define occ_root_set_child(m, c) ((void)((m)->priv.root_child = (c)))
+#define occ_root_set_flags(m, f) ((void)((m)->priv.root_flags = (f)))
+
+/* Marker in flags[7] of an inner block on the free list (used blocks only use bits 0..2). */
+#define OCC_INNER_FREE_MARK 0xA5u
+
+static inline bool occ_inner_is_free(const occ_inner_block_t *const b)
+{
+    return b->flags[7] == OCC_INNER_FREE_MARK;
+}
+
+static inline void occ_inner_mark_free(occ_inner_block_t *const b)
+{
+    b->flags[7] = OCC_INNER_FREE_MARK;
+}
+
+static inline void occ_inner_mark_used(occ_inner_block_t *const b)
+{
+    b->flags[7] = 0u;
+}
+
+/* Eight uniform entries of value v and flags f, without children. */
+static inline void occ_inner_fill(occ_inner_block_t *const b, const occ_value_t v, const uint8_t f)
+{
+    for (unsigned i = 0; i < 8u; i++) {
+        b->child[i] = OCC_NONE;
+        b->value[i] = v;
+        b->flags[i] = f;
+    }
+}
+#endif
 
 /* A shared map's snapshots need every block write (occ_shared.h): a node's three fields sit in
  * three arrays of its block, so each is marked. Nothing but a NULL test when not shared. */
+static inline void occ_touch_child(occ_map_t *const m, const occ_nodep_t n)
+{
+    occi_shared_touch(m, n.child, OCC_CHILD_BYTES);
+}
+
 static inline void occ_touch_node(occ_map_t *const m, const occ_nodep_t n)
 {
-    occi_shared_touch(m, n.child, sizeof *n.child);
+    occi_shared_touch(m, n.child, OCC_CHILD_BYTES);
     occi_shared_touch(m, n.value, sizeof *n.value);
-    occi_shared_touch(m, n.flags, sizeof *n.flags);
+    occi_shared_touch(m, n.flags, OCC_FLAG_BYTES);
 }
 
 /* A hint that a cache line will be read soon; nothing where the compiler has no such hint. */
@@ -119,9 +362,16 @@ static inline const occ_leaf_block_t *occ_leaf_base(const occ_map_t *m)
 static inline occ_nodep_t occ_root(occ_map_t *m)
 {
     occ_nodep_t n;
+#if OCC_INNER_PACKED
+    n.child = m->priv.root_child;
+    n.value = &m->priv.root_value;
+    n.flags = m->priv.root_flags;
+    n.bit = 1u;
+#else
     n.child = &m->priv.root_child;
     n.value = &m->priv.root_value;
     n.flags = &m->priv.root_flags;
+#endif
     return n;
 }
 
@@ -130,9 +380,16 @@ static inline occ_nodep_t occ_inner_node(const occ_map_t *m, uint32_t block, uns
     OCC_ASSERT(slot < 8u);
     occ_inner_block_t *const b = occ_inner_at(m, block);
     occ_nodep_t n;
+#if OCC_INNER_PACKED
+    n.child = &b->child[3u * slot];
+    n.value = &b->value[slot];
+    n.flags = b->flags;
+    n.bit = 1u << slot;
+#else
     n.child = &b->child[slot];
     n.value = &b->value[slot];
     n.flags = &b->flags[slot];
+#endif
     return n;
 }
 
@@ -167,8 +424,8 @@ static inline occ_entry_t occ_entry_at(const occ_map_t *m, uint32_t block, unsig
     } else {
         const occ_inner_block_t *const b = occ_inner_at(m, block);
         e.value = b->value[slot];
-        e.flags = b->flags[slot];
-        e.child = b->child[slot];
+        e.flags = occ_inner_flags(b, slot);
+        e.child = occ_inner_child(b, slot);
     }
     return e;
 }
@@ -329,8 +586,6 @@ uint32_t occi_pool_alloc_inner(occ_map_t *m);
 uint32_t occi_pool_alloc_leaf(occ_map_t *m);
 bool occi_pool_free_inner(occ_map_t *m, uint32_t idx);
 bool occi_pool_free_leaf(occ_map_t *m, uint32_t idx);
-/* Marker in flags[7] of an inner block on the free list (used blocks only use bits 0..2). */
-#define OCC_INNER_FREE_MARK 0xA5u
 /* True when n_inner inner and n_leaf leaf blocks can be allocated now. */
 bool occi_pool_can_supply(const occ_map_t *m, uint32_t n_inner, uint32_t n_leaf);
 /* Release a node's whole subtree to the pools (iterative). The node's child becomes OCC_NONE. */

@@ -19,9 +19,15 @@ typedef struct {
     unsigned low;
     /* tree.c's count_blocks: a copy of the root, where its read-only path starts (the map stays
      * const) */
+#if OCC_INNER_PACKED
+    uint8_t root_child[3];
+    occ_value_t root_value;
+    uint8_t root_flags[3];
+#else
     uint32_t root_child;
     occ_value_t root_value;
     uint8_t root_flags;
+#endif
 } path_t;
 
 /* Lowest level whose node contains both codes. */
@@ -56,14 +62,14 @@ static inline occ_value_t descend(const occ_map_t *const m, path_t *const p, con
                            unsigned start, unsigned *const stop)
 {
     unsigned l = start;
-    while (l > 1u && *p->node[l].child != OCC_NONE) {
-        p->node[l - 1u] = occ_inner_node(m, *p->node[l].child, occ_code_slot(code, l));
+    while (l > 1u && occ_node_child(p->node[l]) != OCC_NONE) {
+        p->node[l - 1u] = occ_inner_node(m, occ_node_child(p->node[l]), occ_code_slot(code, l));
         l--;
     }
     p->low = l;
-    if (*p->node[l].child != OCC_NONE) { /* l == 1 with a leaf block */
+    if (occ_node_child(p->node[l]) != OCC_NONE) { /* l == 1 with a leaf block */
         *stop = 0u;
-        return occ_leaf_at(m, *p->node[1].child)->value[occ_code_slot(code, 1u)];
+        return occ_leaf_at(m, occ_node_child(p->node[1]))->value[occ_code_slot(code, 1u)];
     }
     *stop = l;
     return *p->node[l].value;

@@ -53,13 +53,13 @@ bool occ_walk_next(occ_walk_t *const w, occ_walk_node_t *const node)
         const occ_key_t zero = {{0u, 0u, 0u}};
         node->key = zero;
         node->level = m->cfg.depth_levels;
-        node->has_children = m->priv.root_child != OCC_NONE;
+        node->has_children = occ_root_child(m) != OCC_NONE;
         node->value = m->priv.root_value;
         node->observed = true;
-        node->flags = (uint8_t)(m->priv.root_flags | (node->has_children ? 0u : OCC_NODE_UNIFORM));
+        node->flags = (uint8_t)(occ_root_flags(m) | (node->has_children ? 0u : OCC_NODE_UNIFORM));
         w->code = 0u;
         if (node->has_children) {
-            push(w, m->priv.root_child, (unsigned)m->cfg.depth_levels - 1u);
+            push(w, occ_root_child(m), (unsigned)m->cfg.depth_levels - 1u);
         }
         return true;
     }

@@ -184,13 +184,13 @@ static void collapse(ctx_t *const x, const occ_nodep_t n, const unsigned level)
     occ_value_t v = OCC_VALUE_UNOBSERVED;
     if (!forgetting(x)) {
         v = *n.value;
-        if (occ_value_state(m, v) == OCC_STATE_FREE && (*n.flags & OCC_NODE_HAS_UNKNOWN) != 0u) {
+        if (occ_value_state(m, v) == OCC_STATE_FREE && (occ_node_flags(n) & OCC_NODE_HAS_UNKNOWN) != 0u) {
             v = OCC_VALUE_UNOBSERVED;
         }
     }
     occi_tree_release_children(m, n, level);
     *n.value = v;
-    *n.flags = occ_value_flags(m, v);
+    occ_node_set_flags(n, occ_value_flags(m, v));
     occ_touch_node(m, n);
     x->evictions++;
 }
@@ -199,7 +199,7 @@ static bool children_childless(const occ_map_t *const m, const uint32_t block)
 {
     const occ_inner_block_t *const b = occ_inner_at(m, block);
     for (unsigned s = 0; s < 8u; s++) {
-        if (b->child[s] != OCC_NONE) {
+        if (occ_inner_child(b, s) != OCC_NONE) {
             return false;
         }
     }
@@ -221,10 +221,10 @@ static bool begin_pass(ctx_t *const x)
 {
     occ_evict_cursor_t *const cur = x->cur;
     cur->sp = 0u;
-    if (x->m->priv.root_child == OCC_NONE) {
+    if (occ_root_child(x->m) == OCC_NONE) {
         return false;
     }
-    push(cur, x->m->priv.root_child, 0u);
+    push(cur, occ_root_child(x->m), 0u);
     return true;
 }
 
@@ -256,7 +256,7 @@ static void resume(ctx_t *const x)
             return;
         }
         cur->next[top] = (uint8_t)(slot + 1u);
-        const uint32_t child = occ_inner_at(x->m, cur->block[top])->child[slot];
+        const uint32_t child = occ_inner_child(occ_inner_at(x->m, cur->block[top]), slot);
         if (child == OCC_NONE) {
             return;
         }
@@ -276,10 +276,10 @@ static void pop(ctx_t *const x)
     if (cur->dirty[top] != 0u) {
         changed = occi_tree_refresh(m, n, lvl);
     }
-    if (*n.child != OCC_NONE && collapsible_level(x, lvl)) {
+    if (occ_node_child(n) != OCC_NONE && collapsible_level(x, lvl)) {
         float dmin, dmax;
         node_distance(x, cur->base[top], lvl, &dmin, &dmax);
-        if (qualifies(x, dmin) && children_childless(m, *n.child)) {
+        if (qualifies(x, dmin) && children_childless(m, occ_node_child(n))) {
             collapse(x, n, lvl);
             changed = true;
         } else if (dmax > x->eps) {
@@ -382,7 +382,7 @@ static run_end_t run(ctx_t *const x)
         const unsigned slot = cur->next[top]++;
         const unsigned lc = lvl - 1u;
         const occ_nodep_t cn = occ_inner_node(m, cur->block[top], slot);
-        if (*cn.child == OCC_NONE) {
+        if (occ_node_child(cn) == OCC_NONE) {
             continue; /* uniform: holds no block */
         }
         const occ_code_t code = cur->base[top] | ((occ_code_t)slot << (3u * lc));
@@ -406,10 +406,10 @@ static run_end_t run(ctx_t *const x)
             continue;
         }
         x->visited++;
-        if (!forgetting(x) && lc == cur->coarse_level + 1u && children_childless(m, *cn.child)) {
+        if (!forgetting(x) && lc == cur->coarse_level + 1u && children_childless(m, occ_node_child(cn))) {
             continue; /* already coarse at this level: nothing below to collapse */
         }
-        push(cur, *cn.child, code);
+        push(cur, occ_node_child(cn), code);
     }
 }
 

@@ -76,10 +76,10 @@ size_t occi_coarse_apply(occ_map_t *const m, const occ_code_t *const codes, cons
         }
         for (unsigned l = start; l > level; l--) {
             const occ_nodep_t nd = node_at(m, blk[l], l < depth ? occ_code_slot(c, l + 1u) : 0u);
-            if (*nd.child == OCC_NONE) {
+            if (occ_node_child(nd) == OCC_NONE) {
                 occi_tree_expand(m, nd, l);
             }
-            blk[l - 1u] = *nd.child;
+            blk[l - 1u] = occ_node_child(nd);
         }
         occi_tree_apply_subtree(m, node_at(m, blk[level], occ_code_slot(c, level + 1u)), level,
                                 delta);

@@ -41,9 +41,9 @@ void occi_build_root_uniform(occ_build_t *const b, const occ_value_t v)
     b->root_uniform = true;
     b->root_value = v;
     if (b->map != NULL) {
-        b->map->priv.root_child = OCC_NONE;
+        occ_root_set_child(b->map, OCC_NONE);
         b->map->priv.root_value = v;
-        b->map->priv.root_flags = occ_value_flags(b->map, v);
+        occ_root_set_flags(b->map, occ_value_flags(b->map, v));
     }
 }
 
@@ -63,12 +63,7 @@ static uint32_t new_block(occ_map_t *const m, const unsigned level)
     const uint32_t idx = occi_pool_alloc_inner(m);
     if (idx != OCC_NONE) {
         occ_inner_block_t *const ib = occ_inner_at(m, idx);
-        const uint8_t f = occ_value_flags(m, OCC_VALUE_UNOBSERVED);
-        for (unsigned i = 0; i < 8u; i++) {
-            ib->child[i] = OCC_NONE;
-            ib->value[i] = OCC_VALUE_UNOBSERVED;
-            ib->flags[i] = f;
-        }
+        occ_inner_fill(ib, OCC_VALUE_UNOBSERVED, occ_value_flags(m, OCC_VALUE_UNOBSERVED));
     }
     return idx;
 }
@@ -94,7 +89,7 @@ void occi_build_open_root(occ_build_t *const b)
     if (b->map != NULL) {
         blk = new_block(b->map, b->top);
         OCC_ASSERT(blk != OCC_NONE);
-        b->map->priv.root_child = blk;
+        occ_root_set_child(b->map, blk);
     }
     push(b, b->top, 0u, blk);
 }
@@ -112,7 +107,7 @@ void occi_build_open(occ_build_t *const b, const unsigned slot)
     if (b->map != NULL) {
         blk = new_block(b->map, level);
         OCC_ASSERT(blk != OCC_NONE);
-        occ_inner_at(b->map, p->block)->child[slot] = blk;
+        occ_inner_set_child(occ_inner_at(b->map, p->block), slot, blk);
     }
     push(b, level, slot, blk);
 }
@@ -141,7 +136,7 @@ void occi_build_leaf(occ_build_t *const b, const unsigned slot, const occ_value_
         } else {
             occ_inner_block_t *const ib = occ_inner_at(b->map, p->block);
             ib->value[slot] = v;
-            ib->flags[slot] = occ_value_flags(b->map, v);
+            occ_inner_set_flags(ib, slot, occ_value_flags(b->map, v));
         }
     }
 }

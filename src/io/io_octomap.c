@@ -254,9 +254,9 @@ static bool has_unobserved(const occ_map_t *const m, const uint32_t block, const
         if (!occ_is_observed(ib->value[i])) {
             return true;
         }
-        if (ib->child[i] != OCC_NONE) {
+        if (occ_inner_child(ib, i) != OCC_NONE) {
             OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
-            st[sp].block = ib->child[i];
+            st[sp].block = occ_inner_child(ib, i);
             st[sp].level = (uint8_t)(f->level - 1u);
             st[sp].next = 0u;
             sp++;
@@ -277,16 +277,16 @@ static unsigned ml_of_value(const occ_map_t *const m, const occ_value_t v)
 static unsigned ml_of_entry(const occ_map_t *const m, const occ_inner_block_t *const ib,
                             const unsigned slot, const unsigned level)
 {
-    if (ib->child[slot] == OCC_NONE) {
+    if (occ_inner_child(ib, slot) == OCC_NONE) {
         return ml_of_value(m, ib->value[slot]);
     }
-    const uint8_t f = ib->flags[slot];
+    const uint8_t f = occ_inner_flags(ib, slot);
     const bool occ = (f & OCC_NODE_HAS_OCCUPIED) != 0u;
     const bool fr = (f & OCC_NODE_HAS_FREE) != 0u;
     const bool unk = (f & OCC_NODE_HAS_UNKNOWN) != 0u;
     if (unk) {
         const bool band_empty = !(m->priv.q_free_max < m->priv.q_occ_min);
-        if (band_empty || has_unobserved(m, ib->child[slot], level)) {
+        if (band_empty || has_unobserved(m, occ_inner_child(ib, slot), level)) {
             return BT_INNER;
         }
         return occ ? BT_INNER : BT_FREE;  /* all observed; band values count as free */
@@ -320,7 +320,7 @@ void occi_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const
     if (!occ_is_observed(m->priv.root_value)) {
         return;
     }
-    if (m->priv.root_child == OCC_NONE) {
+    if (occ_root_child(m) == OCC_NONE) {
         /* OctoMap never prunes the root: a uniform map is a root with 8 equal leaves. */
         const unsigned k = ml_of_value(m, m->priv.root_value);
         uint16_t codes = 0u;
@@ -333,10 +333,10 @@ void occi_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const
     }
     emit_frame_t st[OCC_MAX_DEPTH + 1];
     unsigned sp = 0u;
-    st[0].block = m->priv.root_child;
+    st[0].block = occ_root_child(m);
     st[0].level = m->cfg.depth_levels;
     st[0].next = 0u;
-    st[0].codes = bt_codes_of(m, m->priv.root_child, m->cfg.depth_levels);
+    st[0].codes = bt_codes_of(m, occ_root_child(m), m->cfg.depth_levels);
     occi_sink_u16(s, st[0].codes);
     *nodes = 1u + bt_count(st[0].codes);
     sp = 1u;
@@ -351,7 +351,7 @@ void occi_bt_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const
             continue;
         }
         f->next = (uint8_t)(i + 1u);
-        const uint32_t child = occ_inner_at(m, f->block)->child[i];
+        const uint32_t child = occ_inner_child(occ_inner_at(m, f->block), i);
         OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
         emit_frame_t *const g = &st[sp];
         g->block = child;
@@ -389,7 +389,7 @@ void occi_ot_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const
     if (!occ_is_observed(m->priv.root_value)) {
         return;
     }
-    if (m->priv.root_child == OCC_NONE) {
+    if (occ_root_child(m) == OCC_NONE) {
         ot_rec(s, m->priv.root_value, 0xFFu);
         for (unsigned i = 0; i < 8u; i++) {
             ot_rec(s, m->priv.root_value, 0u);
@@ -399,10 +399,10 @@ void occi_ot_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const
     }
     emit_frame_t st[OCC_MAX_DEPTH + 1];
     unsigned sp = 1u;
-    st[0].block = m->priv.root_child;
+    st[0].block = occ_root_child(m);
     st[0].level = m->cfg.depth_levels;
     st[0].next = 0u;
-    ot_rec(s, m->priv.root_value, observed_mask(m, m->priv.root_child, st[0].level));
+    ot_rec(s, m->priv.root_value, observed_mask(m, occ_root_child(m), st[0].level));
     *nodes = 1u;
     while (sp > 0u && s->err == OCC_OK) {
         emit_frame_t *const f = &st[sp - 1u];
@@ -424,13 +424,13 @@ void occi_ot_emit(const occ_map_t *const m, occ_sink_t *const s, uint64_t *const
             continue;
         }
         (*nodes)++;
-        if (ib->child[i] == OCC_NONE) {
+        if (occ_inner_child(ib, i) == OCC_NONE) {
             ot_rec(s, ib->value[i], 0u);
             continue;
         }
         OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
         emit_frame_t *const g = &st[sp];
-        g->block = ib->child[i];
+        g->block = occ_inner_child(ib, i);
         g->level = (uint8_t)(f->level - 1u);
         g->next = 0u;
         ot_rec(s, ib->value[i], observed_mask(m, g->block, g->level));

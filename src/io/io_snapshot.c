@@ -250,7 +250,7 @@ static uint8_t put_node(const occ_map_t *const m, occ_sink_t *const s, const uin
     const occ_inner_block_t *const ib = occ_inner_at(m, block);
     for (unsigned i = 0; i < 8u; i++) {
         obs = (uint8_t)(obs | (occ_is_observed(ib->value[i]) ? 1u << i : 0u));
-        blk = (uint8_t)(blk | (ib->child[i] != OCC_NONE ? 1u << i : 0u));
+        blk = (uint8_t)(blk | (occ_inner_child(ib, i) != OCC_NONE ? 1u << i : 0u));
     }
     occi_sink_u8(s, obs);
     occi_sink_u8(s, blk);
@@ -268,7 +268,7 @@ static void put_payload(const occ_map_t *const m, occ_sink_t *const s)
         occi_sink_u8(s, 0u);
         return;
     }
-    if (m->priv.root_child == OCC_NONE) {
+    if (occ_root_child(m) == OCC_NONE) {
         occi_sink_u8(s, 1u);
         put_value(s, m->priv.root_value);
         return;
@@ -276,10 +276,10 @@ static void put_payload(const occ_map_t *const m, occ_sink_t *const s)
     occi_sink_u8(s, 2u);
     snap_frame_t st[OCC_MAX_DEPTH + 1];
     unsigned sp = 1u;
-    st[0].block = m->priv.root_child;
+    st[0].block = occ_root_child(m);
     st[0].level = m->cfg.depth_levels;
     st[0].next = 0u;
-    st[0].blk = put_node(m, s, m->priv.root_child, st[0].level);
+    st[0].blk = put_node(m, s, occ_root_child(m), st[0].level);
     while (sp > 0u && s->err == OCC_OK) {
         snap_frame_t *const f = &st[sp - 1u];
         unsigned i = f->next;
@@ -293,7 +293,7 @@ static void put_payload(const occ_map_t *const m, occ_sink_t *const s)
         f->next = (uint8_t)(i + 1u);
         OCC_ASSERT(sp <= OCC_MAX_DEPTH && f->level > 1u);
         snap_frame_t *const g = &st[sp++];
-        g->block = occ_inner_at(m, f->block)->child[i];
+        g->block = occ_inner_child(occ_inner_at(m, f->block), i);
         g->level = (uint8_t)(f->level - 1u);
         g->next = 0u;
         g->blk = put_node(m, s, g->block, g->level);

@@ -46,8 +46,8 @@ static void descend(cursor_t *c, unsigned level)
         const unsigned slot = ((k0 >> l) & 1u) | (((k1 >> l) & 1u) << 1) | (((k2 >> l) & 1u) << 2);
         OCC_ASSERT(b < c->m->inner.hwm);
         const occ_inner_block_t *const ib = top - b; /* occ_inner_at(m, b) */
-        const uint32_t ch = ib->child[slot];
-        if (ch == OCC_NONE || (ib->flags[slot] & stop) == 0u) {
+        const uint32_t ch = occ_inner_child(ib, slot);
+        if (ch == OCC_NONE || (occ_inner_flags(ib, slot) & stop) == 0u) {
             c->lu = l;
             c->val = ib->value[slot];
             return;
@@ -71,12 +71,12 @@ static void cursor_init(cursor_t *c, const occ_map_t *m, const uint32_t key[3], 
     c->key[1] = key[1];
     c->key[2] = key[2];
     const unsigned d = m->cfg.depth_levels;
-    if (m->priv.root_child == OCC_NONE || (m->priv.root_flags & stop) == 0u) {
+    if (occ_root_child(m) == OCC_NONE || (occ_root_flags(m) & stop) == 0u) {
         c->lu = d;
         c->val = m->priv.root_value;
         return;
     }
-    c->blk[d] = m->priv.root_child;
+    c->blk[d] = occ_root_child(m);
     descend(c, d);
 }
 

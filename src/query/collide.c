@@ -77,9 +77,9 @@ static bool walk(const occ_map_t *m, const occ_volume_t *v, unsigned states, occ
     for (unsigned t = 0; t < st.n; t++) {
         const occ_key_t key = occi_q_start_key(&st, t);
         unsigned level = depth;
-        uint32_t child = m->priv.root_child;
+        uint32_t child = occ_root_child(m);
         occ_value_t val = m->priv.root_value;
-        uint8_t flags = m->priv.root_flags;
+        uint8_t flags = occ_root_flags(m);
         bool check = true;
         if (t > 0u) {
             const uint32_t x = (key.k[0] ^ prev.k[0]) | (key.k[1] ^ prev.k[1]) |

@@ -24,7 +24,7 @@ static inline occ_value_t descend(const occ_map_t *m, const occ_key_t *k, unsign
         level--;
         const occ_inner_block_t *const ib = occ_inner_at(m, b);
         const unsigned slot = occ_key_slot(k, level);
-        const uint32_t ch = ib->child[slot];
+        const uint32_t ch = occ_inner_child(ib, slot);
         if (ch == OCC_NONE) {
             *lu = level;
             return ib->value[slot];
@@ -44,11 +44,11 @@ occ_state_t occ_map_state_at(const occ_map_t *const map, const occ_vec3_t p)
     if (map == NULL || !point_key(map, p, &k)) {
         return OCC_STATE_UNKNOWN;
     }
-    if (map->priv.root_child == OCC_NONE) {
+    if (occ_root_child(map) == OCC_NONE) {
         return occ_value_state(map, map->priv.root_value);
     }
     unsigned lu;
-    return occ_value_state(map, descend(map, &k, map->cfg.depth_levels, map->priv.root_child, NULL, &lu));
+    return occ_value_state(map, descend(map, &k, map->cfg.depth_levels, occ_root_child(map), NULL, &lu));
 }
 
 void occ_lookup_init(occ_lookup_t *lk, const occ_map_t *map)
@@ -89,13 +89,13 @@ static inline occ_state_t cached_state(occ_lookup_t *lk, occ_key_t k)
     } else {
         lk->key = k;
         lk->valid = true;
-        if (m->priv.root_child == OCC_NONE) {
+        if (occ_root_child(m) == OCC_NONE) {
             lk->lu = (uint8_t)depth;
             lk->val = m->priv.root_value;
             return occ_value_state(m, lk->val);
         }
         level = depth;
-        b = m->priv.root_child;
+        b = occ_root_child(m);
         lk->blk[depth] = b;
     }
     unsigned lu;

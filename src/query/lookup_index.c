@@ -12,7 +12,7 @@ occ_err_t occ_lookup_index_status(const occ_lookup_index_t *const idx)
         return OCC_ERR_ARG;
     }
     const occ_map_t *const m = idx->map;
-    if (m == NULL || m->write_gen != idx->priv.gen || m->priv.root_child != idx->priv.root ||
+    if (m == NULL || m->write_gen != idx->priv.gen || occ_root_child(m) != idx->priv.root ||
         (const void *)m->priv.arena != idx->priv.arena) {
         return OCC_ERR_STATE;
     }
@@ -50,7 +50,7 @@ static inline occ_value_t walk_down(const occ_map_t *const m, const occ_key_t *c
         level--;
         const occ_inner_block_t *const ib = occ_inner_at(m, b);
         const unsigned slot = occ_key_slot(k, level);
-        const uint32_t ch = ib->child[slot];
+        const uint32_t ch = occ_inner_child(ib, slot);
         if (ch == OCC_NONE) {
             return ib->value[slot];
         }

@@ -21,18 +21,18 @@ static bool walk_root(occ_idx_walk_t *const w, const occ_map_t *const m, occ_idx
 {
     const unsigned depth = m->cfg.depth_levels;
     w->root_pending = false;
-    if (m->priv.root_child != OCC_NONE && w->stop < depth) {
+    if (occ_root_child(m) != OCC_NONE && w->stop < depth) {
         w->top = depth;
-        w->blk[depth] = m->priv.root_child;
+        w->blk[depth] = occ_root_child(m);
         w->next[depth] = 0u;
         return false;
     }
-    if (m->priv.root_child == OCC_NONE && !occ_is_observed(m->priv.root_value)) {
+    if (occ_root_child(m) == OCC_NONE && !occ_is_observed(m->priv.root_value)) {
         return false;
     }
     out->key = w->key;
     out->level = depth;
-    out->child = m->priv.root_child;
+    out->child = occ_root_child(m);
     out->value = m->priv.root_value;
     return true;
 }
@@ -247,7 +247,7 @@ occ_err_t occ_lookup_index_build(occ_lookup_index_t *const idx, const occ_map_t 
     idx->priv.cells = cells;
     idx->priv.bricks = bricks;
     idx->priv.gen = map->write_gen;
-    idx->priv.root = map->priv.root_child;
+    idx->priv.root = occ_root_child(map);
     idx->priv.arena = map->priv.arena;
     idx->map = map;
     return OCC_OK;

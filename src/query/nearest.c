@@ -90,9 +90,9 @@ occ_err_t occ_nearest_begin(occ_nearest_t *it, const occ_map_t *map, occ_vec3_t 
     occ_nearest_entry_t e;
     e.key.k[0] = e.key.k[1] = e.key.k[2] = 0u;
     e.level = map->cfg.depth_levels;
-    e.child = map->priv.root_child;
+    e.child = occ_root_child(map);
     e.value = map->priv.root_value;
-    e.flags = map->priv.root_flags;
+    e.flags = occ_root_flags(map);
     if (matches(it, e.value, e.flags, e.child == OCC_NONE)) {
         e.dist2 = box_d2(p, occ_geom_center(map, e.key, e.level), occ_q_half(map, e.level));
         if (e.dist2 <= it->max_dist2) {

@@ -197,9 +197,9 @@ static bool next_start(occ_query_iter_t *it, occ_query_node_t *out)
     const unsigned depth = m->cfg.depth_levels;
     const occ_key_t key = it->start[it->istart];
     unsigned level = depth;
-    uint32_t child = m->priv.root_child;
+    uint32_t child = occ_root_child(m);
     occ_value_t v = m->priv.root_value;
-    uint8_t flags = m->priv.root_flags;
+    uint8_t flags = occ_root_flags(m);
     bool check = true;
     if (it->istart > 0u) {
         const uint32_t x = (key.k[0] ^ it->path.k[0]) | (key.k[1] ^ it->path.k[1]) |

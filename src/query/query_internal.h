@@ -73,7 +73,11 @@ static inline float occ_q_half(const occ_map_t *m, unsigned level)
 static inline unsigned occ_q_inner_match(const occ_inner_block_t *b, unsigned states)
 {
     const unsigned wf = occ_q_has_bits(states);
-#ifdef OCC_Q_SWAR_FLAGS
+#if OCC_INNER_PACKED
+    /* Byte j holds indicator bit j of the 8 entries: OR the wanted bytes. */
+    return ((wf & 1u) != 0u ? b->flags[0] : 0u) | ((wf & 2u) != 0u ? b->flags[1] : 0u) |
+           ((wf & 4u) != 0u ? b->flags[2] : 0u);
+#elif defined(OCC_Q_SWAR_FLAGS)
     /* The 8 flag bytes at once: a byte with a wanted bit (wf < 0x10) gets its top bit, and the
      * multiply gathers the 8 top bits into bits 56..63. */
     uint64_t f;
@@ -84,7 +88,7 @@ static inline unsigned occ_q_inner_match(const occ_inner_block_t *b, unsigned st
 #else
     unsigned pm = 0u;
     for (unsigned s = 0; s < 8u; s++) {
-        pm |= (unsigned)((b->flags[s] & wf) != 0u) << s;
+        pm |= (unsigned)((occ_inner_flags(b, s) & wf) != 0u) << s;
     }
     return pm;
 #endif
@@ -122,7 +126,7 @@ static inline unsigned occ_q_open_inner(const occ_map_t *m, uint32_t block, unsi
 {
     const occ_inner_block_t *const b = occ_inner_at(m, block);
     OCC_PREFETCH(&b->child[0]);
-    OCC_PREFETCH(&b->child[7]);
+    OCC_PREFETCH(&b->child[sizeof b->child / sizeof b->child[0] - 1u]);
     return occ_q_inner_match(b, states);
 }
 
