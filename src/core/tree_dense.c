@@ -8,8 +8,6 @@
  * (occ_map_observe_codes on the set's codes): the voxels end with the same values, and a
  * refreshed tree is the one pruned tree of its voxels.
  */
-#include <string.h>
-
 #include "tree_path.h"
 #if defined(__SSE2__) && !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 16
 #include <emmintrin.h>
@@ -32,8 +30,8 @@ static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigne
                           const occ_value_t vh)
 {
     const occ_value_t v = *n.value;
-    const size_t changed = (occ_value_eq(vm, v) ? 0u : occ_popcount64(mb & cb)) +
-                           (occ_value_eq(vh, v) ? 0u : occ_popcount64(hb & cb));
+    const size_t changed = (occ_value_eq(vm, v) ? 0u : occ_popcount8(mb & cb)) +
+                           (occ_value_eq(vh, v) ? 0u : occ_popcount8(hb & cb));
     /* the values present: untouched (pu), missed (pm), hit (ph) */
     const bool pu = (mb | hb) != 0xFFu, pm = mb != 0u, ph = hb != 0u;
     const bool same = (!pu || occ_value_eq(v, ph ? vh : vm)) && (!pm || !ph || occ_value_eq(vm, vh));
@@ -61,10 +59,11 @@ static size_t node1_split(occ_map_t *const m, const occ_nodep_t n, const unsigne
     return changed;
 }
 
-/* The eight values v of a leaf block with the miss on the voxels of mb and the hit on those of
- * hb (disjoint) into nv, all lanes alike and without a branch (occ_value_apply_delta per lane);
- * returns the lanes that moved. With SSE2 and 16-bit values the eight lanes are one register
- * (a saturating add then the clamp: the same values as the 32-bit sum clamped). */
+/* The values of leaf block lb with the miss on the voxels of mb and the hit on those of hb
+ * (disjoint), occ_value_apply_delta per voxel; returns the voxels whose value moved (each
+ * write marked for a shared map). With SSE2 and 16-bit values the eight lanes are one register,
+ * updated without a branch (a saturating add then the clamp: the values of the 32-bit sum
+ * clamped); elsewhere (firmware) a loop over the named voxels only. */
 #if defined(__SSE2__) && !OCC_VALUE_FLOAT && OCC_VALUE_BITS == 16
 static OCC_ALWAYS_INLINE __m128i lanes_of(const unsigned bits)
 {
@@ -77,11 +76,10 @@ static OCC_ALWAYS_INLINE __m128i select16(const __m128i mask, const __m128i a, c
     return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b));
 }
 
-static OCC_ALWAYS_INLINE unsigned leaf8_update(const occ_map_t *const m,
-                                               const occ_value_t *const v, const unsigned mb,
-                                               const unsigned hb, occ_value_t *const nv)
+static OCC_ALWAYS_INLINE unsigned leaf_update(occ_map_t *const m, occ_leaf_block_t *const lb,
+                                              const unsigned mb, const unsigned hb)
 {
-    const __m128i vv = _mm_loadu_si128((const __m128i *)(const void *)v);
+    const __m128i vv = _mm_loadu_si128((const __m128i *)(const void *)lb->value);
     const __m128i cmin = _mm_set1_epi16(m->priv.q_clamp_min);
     const __m128i cmax = _mm_set1_epi16(m->priv.q_clamp_max);
     const __m128i d = select16(lanes_of(hb), _mm_set1_epi16(m->priv.q_hit),
@@ -95,21 +93,29 @@ static OCC_ALWAYS_INLINE unsigned leaf8_update(const occ_map_t *const m,
     const __m128i sum = _mm_adds_epi16(_mm_and_si128(observed, vv), d);
     const __m128i moved_to = _mm_min_epi16(_mm_max_epi16(sum, cmin), cmax);
     const __m128i r = select16(_mm_andnot_si128(keep, lanes_of(mb | hb)), moved_to, vv);
-    _mm_storeu_si128((__m128i *)(void *)nv, r);
     const __m128i same = _mm_cmpeq_epi16(r, vv);
-    return ~(unsigned)_mm_movemask_epi8(_mm_packs_epi16(same, same)) & 0xFFu;
+    const unsigned moved = ~(unsigned)_mm_movemask_epi8(_mm_packs_epi16(same, same)) & 0xFFu;
+    if (moved != 0u) {
+        _mm_storeu_si128((__m128i *)(void *)lb->value, r);
+        occi_shared_touch(m, lb, sizeof *lb);
+    }
+    return moved;
 }
 #else
-static OCC_ALWAYS_INLINE unsigned leaf8_update(const occ_map_t *const m,
-                                               const occ_value_t *const v, const unsigned mb,
-                                               const unsigned hb, occ_value_t *const nv)
+static OCC_ALWAYS_INLINE unsigned leaf_update(occ_map_t *const m, occ_leaf_block_t *const lb,
+                                              const unsigned mb, const unsigned hb)
 {
     unsigned moved = 0;
-    for (unsigned k = 0; k < 8u; k++) {
-        const occ_delta_t d = ((hb >> k) & 1u) != 0u ? m->priv.q_hit : m->priv.q_miss;
-        const occ_value_t u = occ_value_apply_delta_nb(m, v[k], d);
-        nv[k] = (((mb | hb) >> k) & 1u) != 0u ? u : v[k];
-        moved |= (unsigned)!occ_value_eq(nv[k], v[k]) << k;
+    for (unsigned all = mb | hb; all != 0u; all &= all - 1u) {
+        const unsigned k = occ_first_slot(all);
+        const occ_value_t v = lb->value[k];
+        const occ_value_t nv =
+            occ_value_apply_delta(m, v, ((hb >> k) & 1u) != 0u ? m->priv.q_hit : m->priv.q_miss);
+        if (!occ_value_eq(nv, v)) {
+            lb->value[k] = nv;
+            occi_shared_touch(m, &lb->value[k], sizeof nv);
+            moved |= 1u << k;
+        }
     }
     return moved;
 }
@@ -130,15 +136,9 @@ static OCC_ALWAYS_INLINE size_t node1_step(occ_map_t *const m, const occ_nodep_t
         *dirty = true;
         return node1_split(m, n, mb, hb, cb, vm, vh);
     }
-    occ_leaf_block_t *const lb = occ_leaf_at(m, occ_node_child(n));
-    occ_value_t nv[8];
-    const unsigned moved = leaf8_update(m, lb->value, mb, hb, nv);
-    if (moved != 0u) {
-        memcpy(lb->value, nv, sizeof nv);
-        occi_shared_touch(m, lb, sizeof *lb);
-    }
-    const size_t changed = occ_popcount64(moved & cb);
-    if (moved && occi_tree_refresh(m, n, 1u)) {
+    const unsigned moved = leaf_update(m, occ_leaf_at(m, occ_node_child(n)), mb, hb);
+    const size_t changed = occ_popcount8(moved & cb);
+    if (moved != 0u && occi_tree_refresh(m, n, 1u)) {
         *dirty = true;
     }
     return changed;

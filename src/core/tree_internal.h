@@ -469,6 +469,14 @@ static inline unsigned occ_popcount64(uint64_t x)
     return (unsigned)((x * 0x0101010101010101ull) >> 56);
 }
 
+/* Bits set in a byte (SWAR in 32 bits: cheap on a 32-bit core). */
+static inline unsigned occ_popcount8(unsigned x)
+{
+    x = x - ((x >> 1) & 0x55u);
+    x = (x & 0x33u) + ((x >> 2) & 0x33u);
+    return (x + (x >> 4)) & 0x0Fu;
+}
+
 /* Number of significant bits of x (0 for 0): 1 + the highest set bit. */
 static inline unsigned occ_bit_length32(uint32_t x)
 {
@@ -555,23 +563,6 @@ static inline occ_value_t occ_value_apply_delta(const occ_map_t *const m, const 
     }
     return (occ_value_t)nv;
 }
-/* occ_value_apply_delta without branches (for loops over a block's values): the same value. */
-static inline occ_value_t occ_value_apply_delta_nb(const occ_map_t *const m, const occ_value_t v,
-                                                   const occ_delta_t delta)
-{
-    const bool observed = occ_is_observed(v);
-    const bool keep = observed & (((delta >= 0) & (v >= m->priv.q_clamp_max)) |
-                                  ((delta <= 0) & (v <= m->priv.q_clamp_min)));
-#if OCC_VALUE_FLOAT
-    float nv = (observed ? v : 0.0f) + delta;
-#else
-    int32_t nv = (int32_t)(observed ? v : 0) + (int32_t)delta;
-#endif
-    nv = nv < m->priv.q_clamp_min ? m->priv.q_clamp_min : nv;
-    nv = nv > m->priv.q_clamp_max ? m->priv.q_clamp_max : nv;
-    return keep ? v : (occ_value_t)nv;
-}
-
 /* Equality of raw values (also for the float build, where -Wfloat-equal forbids ==). */
 static inline bool occ_value_eq(occ_value_t a, occ_value_t b)
 {

@@ -133,15 +133,6 @@ static occ_err_t ot_record(occ_cursor_t *const c, const size_t extra, occ_value_
     return OCC_OK;
 }
 
-static unsigned popcount8(const uint8_t m)
-{
-    unsigned n = 0u;
-    for (unsigned i = 0; i < 8u; i++) {
-        n += ((unsigned)m >> i) & 1u;
-    }
-    return n;
-}
-
 /* -fanalyzer reads st[top] as uninitialised: st[] mirrors the builder's stack, frame for frame
  * (occi_build_open_root / occi_build_open push b->sp exactly where st[0] / st[top + 1] are
  * written, occi_build_close pops), which it cannot see across the calls. */
@@ -166,7 +157,7 @@ occ_err_t occi_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint6
     if (mask == 0u) {
         occi_build_root_uniform(b, v);
     } else {
-        if (1u + popcount8(mask) > header_size) {
+        if (1u + occ_popcount8(mask) > header_size) {
             return occ_cursor_fail(c, c->pos - 1u, "more nodes than the header's size");
         }
         occi_build_open_root(b);
@@ -200,7 +191,7 @@ occ_err_t occi_ot_parse(occ_cursor_t *const c, occ_build_t *const b, const uint6
         if (occ_build_level(b) <= 1u) {
             return occ_cursor_fail(c, at, "a voxel with children");
         }
-        if (b->nodes + 1u + popcount8(mask) > header_size) {
+        if (b->nodes + 1u + occ_popcount8(mask) > header_size) {
             return occ_cursor_fail(c, at, "more nodes than the header's size");
         }
         occi_build_open(b, i);
