@@ -85,17 +85,12 @@ void occi_dense_need(const occi_dense_t *const d, const size_t cap, const unsign
     *leaf = 0u;
     *voxels = 0u;
     while (occi_dense_next(d, &c, &b)) {
-        uint64_t any = b.miss | b.hit;
-        const unsigned k = occ_popcount64(any);
+        const unsigned k = occ_popcount64(b.miss | b.hit);
         const bool first = fill == 0u || k > cap - fill;
         const unsigned s = first ? depth + 1u : split_level(b.code, prev);
         fill = first ? k : fill + k;
         prev = b.code;
         *voxels += k;
-        any |= any >> 4;
-        any |= any >> 2;
-        any |= any >> 1;
-        *leaf += occ_popcount64(any & 0x0101010101010101ull);
-        *inner += s - 2u;
+        brick_need(s, b.miss | b.hit, inner, leaf);
     }
 }

@@ -92,8 +92,7 @@ static bool is_brick(const occ_code_t e)
 /* Blocks the stream can allocate, as if no node existed, over-approximated by counting the
  * bricks and the whole nodes as two sorted chains: the entry that first goes below a node on
  * its chain's paths (its split from the chain's previous entry is above that node) counts the
- * node's child block for the levels below the split; a brick its level-2 node's inner block
- * and a leaf block per level-1 node it names (the update by bricks' rule, occi_dense_need). */
+ * node's child block for the levels below the split (a brick: brick_need). */
 static void frame_need(const occ_map_t *const m, const occi_frame_t *const f,
                        uint64_t *const inner, uint64_t *const leaf)
 {
@@ -107,12 +106,7 @@ static void frame_need(const occ_map_t *const m, const occi_frame_t *const f,
         if (is_brick(e)) {
             const occ_code_t code = e & ~OCC_CODE_HIT_BIT;
             const unsigned s = first_b ? top : split_level(code, prev_b);
-            uint64_t any = f->s[i + 1u] | f->s[i + 2u];
-            any |= any >> 4;
-            any |= any >> 2;
-            any |= any >> 1;
-            *leaf += occ_popcount64(any & 0x0101010101010101ull);
-            *inner += s - 2u;
+            brick_need(s, f->s[i + 1u] | f->s[i + 2u], inner, leaf);
             prev_b = code;
             first_b = false;
             i += OCC_FRAME_BRICK_SLOTS;

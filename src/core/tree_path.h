@@ -45,12 +45,6 @@ static inline unsigned split_level(const occ_code_t a, const occ_code_t b)
         x >>= 1;
         h++;
     }
-/* One brick (tree_dense.c) from path level `start`: descend to its level-2 node or a uniform
- * node above it, split that only where a value moves, update its voxels (miss: q_miss, hit:
- * q_hit). Returns the voxels of `count` whose value changed. */
-size_t occi_tree_brick_step(occ_map_t *m, path_t *p, const occi_brick_t *b, unsigned start,
-                            uint64_t count);
-
 #endif
     return h / 3u + 1u;
 }
@@ -113,6 +107,19 @@ static inline unsigned path_start(occ_map_t *const m, path_t *const p, const occ
         return s;
     }
     return p->low;
+}
+
+/* Blocks one brick can allocate, as if no node existed (the update by bricks' rule): split `s`
+ * from the previous brick (depth + 1 for the first), an inner block per level 2 .. s - 1 and a
+ * leaf block per level-1 node its voxels (miss | hit) name. */
+static inline void brick_need(const unsigned s, uint64_t voxels, uint64_t *const inner,
+                              uint64_t *const leaf)
+{
+    voxels |= voxels >> 4; /* each byte's bits gathered in its bit 0 */
+    voxels |= voxels >> 2;
+    voxels |= voxels >> 1;
+    *leaf += occ_popcount64(voxels & 0x0101010101010101ull);
+    *inner += s - 2u;
 }
 
 /* One brick (tree_dense.c) from path level `start`: descend to its level-2 node or a uniform
