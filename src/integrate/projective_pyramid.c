@@ -124,20 +124,19 @@ void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_
     OCC_ASSERT(l < x->levels);
     /* The 1..3 cells per axis as a fixed 3 x 3 window (the middle one repeated where a span
      * has fewer: min and max do not mind), so that no loop bound depends on the footprint
-     * (their exits mispredicted). */
+     * (their exits mispredicted); written out as two trees of nine, without a serial chain
+     * (gcc kept the 3 x 3 loops rolled, one dependent min and max per cell). */
     const uint32_t a0 = i0 >> l, a1 = i1 >> l, b0 = j0 >> l, b1 = j1 >> l;
     const uint32_t am = a0 + 1u < a1 ? a0 + 1u : a1, bm = b0 + 1u < b1 ? b0 + 1u : b1;
-    const uint32_t ac[3] = {a0, am, a1}, br[3] = {b0, bm, b1};
-    const uint32_t lw = x->lw[l];
-    const float *const pmn = x->mn[l], *const pmx = x->mx[l];
-    float lo = INFINITY, hi = -INFINITY;
-    for (unsigned b = 0; b < 3u; b++) {
-        for (unsigned a = 0; a < 3u; a++) {
-            const size_t k = (size_t)br[b] * lw + ac[a];
-            lo = lo_of(lo, pmn[k]);
-            hi = hi_of(hi, pmx[k]);
-        }
-    }
+    const size_t lw = x->lw[l];
+    const size_t r0 = (size_t)b0 * lw, r1 = (size_t)bm * lw, r2 = (size_t)b1 * lw;
+    const float *const n = x->mn[l], *const p = x->mx[l];
+    const float lo = lo_of(lo_of(lo_of(n[r0 + a0], n[r0 + am]), lo_of(n[r0 + a1], n[r1 + a0])),
+                           lo_of(lo_of(n[r1 + am], n[r1 + a1]),
+                                 lo_of(lo_of(n[r2 + a0], n[r2 + am]), n[r2 + a1])));
+    const float hi = hi_of(hi_of(hi_of(p[r0 + a0], p[r0 + am]), hi_of(p[r0 + a1], p[r1 + a0])),
+                           hi_of(hi_of(p[r1 + am], p[r1 + a1]),
+                                 hi_of(hi_of(p[r2 + a0], p[r2 + am]), p[r2 + a1])));
     *mn = lo;
     *mx = hi;
 }
