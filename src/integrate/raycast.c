@@ -371,7 +371,7 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     for (unsigned i = 0; i < 3u; i++) {
         w.n[i] = chunk_countdown(ko[i], w.dd.step[i]);
     }
-    cw[(w.c >> 6) & 511u] |= (uint64_t)1 << (w.c & 63u);
+    cw[(w.c >> 6) & 511u] |= bit64[w.c & 63u];
     switch ((w.dd.step[0] < 0 ? 1u : 0u) | (w.dd.step[1] < 0 ? 2u : 0u) |
             (w.dd.step[2] < 0 ? 4u : 0u)) {
     case 0u: mark_ppp(&w, vs, cw); break;
