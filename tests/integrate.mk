@@ -19,3 +19,15 @@ integrate-cli: $(BUILD)/occmap $(BUILD)/data/scan.dat
 	  { ./$(BUILD)/occmap build --scan $(BUILD)/data/scan.dat --method bogus >/dev/null 2>&1; test $$? -eq 2; }
 TEST_STEPS += integrate-cli
 .PHONY: integrate-cli
+
+# test_projective once more, linked against the release library (build/libocc.a: -O2, the
+# projective lane loops vectorised, their AVX2 clones where the CPU has AVX2), so that the
+# oracle test covers the code `make bench` times, not only the ASan build's scalar loops. The
+# test's own objects are the ASan build's (an uninstrumented library links with them).
+.SECONDEXPANSION:
+PROJ_REL_TEST := $(BUILD)/asan/tests/bin/test_projective_rel
+$(PROJ_REL_TEST): $(BUILD)/asanhost/tests/test_projective.o $$(TEST_SUPPORT_OBJ) \
+    $$(TEST_PORT_OBJ) $(BUILD)/libocc.a
+	@mkdir -p $(dir $@)
+	$(CXX) $(SAN) -o $@ $^ $(HOST_LIBS)
+TEST_BINS_EXTRA += $(PROJ_REL_TEST)
