@@ -46,12 +46,13 @@ OCC_PROJ_LANES static void rows_minmax(const uint32_t n, const float *restrict a
     }
 }
 
-/* Horizontal step: pairs of columns. */
+/* Horizontal step: pairs of columns. The index is a size_t: with a 32-bit one, 2 i could wrap,
+ * and GCC loads the lanes one by one instead of two vectors it deinterleaves. */
 OCC_PROJ_LANES static void pairs_minmax(const uint32_t n, const float *restrict tmn,
                                         const float *restrict tmx, float *restrict dmn,
                                         float *restrict dmx)
 {
-    for (uint32_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n; i++) {
         dmn[i] = lo_of(tmn[2u * i], tmn[2u * i + 1u]);
         dmx[i] = hi_of(tmx[2u * i], tmx[2u * i + 1u]);
     }
