@@ -11,19 +11,36 @@
 #define CODE_BITS ((occ_code_t)0x7FFFFFFFFFFFFFFFull)
 #define DIGIT_MASK ((occ_code_t)(OCC_KS_RADIX - 1u))
 
-/* Every pass's digit histogram in one sweep; returns the bits that differ between codes. */
-static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t *const hist)
+/* The bits that differ between codes (the hit flag aside). */
+static occ_code_t code_diff(const occ_code_t *const a, const size_t n)
 {
     const occ_code_t first = a[0] & CODE_BITS;
     occ_code_t diff = 0;
-    memset(hist, 0, OCC_KS_HIST_WORDS * sizeof hist[0]);
+    for (size_t i = 0; i < n; i++) {
+        diff |= (a[i] & CODE_BITS) ^ first;
+    }
+    return diff;
+}
+
+/* The digit histograms of the passes that sort (a digit that differs somewhere), in one sweep;
+ * returns the bits that differ between codes. A frame's or a scan's codes differ in their low
+ * bits only: counting every pass cost as much as sorting. */
+static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t *const hist)
+{
+    const occ_code_t diff = code_diff(a, n);
+    uint32_t *live[OCC_KS_PASSES];
+    unsigned shift[OCC_KS_PASSES], n_live = 0;
+    for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
+        if (((diff >> (p * OCC_INSERT_RADIX_BITS)) & DIGIT_MASK) != 0u) {
+            live[n_live] = &hist[p * OCC_KS_RADIX];
+            shift[n_live++] = p * OCC_INSERT_RADIX_BITS;
+            memset(&hist[p * OCC_KS_RADIX], 0, OCC_KS_RADIX * sizeof hist[0]);
+        }
+    }
     for (size_t i = 0; i < n; i++) {
         const occ_code_t c = a[i] & CODE_BITS;
-        diff |= c ^ first;
-        occ_code_t v = c;
-        for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
-            hist[p * OCC_KS_RADIX + (unsigned)(v & DIGIT_MASK)]++;
-            v >>= OCC_INSERT_RADIX_BITS;
+        for (unsigned q = 0; q < n_live; q++) {
+            live[q][(unsigned)((c >> shift[q]) & DIGIT_MASK)]++;
         }
     }
     return diff;
