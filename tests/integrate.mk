@@ -20,14 +20,15 @@ integrate-cli: $(BUILD)/occmap $(BUILD)/data/scan.dat
 TEST_STEPS += integrate-cli
 .PHONY: integrate-cli
 
-# test_projective once more, linked against the release library (build/libocc.a: -O2, the
-# projective lane loops vectorised, their AVX2 clones where the CPU has AVX2), so that the
-# oracle test covers the code `make bench` times, not only the ASan build's scalar loops. The
-# test's own objects are the ASan build's (an uninstrumented library links with them).
+# The integration tests once more, linked against the release library (build/libocc.a: -O2,
+# the projective lane loops vectorised, their AVX2 clones where the CPU has AVX2), so that the
+# OctoMap and oracle comparisons cover the code `make bench` times, not only the ASan build's
+# (-O1, scalar loops). The tests' own objects are the ASan build's (an uninstrumented library
+# links with them).
+REL_TWINS := test_integrate test_projective
 .SECONDEXPANSION:
-PROJ_REL_TEST := $(BUILD)/asan/tests/bin/test_projective_rel
-$(PROJ_REL_TEST): $(BUILD)/asanhost/tests/test_projective.o $$(TEST_SUPPORT_OBJ) \
-    $$(TEST_PORT_OBJ) $(BUILD)/libocc.a
+$(REL_TWINS:%=$(BUILD)/asan/tests/bin/%_rel): $(BUILD)/asan/tests/bin/%_rel: \
+    $(BUILD)/asanhost/tests/%.o $$(TEST_SUPPORT_OBJ) $$(TEST_PORT_OBJ) $(BUILD)/libocc.a
 	@mkdir -p $(dir $@)
 	$(CXX) $(SAN) -o $@ $^ $(HOST_LIBS)
-TEST_BINS_EXTRA += $(PROJ_REL_TEST)
+TEST_BINS_EXTRA += $(REL_TWINS:%=$(BUILD)/asan/tests/bin/%_rel)
