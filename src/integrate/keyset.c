@@ -28,19 +28,32 @@ static occ_code_t code_diff(const occ_code_t *const a, const size_t n)
 static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t *const hist)
 {
     const occ_code_t diff = code_diff(a, n);
-    uint32_t *live[OCC_KS_PASSES];
-    unsigned shift[OCC_KS_PASSES], n_live = 0;
+    unsigned live = 0, top = 0; /* bit p: pass p sorts; passes 0 .. top - 1 hold them all */
     for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
         if (((diff >> (p * OCC_INSERT_RADIX_BITS)) & DIGIT_MASK) != 0u) {
-            live[n_live] = &hist[p * OCC_KS_RADIX];
-            shift[n_live++] = p * OCC_INSERT_RADIX_BITS;
+            live |= 1u << p;
+            top = p + 1u;
             memset(&hist[p * OCC_KS_RADIX], 0, OCC_KS_RADIX * sizeof hist[0]);
         }
     }
+    /* digits by shifts of a constant: a variable 64-bit shift is a library call on the M0+ */
+    if (live + 1u == 1u << top) { /* passes 0 .. top - 1 all sort: no test per pass */
+        for (size_t i = 0; i < n; i++) {
+            occ_code_t v = a[i] & CODE_BITS;
+            for (unsigned p = 0; p < top; p++) {
+                hist[p * OCC_KS_RADIX + (unsigned)(v & DIGIT_MASK)]++;
+                v >>= OCC_INSERT_RADIX_BITS;
+            }
+        }
+        return diff;
+    }
     for (size_t i = 0; i < n; i++) {
-        const occ_code_t c = a[i] & CODE_BITS;
-        for (unsigned q = 0; q < n_live; q++) {
-            live[q][(unsigned)((c >> shift[q]) & DIGIT_MASK)]++;
+        occ_code_t v = a[i] & CODE_BITS;
+        for (unsigned p = 0; p < top; p++) {
+            if (((live >> p) & 1u) != 0u) {
+                hist[p * OCC_KS_RADIX + (unsigned)(v & DIGIT_MASK)]++;
+            }
+            v >>= OCC_INSERT_RADIX_BITS;
         }
     }
     return diff;
