@@ -23,8 +23,9 @@ static occ_code_t code_diff(const occ_code_t *const a, const size_t n)
 }
 
 /* The digit histograms of the passes that sort (a digit that differs somewhere), in one sweep;
- * returns the bits that differ between codes. A frame's or a scan's codes differ in their low
- * bits only: counting every pass cost as much as sorting. */
+ * returns the bits that differ between codes. A frame's or a scan's codes often differ in
+ * their low bits only (not where the keys cross 2^(D-1) on an axis): counting every pass there
+ * cost as much as the sort. */
 static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t *const hist)
 {
     const occ_code_t diff = code_diff(a, n);

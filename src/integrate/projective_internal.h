@@ -10,13 +10,13 @@
 #include "integrate_internal.h"
 
 /* A vectorisable loop kept out of line: inlined into its caller, GCC 12 drops the loop's
- * restrict qualifiers and leaves it scalar. On x86-64 Linux hosts GCC also builds an AVX2
+ * restrict qualifiers and leaves it scalar. On x86-64 glibc hosts GCC also builds an AVX2
  * clone of it, picked once at load time by the CPU (an ifunc; libgcc's __cpu_model): eight
  * lanes instead of SSE2's four. The same IEEE operations lane for lane (AVX2 brings no FMA,
  * and C99 mode contracts none), so the same map (bench/ab_split compares digests;
  * test_projective_rel runs the oracle test on the release build). Measured 0.94x the time of
  * SSE2 alone on the TUM frames; an AVX-512 clone measured 0.99x, so there is none. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__linux__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__GLIBC__)
 #define OCC_PROJ_LANES OCC_NOINLINE __attribute__((target_clones("avx2", "default")))
 #else
 #define OCC_PROJ_LANES OCC_NOINLINE
