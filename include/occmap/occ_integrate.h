@@ -154,7 +154,8 @@ typedef enum {
      * [1.32, 1.48] at 0.2 m and 1.03x [0.95, 1.24] at 0.1 m, on 25a4548 1.24x [1.14, 1.27]
      * and 0.98x [0.89, 1.09], on 28c6fa7 (an Intel Xeon; the runs before, an AMD EPYC) 1.31x
      * [1.30, 1.33] and 1.03x [1.03, 1.05], on ee14210 1.31x [1.28, 1.36] and 1.03x
-     * [1.01, 1.05] (README, Performance).
+     * [1.01, 1.05], on 3e94854 1.30x [1.24, 1.40] and 1.03x [1.03, 1.10] (README,
+     * Performance).
      * When not: at 0.1 m or finer, and for laser scans (scan.dat, spherical_scan.graph at
      * 0.2 / 0.1 / 0.05 m: 0.95x to 1.11x over three runs, 1.0 to 1.8 points per traversal),
      * it buys nothing over SIMPLE. If OctoMap's discretize = true map will do, DISCRETE is
