@@ -458,7 +458,8 @@ def test_drop(o, frames, gt):
     nomem = fr.get("dropped", {}).get("nomem", 0)
     extra = sorted(set(got_drop) - set(want))
     c.that(len(extra) == nomem + fr.get("dropped", {}).get("error", 0),
-           "dropped frames that had a pose: %s (%s)" % (extra[:10], drop_detail(extra, frames, peer, fin)))
+           "dropped frames that had a pose: %s (%s)" %
+           (extra[:10], drop_detail(extra, frames, peer, fin)))
     for why in ("no_pose_gap", "no_pose_too_old", "no_pose_too_new"):
         n = sum(1 for w in want.values() if w == why)
         c.that(fr.get("dropped", {}).get(why) == n, "%s: %s, want %d" % (why, fr.get("dropped"), n))
