@@ -20,7 +20,7 @@ integrate-cli: $(BUILD)/occmap $(BUILD)/data/scan.dat
 TEST_STEPS += integrate-cli
 .PHONY: integrate-cli
 
-# The integration tests once more, linked against the release library (build/libocc.a: -O2,
+# The integration tests once more, linked against the release library (build/libocc.a: -O3,
 # the projective lane loops vectorised, their AVX2 clones where the CPU has AVX2), so that the
 # OctoMap and oracle comparisons cover the code `make bench` times, not only the ASan build's
 # (-O1, scalar loops). The tests' own objects are the ASan build's (an uninstrumented library
