@@ -154,8 +154,8 @@ typedef enum {
      * [1.32, 1.48] at 0.2 m and 1.03x [0.95, 1.24] at 0.1 m, on 25a4548 1.24x [1.14, 1.27]
      * and 0.98x [0.89, 1.09], on 28c6fa7 (an Intel Xeon; the runs before, an AMD EPYC) 1.31x
      * [1.30, 1.33] and 1.03x [1.03, 1.05], on ee14210 1.31x [1.28, 1.36] and 1.03x
-     * [1.01, 1.05], on 3e94854 1.30x [1.24, 1.40] and 1.03x [1.03, 1.10] (README,
-     * Performance).
+     * [1.01, 1.05], on 3e94854 1.30x [1.24, 1.40] and 1.03x [1.03, 1.10], on 35302fc
+     * (-O3) 1.30x [1.29, 1.31] and 1.03x [1.01, 1.04] (README, Performance).
      * When not: at 0.1 m or finer, and for laser scans (scan.dat, spherical_scan.graph at
      * 0.2 / 0.1 / 0.05 m: 0.95x to 1.11x over three runs, 1.0 to 1.8 points per traversal),
      * it buys nothing over SIMPLE. If OctoMap's discretize = true map will do, DISCRETE is
@@ -363,11 +363,12 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  *
  * Work, bounded per call: O(pixels) for the pixel pass (depths, end points), the gap filling
  * and the pyramid; the near rays (about (32 w / f) (32 h / f) rays of at most 4 sqrt(3) + 3
- * voxels each); the walk tests a node in O(1) (8 corner projections, at most 4 pyramid cells)
- * and descends only where its answer is mixed, down to level 2, whose 64 voxels it decides at
- * once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a noisy surface filling the
- * frustum) every voxel of the frustum within max range. Typical: proportional to the surface's
- * voxels, not pixels x ray length. Then one pass over the tree. Stack: O(D), no recursion. */
+ * voxels each); the walk tests a node in O(1) (8 corner projections, at most 3 x 3 pyramid
+ * cells) and descends only where its answer is mixed, down to level 2, whose 64 voxels it
+ * decides at once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a noisy
+ * surface filling the frustum) every voxel of the frustum within max range. Typical:
+ * proportional to the surface's voxels, not pixels x ray length. Then one pass over the tree.
+ * Stack: O(D), no recursion. */
 #define OCC_PROJ_CELLS(w, h) \
     ((size_t)(w) * (size_t)(h) / 3u + (size_t)(w) + (size_t)(h) + 20u)
 #define OCC_PROJ_LEVELS_BYTES 2048u /* the walk's per-level constants (kept off the stack) */

@@ -8,9 +8,6 @@
 void occi_proj_hits_sort(occ_proj_t *const x)
 {
     const size_t n = x->nh;
-#ifdef OCC_PROJ_PROFILE
-    { extern unsigned long occdbg_emit; occdbg_emit += n; }
-#endif
     occ_code_t *const sorted = occi_keyset_sort(x->out, x->out + n, n, x->hist);
     if (sorted != x->out) {
         memcpy(x->out, sorted, n * sizeof *sorted);

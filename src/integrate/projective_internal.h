@@ -146,7 +146,7 @@ void occi_proj_fill(occ_proj_t *x, float *mem);
  * aligned, occi_proj_pyramid_bytes bytes); x->dmax. */
 void occi_proj_build(occ_proj_t *x, float *mem);
 /* Min and max depth over pixels [i0, i1] x [j0, j1] (inside the image, i0 <= i1, j0 <= j1),
- * over-approximated by at most 2 x 2 cells of one level (so mn may be lower, mx higher). */
+ * over-approximated by at most 3 x 3 cells of one level (so mn may be lower, mx higher). */
 void occi_proj_range(const occ_proj_t *x, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1,
                      float *mn, float *mx);
 
