@@ -100,7 +100,9 @@ $(DEPS_STAMP): Makefile $(wildcard port/*.mk tests/*.mk tools/*.mk bench/*.mk)
 # REL_OPT=-O2, its symbols renamed old_*): PROJECTIVE new/old 0.937 and 0.939 where the same
 # library on both sides gave 0.980 (where code lands moves a run by that much), the exact
 # integrators 0.96 to 0.99; the same maps (no fast-math; ISO C mode contracts nothing). Most of
-# it is the pixel pass's row loops. -funroll-loops on top measured 0.998, LTO 1.011: neither.
+# it is the pixel pass's row loops. Against -O2 (old half built by bench/ab_split.mk),
+# -O3 -funroll-loops measured 0.998 and -O3 with LTO 1.011; against -O3, -falign-functions=64
+# -falign-loops=32 0.996 and -march=x86-64-v2 1.022: none of them.
 REL_OPT := -O3
 REL_CFLAGS := $(WARN) $(REL_OPT) -g $(INC)
 ASAN_CFLAGS := $(WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 $(OCC_TEST_ASSERTS)
