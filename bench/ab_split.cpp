@@ -281,6 +281,7 @@ static void bench_proj(const std::vector<DepthFrame> &fr, int rounds, const char
     proj_once(lib_new, fr, &rn, &dnew);
     ro.scratch_used = rn.scratch_used = 0; /* a layout change may use other scratch */
     ro.voxel_visits = rn.voxel_visits = 0; /* nodes tested: a walk change may test others */
+    ro.coarse_updated = rn.coarse_updated = 0; /* and decide a free region at another level */
     if (std::memcmp(&ro, &rn, sizeof ro) != 0 || dold != dnew) {
         std::fprintf(stderr, "ab_split: %s: old and new results differ (updated %zu / %zu, changed %zu / %zu, digest %s)\n",
                      name, (size_t)ro.voxels_updated, (size_t)rn.voxels_updated,

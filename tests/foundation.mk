@@ -30,7 +30,8 @@ $(FOUNDATION_DIR)/morton_bmi2.o: src/core/morton.c include/occmap/occmap.h
 	for s in $$syms; do args="$$args --redefine-sym $$s=bmi2_$$s"; done; \
 	objcopy $$args $@.raw.o $@ && rm -f $@.raw.o
 
-$(FOUNDATION_DIR)/test_morton_bmi2.o: tests/test_morton.c include/occmap/occmap.h src/core/tree_internal.h
+$(FOUNDATION_DIR)/test_morton_bmi2.o: tests/test_morton.c include/occmap/occmap.h src/core/tree_internal.h \
+    tests/support/seeded_rng.h
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_WARN) -O1 -g $(SAN) $(INC) -DOCC_TESTING=1 -DTEST_MORTON_BMI2=1 -c $< -o $@
 

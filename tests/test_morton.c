@@ -18,6 +18,7 @@
 
 #include "occmap/occmap.h"
 #include "core/tree_internal.h"
+#include "support/seeded_rng.h"
 
 #ifdef TEST_MORTON_BMI2
 occ_code_t bmi2_occ_morton_encode(occ_key_t key);
@@ -27,23 +28,10 @@ occ_key_t bmi2_occ_morton_decode(occ_code_t code);
 #define KEY_MASK 0x1FFFFFu
 #define N_RANDOM 200000u
 
-static uint64_t rng_state;
-
-static uint64_t rng_next(void)
-{
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 static int setup_seed(void **state)
 {
     (void)state;
-    const char *const env = getenv("OCC_SEED");
-    const uint64_t seed = env != NULL ? strtoull(env, NULL, 0) : (uint64_t)time(NULL);
-    rng_state = seed;
-    printf("test_morton: seed %llu (set OCC_SEED to repeat)\n", (unsigned long long)seed);
+    rng_seed("test_morton");
     return 0;
 }
 

@@ -347,8 +347,9 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * repeat filter for end points, the radix sort's histograms, the call's context, the walk's
  * per-level constants and stack and the 64-voxel rule's lane arrays (6 KiB, kept off the
  * stack)), 4 bytes per pixel (the
- * depths), 8 bytes per pyramid cell (min and max, levels 1.. of halved sides: at most
- * OCC_PROJ_CELLS(w, h) = w h / 3 + w + h + 20 cells), 52 bytes per image column (the pixel
+ * depths), 8 bytes per pyramid cell (min and max, levels 1.. of halved sides, and from level 2
+ * on per cell the min and max over the 8 x 8 cells from it: at most OCC_PROJ_CELLS(w, h) =
+ * 5 w h / 12 + 3 (w + h) / 2 + 40 cells), 52 bytes per image column (the pixel
  * pass's per-column tables and row buffers, OCC_PROJ_COLUMN_BYTES) and the output, in 8-byte
  * slots: the end points' codes after the repeat filter (twice while they are sorted), the near
  * rays' voxels (twice while sorted; ~5,000 for a 640 x 480 Kinect frame), then the updates:
@@ -364,15 +365,15 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * Work, bounded per call: O(pixels) for the pixel pass (depths, end points), the gap filling
  * and the pyramid; the near rays (about (32 w / f) (32 h / f) rays of at most 4 sqrt(3) + 3
  * voxels each); the walk tests a node in O(1) (8 corner projections, at most 3 x 3 pyramid
- * cells) and descends only where its answer is mixed, down to level 2, whose 64 voxels it
+ * cells or 2 x 2 windows) and descends only where its answer is mixed, down to level 2, whose 64 voxels it
  * decides at once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a noisy
  * surface filling the frustum) every voxel of the frustum within max range. Typical:
  * proportional to the surface's voxels, not pixels x ray length. Then one pass over the tree.
  * Stack: O(D), no recursion. */
 #define OCC_PROJ_CELLS(w, h) \
-    ((size_t)(w) * (size_t)(h) / 3u + (size_t)(w) + (size_t)(h) + 20u)
+    (5u * (size_t)(w) * (size_t)(h) / 12u + 3u * ((size_t)(w) + (size_t)(h)) / 2u + 40u)
 #define OCC_PROJ_LEVELS_BYTES 2048u /* the walk's per-level constants (kept off the stack) */
-#define OCC_PROJ_CTX_BYTES 2048u    /* the call's context and walk stack (kept off the stack) */
+#define OCC_PROJ_CTX_BYTES 2304u    /* the call's context and walk stack (kept off the stack) */
 #define OCC_PROJ_BULK_BYTES 2048u   /* the 64-voxel rule's lane arrays (kept off the stack) */
 #define OCC_PROJ_FIXED_BYTES                                                               \
     (8u + 8192u + (size_t)OCC_INSERT_RADIX_PASSES * ((size_t)1 << OCC_INSERT_RADIX_BITS) * 4u + \

@@ -26,10 +26,13 @@ size_t occi_proj_pyramid_bytes(const uint32_t w, const uint32_t h)
 {
     size_t cells = 0;
     uint32_t lw = w, lh = h;
+    unsigned l = 0;
     while (lw > 1u || lh > 1u) {
         lw = half_up(lw);
         lh = half_up(lh);
-        cells += (size_t)lw * lh;
+        l++;
+        /* the level's cells, and from OCC_PROJ_WIN_LEVEL on its windows too */
+        cells += (size_t)lw * lh * (l >= OCC_PROJ_WIN_LEVEL ? 2u : 1u);
     }
     return 8u * cells;
 }
@@ -77,6 +80,86 @@ static void reduce(const float *smn, const float *smx, const uint32_t sw, const 
     }
 }
 
+/* Per column, dmn / dmx = the min / max of themselves and of row (smn, smx) (another row). */
+OCC_PROJ_LANES static void row_into(const uint32_t n, const float *restrict smn,
+                                    const float *restrict smx, float *restrict dmn,
+                                    float *restrict dmx)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        dmn[i] = lo_of(dmn[i], smn[i]);
+        dmx[i] = hi_of(dmx[i], smx[i]);
+    }
+}
+
+/* windows_first's column steps are written out for N = 8 (steps 1, 2, 4). */
+typedef char occ_proj_win_steps[OCC_PROJ_WIN_SHIFT == 3u ? 1 : -1];
+
+/* Over a row of n cells, dst cell i = min / max of src cells i and min(i + s, n - 1). Separate
+ * rows: in place, GCC vectorised none of the steps (their distance s is below a vector). */
+OCC_PROJ_LANES static void cols_step(const uint32_t n, const uint32_t s, const float *restrict smn,
+                                     const float *restrict smx, float *restrict dmn,
+                                     float *restrict dmx)
+{
+    const size_t body = n > s ? n - s : 0u; /* size_t: a 32-bit i + s could wrap, and GCC
+                                                * then loads the lanes one by one */
+    for (size_t i = 0; i < body; i++) {
+        dmn[i] = lo_of(smn[i], smn[i + s]);
+        dmx[i] = hi_of(smx[i], smx[i + s]);
+    }
+    for (size_t i = body; i < n; i++) {
+        dmn[i] = lo_of(smn[i], smn[n - 1u]);
+        dmx[i] = hi_of(smx[i], smx[n - 1u]);
+    }
+}
+
+/* The first windowed level v: per cell (a, b) the min and max over cells [a, a + N) x
+ * [b, b + N) of the level (N = OCC_PROJ_WIN_CELLS, clipped at its last row and column), by
+ * doubling in place: after step k a cell covers 2^(k+1) rows (then columns). */
+static void windows_first(occ_proj_t *const x, const unsigned v)
+{
+    const uint32_t lw = x->lw[v], lh = x->lh[v];
+    const size_t cells = (size_t)lw * lh;
+    float *const wmn = x->wmn[v], *const wmx = x->wmx[v];
+    memcpy(wmn, x->mn[v], cells * sizeof(float));
+    memcpy(wmx, x->mx[v], cells * sizeof(float));
+    for (uint32_t s = 1; s < OCC_PROJ_WIN_CELLS; s *= 2u) {
+        for (uint32_t b = 0; b + 1u < lh; b++) {
+            const size_t from = (size_t)(b + s < lh ? b + s : lh - 1u) * lw;
+            row_into(lw, wmn + from, wmx + from, wmn + (size_t)b * lw, wmx + (size_t)b * lw);
+        }
+    }
+    /* the columns through two row buffers (the pixel pass's, free now): row -> a -> b -> row */
+    float *const amn = x->px.u[0], *const amx = x->px.u[1];
+    float *const bmn = x->px.u[2], *const bmx = x->px.dr;
+    for (uint32_t b = 0; b < lh; b++) {
+        float *const rmn = wmn + (size_t)b * lw, *const rmx = wmx + (size_t)b * lw;
+        cols_step(lw, 1u, rmn, rmx, amn, amx);
+        cols_step(lw, 2u, amn, amx, bmn, bmx);
+        cols_step(lw, 4u, bmn, bmx, rmn, rmx);
+    }
+}
+
+/* Level v's windows from level v - 1's: its cells a .. a + N - 1 are the cells 2 a ..
+ * 2 a + 2 N - 1 below, the windows there at 2 a and 2 a + N (clipped to the last). */
+static void windows_up(occ_proj_t *const x, const unsigned v)
+{
+    const uint32_t lw = x->lw[v], lh = x->lh[v], sw = x->lw[v - 1u], sh = x->lh[v - 1u];
+    const float *const smn = x->wmn[v - 1u], *const smx = x->wmx[v - 1u];
+    for (uint32_t b = 0; b < lh; b++) {
+        const size_t r0 = (size_t)(2u * b) * sw;
+        const size_t r1 = (size_t)(2u * b + OCC_PROJ_WIN_CELLS < sh ? 2u * b + OCC_PROJ_WIN_CELLS
+                                                                     : sh - 1u) * sw;
+        for (uint32_t a = 0; a < lw; a++) {
+            const uint32_t c0 = 2u * a;
+            const uint32_t c1 = c0 + OCC_PROJ_WIN_CELLS < sw ? c0 + OCC_PROJ_WIN_CELLS : sw - 1u;
+            x->wmn[v][(size_t)b * lw + a] = lo_of(lo_of(smn[r0 + c0], smn[r0 + c1]),
+                                                  lo_of(smn[r1 + c0], smn[r1 + c1]));
+            x->wmx[v][(size_t)b * lw + a] = hi_of(hi_of(smx[r0 + c0], smx[r0 + c1]),
+                                                  hi_of(smx[r1 + c0], smx[r1 + c1]));
+        }
+    }
+}
+
 void occi_proj_build(occ_proj_t *const x, float *const mem)
 {
     const uint32_t w = x->im->width, h = x->im->height;
@@ -103,6 +186,16 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
     }
     x->levels = l + 1u;
     x->dmax = x->mx[l][0]; /* -inf: no reading at all */
+    for (unsigned v = OCC_PROJ_WIN_LEVEL; v < x->levels && v < OCC_PROJ_MAX_LEVELS; v++) {
+        x->wmn[v] = next;
+        x->wmx[v] = next + (size_t)x->lw[v] * x->lh[v];
+        next += 2u * (size_t)x->lw[v] * x->lh[v];
+        if (v == OCC_PROJ_WIN_LEVEL) {
+            windows_first(x, v);
+        } else {
+            windows_up(x, v);
+        }
+    }
 }
 
 /* The lowest level at which pixels i0..i1 fall in at most 3 cells, without a loop whose exit
@@ -117,9 +210,43 @@ static uint32_t span_level(const uint32_t i0, const uint32_t i1)
     return w <= 2u ? 0u : l;
 }
 
+/* The lowest level at which pixels i0..i1 (w = i1 - i0) fall in at most 2 N cells (N = 2^s):
+ * with f = floor(log2 w), at level f - s + 1 they span w / 2^(f-s+1) < N cells plus one part,
+ * at f - s - 1 at least 2 N + 1 cells, so it is f - s or f - s + 1. */
+static uint32_t win_level(const uint32_t i0, const uint32_t i1)
+{
+    const uint32_t w = i1 - i0, s = OCC_PROJ_WIN_SHIFT;
+    const uint32_t f = occ_bit_length32(w | 1u) - 1u; /* floor(log2 w), w >= 1 */
+    const uint32_t c = f > s ? f - s : 0u;
+    return ((i1 >> c) - (i0 >> c)) < 2u * OCC_PROJ_WIN_CELLS ? c : c + 1u;
+}
+
+/* Over the windows of level l (>= OCC_PROJ_WIN_LEVEL): two windows of 4 cells per axis cover
+ * the footprint's at most 8. */
+static void window_range(const occ_proj_t *const x, const unsigned l, const uint32_t i0,
+                         const uint32_t i1, const uint32_t j0, const uint32_t j1,
+                         float *const mn, float *const mx)
+{
+    const uint32_t a0 = i0 >> l, a1 = i1 >> l, b0 = j0 >> l, b1 = j1 >> l;
+    const uint32_t m = OCC_PROJ_WIN_CELLS - 1u;
+    const uint32_t a2 = a1 > a0 + m ? a1 - m : a0, b2 = b1 > b0 + m ? b1 - m : b0;
+    const size_t lw = x->lw[l];
+    const float *const n = x->wmn[l], *const p = x->wmx[l];
+    const size_t c00 = (size_t)b0 * lw + a0, c01 = (size_t)b0 * lw + a2;
+    const size_t c10 = (size_t)b2 * lw + a0, c11 = (size_t)b2 * lw + a2;
+    *mn = lo_of(lo_of(n[c00], n[c01]), lo_of(n[c10], n[c11]));
+    *mx = hi_of(hi_of(p[c00], p[c01]), hi_of(p[c10], p[c11]));
+}
+
 void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_t i1,
                      const uint32_t j0, const uint32_t j1, float *const mn, float *const mx)
 {
+    const uint32_t wi = win_level(i0, i1), wj = win_level(j0, j1);
+    const unsigned wl = wi > wj ? wi : wj;
+    if (wl >= OCC_PROJ_WIN_LEVEL) {
+        window_range(x, wl, i0, i1, j0, j1, mn, mx);
+        return;
+    }
     const uint32_t li = span_level(i0, i1), lj = span_level(j0, j1);
     const unsigned l = li > lj ? li : lj;
     OCC_ASSERT(l < x->levels);
