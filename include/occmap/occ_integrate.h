@@ -357,8 +357,8 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * the miss and by the hit) and 1 per whole free node above level 2. OCC_PROJ_SCRATCH_BYTES(w,
  * h, n_out) sizes it for n_out slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers
  * the TUM frames in `make bench` (bench/projective.cpp prints what they used) and an 8x8 ToF
- * array at 0.05 m to 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 11.4
- * bytes per pixel, of which a frame of the pioneer sequence used at most 8.4. A frame that
+ * array at 0.05 m to 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 12.1
+ * bytes per pixel, of which a frame of the pioneer sequence used at most 9.0. A frame that
  * needs more slots is refused with OCC_ERR_SCRATCH (map unchanged): pass more.
  * out->insert.scratch_used says what a call used.
  *
