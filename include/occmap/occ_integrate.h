@@ -150,12 +150,10 @@ typedef enum {
      * points per traversal; 0.1 m 63.9 -> 57.8 ms, 1.13x [1.08, 1.15], 1.7 points; 0.05 m
      * 121.1 -> 118.9 ms, 1.02x, 1.2 points (two more runs: 1.56x / 1.12x / 1.02x and 1.56x /
      * 1.14x / 1.04x). Since SIMPLE's walk got faster (issue 22: per octant, Morton stepping,
-     * the set to the tree by bricks) the gain is smaller: make bench on 29878c6 gave 1.39x
-     * [1.32, 1.48] at 0.2 m and 1.03x [0.95, 1.24] at 0.1 m, on 25a4548 1.24x [1.14, 1.27]
-     * and 0.98x [0.89, 1.09], on 28c6fa7 (an Intel Xeon; the runs before, an AMD EPYC) 1.31x
-     * [1.30, 1.33] and 1.03x [1.03, 1.05], on ee14210 1.31x [1.28, 1.36] and 1.03x
-     * [1.01, 1.05], on 3e94854 1.30x [1.24, 1.40] and 1.03x [1.03, 1.10], on 35302fc
-     * (-O3) 1.30x [1.29, 1.31] and 1.03x [1.01, 1.04] (README, Performance).
+     * the set to the tree by bricks) the gain is smaller: make bench on six commits from
+     * 29878c6 to 35302fc (AMD EPYC, then Intel Xeon from 28c6fa7) gave 1.24x to 1.39x at 0.2 m
+     * and 0.98x to 1.03x at 0.1 m; on 473f112 1.31x [1.26, 1.36] and 1.00x [0.94, 1.06]
+     * (README, Performance).
      * When not: at 0.1 m or finer, and for laser scans (scan.dat, spherical_scan.graph at
      * 0.2 / 0.1 / 0.05 m: 0.95x to 1.11x over three runs, 1.0 to 1.8 points per traversal),
      * it buys nothing over SIMPLE. If OctoMap's discretize = true map will do, DISCRETE is
