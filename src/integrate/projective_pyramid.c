@@ -94,8 +94,8 @@ OCC_PROJ_LANES static void row_into(const uint32_t n, const float *restrict smn,
 /* windows_first's column steps are written out for N = 8 (steps 1, 2, 4). */
 typedef char occ_proj_win_steps[OCC_PROJ_WIN_SHIFT == 3u ? 1 : -1];
 
-/* Over a row of n cells, dst cell i = min / max of src cells i and min(i + s, n - 1). Separate
- * rows: in place, GCC vectorised none of the steps (their distance s is below a vector). */
+/* Over a row of n cells, dst cell i = min / max of src cells i and min(i + s, n - 1) (another
+ * row: each step reads the old cells). */
 OCC_PROJ_LANES static void cols_step(const uint32_t n, const uint32_t s, const float *restrict smn,
                                      const float *restrict smx, float *restrict dmn,
                                      float *restrict dmx)
@@ -114,7 +114,8 @@ OCC_PROJ_LANES static void cols_step(const uint32_t n, const uint32_t s, const f
 
 /* The first windowed level v: per cell (a, b) the min and max over cells [a, a + N) x
  * [b, b + N) of the level (N = OCC_PROJ_WIN_CELLS, clipped at its last row and column), by
- * doubling in place: after step k a cell covers 2^(k+1) rows (then columns). */
+ * doubling: after step k a cell covers 2^(k+1) rows (in place, going down: row b + s is still
+ * the old one when row b reads it), then the same over columns. */
 static void windows_first(occ_proj_t *const x, const unsigned v)
 {
     const uint32_t lw = x->lw[v], lh = x->lh[v];
@@ -221,12 +222,13 @@ static uint32_t win_level(const uint32_t i0, const uint32_t i1)
     return ((i1 >> c) - (i0 >> c)) < 2u * OCC_PROJ_WIN_CELLS ? c : c + 1u;
 }
 
-/* Over the windows of level l (>= OCC_PROJ_WIN_LEVEL): two windows of 4 cells per axis cover
- * the footprint's at most 8. */
+/* Over the windows of level l (>= OCC_PROJ_WIN_LEVEL): two windows of N cells per axis cover
+ * the footprint's at most 2 N there (the second starts N - 1 cells before its last). */
 static void window_range(const occ_proj_t *const x, const unsigned l, const uint32_t i0,
                          const uint32_t i1, const uint32_t j0, const uint32_t j1,
                          float *const mn, float *const mx)
 {
+    OCC_ASSERT(l < x->levels);
     const uint32_t a0 = i0 >> l, a1 = i1 >> l, b0 = j0 >> l, b1 = j1 >> l;
     const uint32_t m = OCC_PROJ_WIN_CELLS - 1u;
     const uint32_t a2 = a1 > a0 + m ? a1 - m : a0, b2 = b1 > b0 + m ? b1 - m : b0;
