@@ -16,8 +16,10 @@ AB_FR079 := $(wildcard ../shared/data/maps/fr_079_t1_model.ot)
 # The map modules and sensors (occ_map_insert_depth), no other front end, with the release
 # build's flags (REL_OPT; PROJ_VEC_CFLAGS on the projective files). Rebuilt when AB_BASE names
 # another commit or those flags change (kept in $(AB_DIR)/base). Where the code lands differs
-# between the halves: the same commit on both sides measured PROJECTIVE 0.96 to 1.02, so a
-# change smaller than a few percent needs repeated runs (or both halves built alike).
+# between the halves: the same commit on both sides measured PROJECTIVE 0.96 to 1.02, and even
+# both halves built alike from one tree (the Makefile with BUILD=<dir>, one renamed) 1.01 and
+# 1.04: a change smaller than about 4 % needs repeated runs and an instruction count (callgrind)
+# beside the times.
 $(AB_DIR)/libocc_old.a: FORCE_AB
 	@set -e; sha=$$(git rev-parse --verify '$(AB_BASE)^{commit}'); \
 	if [ -f $@ ] && [ "$$(cat $(AB_DIR)/base 2>/dev/null)" = "$$sha $(REL_OPT) $(PROJ_VEC_CFLAGS) sensors" ]; then exit 0; fi; \
