@@ -363,9 +363,9 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * Work, bounded per call: O(pixels) for the pixel pass (depths, end points), the gap filling
  * and the pyramid; the near rays (about (32 w / f) (32 h / f) rays of at most 4 sqrt(3) + 3
  * voxels each); the walk tests a node in O(1) (8 corner projections, at most 3 x 3 pyramid
- * cells or 2 x 2 windows) and descends only where its answer is mixed, down to level 2, whose 64 voxels it
- * decides at once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a noisy
- * surface filling the frustum) every voxel of the frustum within max range. Typical:
+ * cells or 2 x 2 windows) and descends only where its answer is mixed, down to level 2, whose
+ * 64 voxels it decides at once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a
+ * noisy surface filling the frustum) every voxel of the frustum within max range. Typical:
  * proportional to the surface's voxels, not pixels x ray length. Then one pass over the tree.
  * Stack: O(D), no recursion. */
 #define OCC_PROJ_CELLS(w, h) \

@@ -199,27 +199,20 @@ void occi_proj_build(occ_proj_t *const x, float *const mem)
     }
 }
 
-/* The lowest level at which pixels i0..i1 fall in at most 3 cells, without a loop whose exit
- * mispredicts: with f = floor(log2 (i1 - i0)) they fall in at most 3 at level f and in at
- * least 5 at f - 2 (a cell count is monotone in the level), so it is f - 1 or f. */
-static uint32_t span_level(const uint32_t i0, const uint32_t i1)
+/* The lowest level at which pixels i0..i1 (w = i1 - i0) span at most `most` + 1 cells, without
+ * a loop whose exit mispredicts: with f = floor(log2 w) it is f - back or f - back + 1, for
+ * the two uses below (a cell count is monotone in the level):
+ *  - at most 3 cells (back 1, most 2): at level f they span at most 3, at f - 2 at least 5;
+ *  - at most 2 N cells, N = 2^s (back s, most 2 N - 1): at f - s + 1 fewer than N plus one,
+ *    at f - s - 1 at least 2 N + 1.
+ * w <= 2: level 0 (c = 0 and the span fits). */
+static uint32_t fit_level(const uint32_t i0, const uint32_t i1, const uint32_t back,
+                          const uint32_t most)
 {
     const uint32_t w = i1 - i0;
     const uint32_t f = occ_bit_length32(w | 1u) - 1u; /* floor(log2 w), w >= 1 */
-    const uint32_t c = f > 0u ? f - 1u : 0u;
-    const uint32_t l = ((i1 >> c) - (i0 >> c)) <= 2u ? c : f;
-    return w <= 2u ? 0u : l;
-}
-
-/* The lowest level at which pixels i0..i1 (w = i1 - i0) fall in at most 2 N cells (N = 2^s):
- * with f = floor(log2 w), at level f - s + 1 they span w / 2^(f-s+1) < N cells plus one part,
- * at f - s - 1 at least 2 N + 1 cells, so it is f - s or f - s + 1. */
-static uint32_t win_level(const uint32_t i0, const uint32_t i1)
-{
-    const uint32_t w = i1 - i0, s = OCC_PROJ_WIN_SHIFT;
-    const uint32_t f = occ_bit_length32(w | 1u) - 1u; /* floor(log2 w), w >= 1 */
-    const uint32_t c = f > s ? f - s : 0u;
-    return ((i1 >> c) - (i0 >> c)) < 2u * OCC_PROJ_WIN_CELLS ? c : c + 1u;
+    const uint32_t c = f > back ? f - back : 0u;
+    return ((i1 >> c) - (i0 >> c)) <= most ? c : c + 1u;
 }
 
 /* Over the windows of level l (>= OCC_PROJ_WIN_LEVEL): two windows of N cells per axis cover
@@ -243,13 +236,16 @@ static void window_range(const occ_proj_t *const x, const unsigned l, const uint
 void occi_proj_range(const occ_proj_t *const x, const uint32_t i0, const uint32_t i1,
                      const uint32_t j0, const uint32_t j1, float *const mn, float *const mx)
 {
-    const uint32_t wi = win_level(i0, i1), wj = win_level(j0, j1);
+    /* at most 2 N cells per axis: two windows of N cover them */
+    const uint32_t most = 2u * OCC_PROJ_WIN_CELLS - 1u;
+    const uint32_t wi = fit_level(i0, i1, OCC_PROJ_WIN_SHIFT, most);
+    const uint32_t wj = fit_level(j0, j1, OCC_PROJ_WIN_SHIFT, most);
     const unsigned wl = wi > wj ? wi : wj;
     if (wl >= OCC_PROJ_WIN_LEVEL) {
         window_range(x, wl, i0, i1, j0, j1, mn, mx);
         return;
     }
-    const uint32_t li = span_level(i0, i1), lj = span_level(j0, j1);
+    const uint32_t li = fit_level(i0, i1, 1u, 2u), lj = fit_level(j0, j1, 1u, 2u); /* <= 3 cells */
     const unsigned l = li > lj ? li : lj;
     OCC_ASSERT(l < x->levels);
     /* The 1..3 cells per axis as a fixed 3 x 3 window (the middle one repeated where a span
