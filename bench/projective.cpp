@@ -354,8 +354,8 @@ int main(int argc, char **argv)
     if (proj_only) {
         std::vector<double> t;
         for (int r = 0; r < reps; r++) t.push_back(run_proj(fr, cam, res, max_m, mp, &used, nullptr));
-        std::printf("PROJECTIVE only: %.2f ms per frame (median of %d), scratch %zu bytes\n",
-                    pct(t, 0.5), reps, used);
+        std::printf("PROJECTIVE only: %.2f ms per frame (median of %d, %zu frames), scratch %zu bytes\n",
+                    pct(t, 0.5), reps, fr.size(), used);
         print_counters();
         return 0;
     }

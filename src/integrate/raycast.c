@@ -246,8 +246,9 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
  * that chunk's words: a directory lookup per 32 steps at most).
  * Measured and dropped: a branch-free walk by slabs of the major axis (the minor steps before
  * each major one from three compares, three marks per slab, this loop at ties, chunk crossings
- * and the end). Same maps, 1.21x the time on scan.dat at 0.1 m: 96 instructions per slab
- * against 22 per step here, and a slab's marks share a word, so each waits on the last store. */
+ * and the end). Same maps, 1.21x the time on scan.dat at 0.1 m: 96 instructions per slab (one
+ * to three steps) against 29 per step here (make bench-profile), and a slab's three marks mostly
+ * share a word, so each waits on the last one's store. */
 typedef struct {
     occ_dda_t dd;   /* tMax, tDelta, steps (the walk keeps them in registers) */
     occ_rr_t len;
