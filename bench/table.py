@@ -84,8 +84,8 @@ EXPECTED = [
         ("shared/reader_latency/view", "reader latency, a whole view with its queries",
          "none set"),
     ]),
-    # Not in issue 22's table: where the time goes (bench/callgrind_phases.py; issue 19 asks for the
-    # projective phases, issue 22 for SIMPLE's instructions per voxel visit).
+    # Not in issue 22's table: where the time goes (bench/callgrind_phases.py; issue 19 asks
+    # for the projective phases, issue 22 for SIMPLE's instructions per voxel visit).
     ("where the time goes (callgrind instructions)", [
         ("profile/simple/scan.dat/0.10", "SIMPLE scan.dat 0.1 m, instructions per voxel visit",
          "none set"),

@@ -18,6 +18,7 @@ import os
 import sys
 import tempfile
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "bench"))
 import callgrind_phases as prof  # noqa: E402
 import table  # noqa: E402
