@@ -55,17 +55,21 @@ def row(rid, work, unit, value, reps):
             "equal": "n/a"}
 
 
-def phase_rows(prefix, what, total, phases, rest_label, per, unit, reps):
-    """One row per phase (share of the call in its text), the rest and the call's own; prints
+def phase_rows(prefix, what, total, phases, parts, rest_label, per, unit, reps):
+    """One row for the call, one per phase and its rest (they add up to the call), and one per
+    part of a phase (`parts`, counted inside their phase, not in the rest); the share of the call
+    in each text. A phase or part without a count (an inlined function) gets no row. Prints
     them."""
-    rest = total - sum(n for key, _, n in phases if n is not None and not key.startswith("sub:"))
+    rest = total - sum(n for _, _, n in phases if n is not None)
     rows = [row(prefix + "/total", "%s: the whole call (%.1f M instructions)" % (what, total / 1e6),
                 unit, total / per, reps)]
-    for key, label, n in phases + [("rest", rest_label, rest)]:
+    ordered = []  # each phase, then its parts ("walk/bulk" under "walk")
+    for phase in phases + [("rest", rest_label, rest)]:
+        ordered += [phase] + [p for p in parts if p[0].startswith(phase[0] + "/")]
+    for key, label, n in ordered:
         if n is None:
             print("phases: %s: no count for %s (inlined?): row left out" % (what, label))
             continue
-        key = key[4:] if key.startswith("sub:") else key
         rows.append(row("%s/%s" % (prefix, key), "%s: %s, %.1f %% of the call" %
                         (what, label, 100.0 * n / total), unit, n / per, reps))
     for r in rows:
@@ -84,7 +88,7 @@ def simple_rows(c, visits):
         ("setup", "per-ray set-up (keys, direction, tMax, chunk look-ups, hits)", rays - walk),
         ("tree", "voxel set to the tree (sort, bricks, tree updates)",
          c["set_sort"] + c["set_bricks"]),
-    ], "rest (the sizing pass over every ray's keys before the walk, checks)", visits,
+    ], [], "rest (the sizing pass over every ray's keys before the walk, checks)", visits,
         "instructions per visit", 1)
 
 
@@ -98,11 +102,12 @@ def projective_rows(c, frames):
         ("pyramid", "gap fill, min/max pyramid, windows", c.get("occi_proj_build")),
         ("near", "near field", c.get("occi_proj_near")),
         ("walk", "free-space walk", c.get("occi_proj_walk")),
-        ("sub:walk/node_tests", "of the walk: node tests with the footprint query",
-         c.get("test_node")),
-        ("sub:walk/bulk", "of the walk: the 64-voxel rule", c.get("occi_proj_bulk")),
         ("tree", "tree pass (bricks and whole nodes into the tree)",
          c.get("occi_tree_apply_frame")),
+    ], [
+        ("walk/node_tests", "of the walk: node tests with the footprint query",
+         c.get("test_node")),
+        ("walk/bulk", "of the walk: the 64-voxel rule", c.get("occi_proj_bulk")),
     ], "rest (checks, scratch layout, pool check)", frames * 1e6, "M instructions per frame",
         frames)
 

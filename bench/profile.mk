@@ -12,10 +12,10 @@ bench-profile: $(BUILD)/occmap $(BUILD)/bench/projective $(BUILD)/data/scan.dat
 	valgrind --tool=callgrind --toggle-collect=occ_map_insert_cloud \
 	  --callgrind-out-file=$(PROFILE_DIR)/simple.out ./$(BUILD)/occmap build \
 	  --scan $(BUILD)/data/scan.dat --res 0.1 --method simple --json -o $(PROFILE_DIR)/simple.bt \
-	  > $(PROFILE_DIR)/simple.json 2> $(PROFILE_DIR)/simple.log
+	  > $(PROFILE_DIR)/simple.json 2> $(PROFILE_DIR)/valgrind.log
 	valgrind --tool=callgrind --toggle-collect=occ_map_insert_projective \
 	  --callgrind-out-file=$(PROFILE_DIR)/projective.out ./$(BUILD)/bench/projective --proj-only \
-	  --reps 1 > $(PROFILE_DIR)/projective.log 2>> $(PROFILE_DIR)/simple.log
+	  --reps 1 > $(PROFILE_DIR)/projective.log 2>> $(PROFILE_DIR)/valgrind.log
 	python3 bench/callgrind_phases.py --rows $(BENCH_ROWS_DIR)/profile.json \
 	  --simple $(PROFILE_DIR)/simple.out $(PROFILE_DIR)/simple.json \
 	  --projective $(PROFILE_DIR)/projective.out $(PROFILE_DIR)/projective.log
