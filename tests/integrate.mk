@@ -25,7 +25,7 @@ TEST_STEPS += integrate-cli
 # OctoMap and oracle comparisons cover the code `make bench` times, not only the ASan build's
 # (-O1, scalar loops). The tests' own objects are the ASan build's (an uninstrumented library
 # links with them).
-REL_TWINS := test_integrate test_projective test_proj_range
+REL_TWINS := test_integrate test_projective test_proj_range test_projective_fuzz
 .SECONDEXPANSION:
 $(REL_TWINS:%=$(BUILD)/asan/tests/bin/%_rel): $(BUILD)/asan/tests/bin/%_rel: \
     $(BUILD)/asanhost/tests/%.o $$(TEST_SUPPORT_OBJ) $$(TEST_PORT_OBJ) $(BUILD)/libocc.a

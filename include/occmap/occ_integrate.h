@@ -309,10 +309,13 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  *  - near field: it is FREE too when one of the near rays crosses it: from the camera t along
  *    every step-th pixel of each row and column and the last one (step = min(fx, fy) / 32
  *    truncated, at least 1: a ray every ~1.8 degrees) that has a free-test depth d, to depth
- *    z = min(T(d), 4 voxels) (the end e = (r (a_i, b_j, 1)) z + t, float), the voxels
- *    occ_ray_keys(t, e) gives (the camera's voxel first, the end's excluded; none when e is off
- *    the map). Within a few voxels of the camera a voxel is large against the frustum, so most
- *    voxels there have their centre outside the image though the camera's rays cross them;
+ *    z = min(T(d), 4 voxels, R) with R = max_range_m / sqrtf(a_i a_i + (b_j b_j + 1)) (max range
+ *    along the pixel's ray: far off the optical axis, in a very wide field of view, 4 voxels of
+ *    depth are a long ray, and a reading beyond max range frees no further than max range; the
+ *    end e = (r (a_i, b_j, 1)) z + t, float), the voxels occ_ray_keys(t, e) gives (the camera's
+ *    voxel first, the end's excluded; none when e is off the map). Within a few voxels of the
+ *    camera a voxel is large against the frustum, so most voxels there have their centre
+ *    outside the image though the camera's rays cross them;
  *  - the voxel is OCCUPIED (cfg.hit) iff it is the end voxel of some pixel with a reading and
  *    |c|^2 <= max_range_m^2: the voxel of the point t + r c, computed from the camera's voxel
  *    in float so that every pixel costs a few vector operations: per map axis a,
@@ -356,13 +359,17 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * h, n_out) sizes it for n_out slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers
  * the TUM frames in `make bench` (bench/projective.cpp prints what they used) and an 8x8 ToF
  * array at 0.05 m to 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 12.1
- * bytes per pixel, of which a frame of the pioneer sequence used at most 9.0. A frame that
- * needs more slots is refused with OCC_ERR_SCRATCH (map unchanged): pass more.
+ * bytes per pixel, of which a frame of the pioneer sequence used at most 9.0. A small image
+ * with a very wide field of view (fx or fy below 32: a near ray at every pixel) can need more
+ * (tests/test_projective_fuzz.c draws such cameras). A frame that needs more slots is refused
+ * with OCC_ERR_SCRATCH (map unchanged): pass more.
  * out->insert.scratch_used says what a call used.
  *
  * Work, bounded per call: O(pixels) for the pixel pass (depths, end points), the gap filling
- * and the pyramid; the near rays (about (32 w / f) (32 h / f) rays of at most 4 sqrt(3) + 3
- * voxels each); the walk tests a node in O(1) (8 corner projections, at most 3 x 3 pyramid
+ * and the pyramid; the near rays (about (32 w / f) (32 h / f) rays, each of at most
+ * sqrt(3) L / res + 4 voxels, L = z sqrt(1 + a^2 + b^2) <= min(4 res sqrt(1 + a^2 + b^2),
+ * max_range_m) its length: 11 on the optical axis, 13 at a Kinect's corners, more in a very
+ * wide field of view); the walk tests a node in O(1) (8 corner projections, at most 3 x 3 pyramid
  * cells or 2 x 2 windows) and descends only where its answer is mixed, down to level 2, whose
  * 64 voxels it decides at once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a
  * noisy surface filling the frustum) every voxel of the frustum within max range. Typical:

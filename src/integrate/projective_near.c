@@ -4,6 +4,7 @@
  * the camera's rays cross them (OctoMap frees them). Exact rays (computeRayKeys) from the camera
  * along a sparse grid of pixels, each to OCC_PROJ_NEAR_VOXELS voxels of depth or the front of its
  * surface if nearer, free the voxels they cross (occ_integrate.h). */
+#include <math.h>
 #include <string.h>
 
 #include "projective_internal.h"
@@ -29,18 +30,22 @@ size_t occi_proj_near_rays(const uint32_t w, const uint32_t h, const uint32_t st
 }
 
 /* The near ray of pixel (i, j) with depth d (a reading): its end point (the header's
- * arithmetic), false when it has no length. */
+ * arithmetic), false when it has no length. Its depth is also held to max range along the
+ * pixel's ray: far off the optical axis (a very wide field of view, or a principal point off
+ * the image) 4 voxels of depth are a long ray, and a reading beyond max range frees no further
+ * than max range. */
 static bool ray_end(const occ_proj_t *const x, const uint32_t i, const uint32_t j, const float d,
                     float e[3])
 {
     const occ_proj_camera_t *const k = x->cam;
-    const float near = x->near_z;
+    const float a = ((float)i - k->cx) / k->fx, b = ((float)j - k->cy) / k->fy;
+    const float reach = k->max_range_m / sqrtf(a * a + (b * b + 1.0f));
     const float front = occ_proj_front(x, d);
-    const float z = front < near ? front : near;
+    float z = front < x->near_z ? front : x->near_z;
+    z = reach < z ? reach : z;
     if (!(z > 0.0f)) {
         return false;
     }
-    const float a = ((float)i - k->cx) / k->fx, b = ((float)j - k->cy) / k->fy;
     const float t[3] = {k->t.x, k->t.y, k->t.z};
     for (unsigned ax = 0; ax < 3u; ax++) {
         e[ax] = (k->r[ax][0] * a + k->r[ax][1] * b + k->r[ax][2]) * z + t[ax];

@@ -179,8 +179,9 @@ static bool ref_free(const occ_proj_image_t *im, const occ_proj_camera_t *k, occ
 
 /* The near field (occ_integrate.h): rays from the camera along the pixel grid (every step-th
  * pixel and the last of a row and a column, step = min(fx, fy) / 32 truncated, at least 1) with
- * a reading, to depth min(front of its surface, 4 voxels); the voxels occ_ray_keys() gives for
- * each (the camera's first, the end's excluded) are free. Appended to c[n..). */
+ * a reading, to depth min(front of its surface, 4 voxels, max range along the pixel's ray); the
+ * voxels occ_ray_keys() gives for each (the camera's first, the end's excluded; however long
+ * the ray) are free. Appended to c[n..). */
 static size_t ref_near(const occ_map_t *map, const occ_proj_image_t *im,
                        const occ_proj_camera_t *k, occ_code_t **c, size_t n, size_t *cap)
 {
@@ -189,23 +190,28 @@ static size_t ref_near(const occ_map_t *map, const occ_proj_image_t *im,
     const float near = 4.0f * map->cfg.resolution_m;
     const float keep = 1.0f - k->noise_rel;
     const float t[3] = {k->t.x, k->t.y, k->t.z};
-    occ_key_t keys[256];
     for (uint32_t j = 0; j < im->height; j = j + 1u == im->height ? j + 1u : (j + step < im->height ? j + step : im->height - 1u)) {
         for (uint32_t i = 0; i < im->width; i = i + 1u == im->width ? i + 1u : (i + step < im->width ? i + step : im->width - 1u)) {
             const float d = ref_free_depth(im, k, i, j);
+            const float a = ((float)i - k->cx) / k->fx, b = ((float)j - k->cy) / k->fy;
+            const float reach = k->max_range_m / sqrtf(a * a + (b * b + 1.0f));
             const float front = keep * d;
-            const float z = front < near ? front : near;
+            float z = front < near ? front : near;
+            z = reach < z ? reach : z;
             if (isnan(d) || !(z > 0.0f)) {
                 continue;
             }
             float e[3];
-            const float a = ((float)i - k->cx) / k->fx, b = ((float)j - k->cy) / k->fy;
             for (unsigned ax = 0; ax < 3u; ax++) {
                 e[ax] = (k->r[ax][0] * a + k->r[ax][1] * b + k->r[ax][2]) * z + t[ax];
             }
             size_t nk = 0;
             const occ_vec3_t ev = {e[0], e[1], e[2]};
-            if (occ_ray_keys(map, k->t, ev, keys, 256u, &nk) != OCC_OK) {
+            const size_t room = occ_ray_max_keys(map, k->t, ev); /* 0: the end off the map */
+            occ_key_t *const keys = malloc((room + 1u) * sizeof *keys);
+            if (keys == NULL || room == 0u ||
+                occ_ray_keys(map, k->t, ev, keys, room, &nk) != OCC_OK) {
+                free(keys);
                 continue;
             }
             for (size_t q = 0; q < nk; q++) {
@@ -215,6 +221,7 @@ static size_t ref_near(const occ_map_t *map, const occ_proj_image_t *im,
                 }
                 (*c)[n++] = occ_morton_encode(keys[q]);
             }
+            free(keys);
         }
     }
     return n;

@@ -1,0 +1,311 @@
+/* SPDX-License-Identifier: BSD-3-Clause */
+/*
+ * test_projective_fuzz.c - OCC_INSERT_PROJECTIVE on random synthetic frames, voxel for voxel
+ * against the brute-force oracle of the header's rule (tests/support/projective_ref.c). The
+ * real TUM frames (test_projective.c) come from a level camera on a ground robot; a drone's
+ * camera rolls, pitches and looks straight down. Here each case draws: any orientation (uniform
+ * on SO(3), or an exact quarter-turn one: axis-aligned planes and corners), a position near
+ * the map's centre (keys crossing 2^(D-1)) or on a voxel face, small images of odd shapes,
+ * off-centre and out-of-image principal points, narrow to very wide fields of view, U16 or F32
+ * depths (NaN, +-Inf, 0, -0, negative, absurdly far, beyond max range, inside min range),
+ * every noise margin, maps of 16 or of 3 to 8 levels, and a misaligned scratch. Two or three
+ * frames go into one map (the second onto the first's voxels). A refused call (scratch short)
+ * must leave the map as it was. Random seed: printed, overridable with OCC_SEED. Also linked
+ * against the release library (test_projective_fuzz_rel: the vectorised lanes and their AVX2
+ * clones).
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "occmap/occmap.h"
+#include "support/iotest.h"
+#include "support/leak_check.h"
+#include "support/projective_ref.h"
+#include "support/seeded_rng.h"
+
+#define CASES 240u
+#define ARENA_BYTES ((size_t)24 << 20)
+#define MAX_W 48u
+#define MAX_H 40u
+/* The largest frame's scratch with room to spare (a near ray at every pixel, each up to ~60
+ * voxels at the widest field of view drawn), plus 15 bytes of misalignment. */
+#define SCRATCH_BYTES (OCC_PROJ_SCRATCH_BYTES(MAX_W, MAX_H, 262144u) + 16u)
+
+static uint8_t *arena_a, *arena_b, *scratch;
+static occ_map_t map_a, map_b;
+static float pix_f32[MAX_H][MAX_W * 2u]; /* room for a pixel stride of 8 bytes */
+static uint16_t pix_u16[MAX_H][MAX_W];
+
+static int setup(void **state)
+{
+    (void)state;
+    rng_seed("test_projective_fuzz");
+    arena_a = malloc(ARENA_BYTES);
+    arena_b = malloc(ARENA_BYTES);
+    scratch = malloc(SCRATCH_BYTES);
+    return arena_a != NULL && arena_b != NULL && scratch != NULL ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    free(arena_a);
+    free(arena_b);
+    free(scratch);
+    return 0;
+}
+
+static float uniform(const float lo, const float hi)
+{
+    return lo + (hi - lo) * (float)(rng_next() >> 40) / (float)(1u << 24);
+}
+
+static uint32_t below(const uint32_t n)
+{
+    return (uint32_t)(rng_next() % n);
+}
+
+/* ---- the camera ---------------------------------------------------------------------------- */
+
+/* A rotation: uniform on SO(3) (a normalised Gaussian-free quaternion by rejection), or one of
+ * the 24 exact quarter-turn rotations (signed permutations with determinant +1). */
+static void random_rotation(float r[3][3])
+{
+    if (below(4u) == 0u) {
+        static const unsigned perm[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1},
+                                            {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+        const unsigned p = below(6u);
+        float s[3] = {below(2u) ? 1.0f : -1.0f, below(2u) ? 1.0f : -1.0f, 1.0f};
+        s[2] = (p < 3u ? 1.0f : -1.0f) * s[0] * s[1]; /* odd permutations flip: det = +1 */
+        memset(r, 0, 9u * sizeof(float));
+        for (unsigned a = 0; a < 3u; a++) {
+            r[perm[p][a]][a] = s[a];
+        }
+        return;
+    }
+    double q[4], n2;
+    do {
+        for (unsigned i = 0; i < 4u; i++) {
+            q[i] = (double)uniform(-1.0f, 1.0f);
+        }
+        n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    } while (n2 > 1.0 || n2 < 1e-3);
+    const double n = sqrt(n2), w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+    const double m[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+                            {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+                            {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
+    for (unsigned a = 0; a < 3u; a++) {
+        for (unsigned b = 0; b < 3u; b++) {
+            r[a][b] = (float)m[a][b];
+        }
+    }
+}
+
+/* A coordinate near the map's centre: random, or on a voxel face (a multiple of res). */
+static float random_coord(const float res, const float span)
+{
+    const float c = uniform(-span, span);
+    return below(3u) == 0u ? res * floorf(c / res) : c;
+}
+
+static occ_proj_camera_t random_camera(const uint32_t w, const uint32_t h, const float res,
+                                       const float half_map)
+{
+    occ_proj_camera_t k;
+    memset(&k, 0, sizeof k);
+    /* fields of view from ~20 to ~150 degrees across the image */
+    k.fx = (float)w * uniform(0.15f, 2.5f) + 0.5f;
+    k.fy = below(2u) ? k.fx : (float)h * uniform(0.15f, 2.5f) + 0.5f;
+    const float wf = (float)w, hf = (float)h;
+    k.cx = below(5u) == 0u ? uniform(-0.5f * wf, 1.5f * wf) : 0.5f * (wf - 1.0f) + uniform(-2, 2);
+    k.cy = below(5u) == 0u ? uniform(-0.5f * hf, 1.5f * hf) : 0.5f * (hf - 1.0f) + uniform(-2, 2);
+    random_rotation(k.r);
+    const float span = half_map < 1.0f ? 0.8f * half_map : 1.0f;
+    k.t = (occ_vec3_t){random_coord(res, span), random_coord(res, span), random_coord(res, span)};
+    /* The oracle visits the cube of half-edge max range: at most ~32 voxels each way. */
+    k.max_range_m = res * uniform(4.0f, 32.0f);
+    k.min_range_m = below(3u) == 0u ? 0.0f : uniform(0.0f, 0.3f * k.max_range_m);
+    k.noise_rel = below(4u) == 0u ? 0.0f : (below(4u) == 0u ? 0.5f : uniform(0.0f, 0.5f));
+    return k;
+}
+
+/* ---- the image ----------------------------------------------------------------------------- */
+
+/* A depth: mostly a blocky surface (planes in pixel blocks) with noise, sometimes a special. */
+static float random_depth(const occ_proj_camera_t *k, const uint32_t i, const uint32_t j,
+                          const uint32_t bw, const uint32_t bh, const uint64_t scene)
+{
+    uint64_t z = scene ^ ((uint64_t)(i / bw) << 32) ^ (j / bh);
+    z = (z ^ (z >> 29)) * 0xBF58476D1CE4E5B9ull;
+    z ^= z >> 32;
+    const float base = k->max_range_m * (0.1f + 1.2f * (float)(z % 1000u) / 1000.0f);
+    const float d = base * (1.0f + uniform(-0.02f, 0.02f)) + 0.01f * (float)(i % bw);
+    switch (below(40u)) {
+    case 0: return NAN;
+    case 1: return INFINITY;
+    case 2: return -INFINITY;
+    case 3: return 0.0f;
+    case 4: return -0.0f;
+    case 5: return -d;
+    case 6: return 3000.0f * k->max_range_m; /* absurdly far: no return within range */
+    case 7: return 0.5f * k->min_range_m;    /* blind zone */
+    default: return (z >> 40) % 9u == 0u ? NAN : d; /* whole blocks without a reading */
+    }
+}
+
+/* Fill the image (U16 or F32, pixel stride 4 or 8 for F32) and describe it. */
+static occ_proj_image_t random_image(const occ_proj_camera_t *k, const uint32_t w,
+                                     const uint32_t h)
+{
+    const uint32_t bw = 1u + below(12u), bh = 1u + below(12u);
+    const uint64_t scene = rng_next();
+    const bool u16 = below(2u) == 0u;
+    const float scale = below(2u) ? 1.0f / 5000.0f : 1.0f / 1000.0f;
+    const size_t pstride = u16 ? 2u : (below(3u) == 0u ? 8u : 4u);
+    for (uint32_t j = 0; j < h; j++) {
+        for (uint32_t i = 0; i < w; i++) {
+            const float d = random_depth(k, i, j, bw, bh, scene);
+            if (u16) {
+                const float raw = d / scale;
+                pix_u16[j][i] = raw > 0.0f && raw < 65535.0f ? (uint16_t)raw : 0u;
+            } else {
+                pix_f32[j][i * (pstride / 4u)] = d;
+            }
+        }
+    }
+    const occ_proj_image_t im = {u16 ? (const void *)pix_u16 : (const void *)pix_f32,
+                                 u16 ? OCC_PROJ_U16 : OCC_PROJ_F32,
+                                 w,
+                                 h,
+                                 u16 ? sizeof pix_u16[0] : sizeof pix_f32[0],
+                                 pstride,
+                                 scale};
+    return im;
+}
+
+/* ---- one case ------------------------------------------------------------------------------ */
+
+/* The map's shape: 16 levels at 0.05 to 0.25 m, or 3 to 8 levels spanning 4 m. */
+static occ_map_config_t random_map(float *half_map)
+{
+    occ_map_config_t c = iotest_octomap_cfg();
+    if (below(4u) == 0u) {
+        c.depth_levels = (uint8_t)(3u + below(6u));
+        c.resolution_m = 4.0f / (float)(1u << c.depth_levels);
+    } else {
+        static const float res[5] = {0.05f, 0.08f, 0.1f, 0.2f, 0.25f};
+        c.resolution_m = res[below(5u)];
+    }
+    *half_map = 0.5f * c.resolution_m * (float)(1u << c.depth_levels);
+    return c;
+}
+
+/* The insert through the header's default scratch, OCC_PROJ_SCRATCH_BYTES(w, h,
+ * OCC_PROJ_OUT_DEFAULT(w, h)) at a random misalignment, and, when a frame needs more (a wide
+ * field of view: a near ray at every pixel, each several voxels long), the refusal leaves the
+ * map as it was and all of the test's scratch is enough. First, when drawn, a scratch short of
+ * the fixed part: refused, map unchanged. */
+static occ_err_t insert(const occ_proj_image_t *im, const occ_proj_camera_t *k,
+                        occ_proj_result_t *r, size_t *retries)
+{
+    unsigned char *const s = scratch + below(16u);
+    const uint64_t before = iotest_map_digest(&map_a);
+    if (below(4u) == 0u) {
+        assert_int_equal(occ_map_insert_projective(&map_a, im, k, s, below(4096u), r),
+                         OCC_ERR_SCRATCH);
+        assert_true(iotest_map_digest(&map_a) == before);
+    }
+    const size_t dflt = OCC_PROJ_SCRATCH_BYTES(im->width, im->height,
+                                               OCC_PROJ_OUT_DEFAULT(im->width, im->height));
+    const occ_err_t e = occ_map_insert_projective(&map_a, im, k, s, dflt, r);
+    if (e != OCC_ERR_SCRATCH) {
+        return e;
+    }
+    assert_true(iotest_map_digest(&map_a) == before);
+    (*retries)++;
+    return occ_map_insert_projective(&map_a, im, k, s, SCRATCH_BYTES - 16u, r);
+}
+
+static void print_case(const occ_proj_image_t *im, const occ_proj_camera_t *k)
+{
+    printf("case: %ux%u %s stride %zu, f %.4f %.4f c %.4f %.4f, t %.5f %.5f %.5f, "
+           "range %.4f..%.4f, noise %.4f, res %.3f, depth %u\n",
+           im->width, im->height, im->format == OCC_PROJ_U16 ? "u16" : "f32",
+           im->pixel_stride_bytes, (double)k->fx, (double)k->fy, (double)k->cx, (double)k->cy,
+           (double)k->t.x, (double)k->t.y, (double)k->t.z, (double)k->min_range_m,
+           (double)k->max_range_m, (double)k->noise_rel, (double)map_a.cfg.resolution_m,
+           (unsigned)map_a.cfg.depth_levels);
+}
+
+/* One frame into map_a by the walk and into map_b by the oracle: equal maps after it. */
+static void frame_equals_oracle(const occ_proj_image_t *im, const occ_proj_camera_t *k,
+                                size_t *updates, size_t *retries)
+{
+    occ_proj_result_t r;
+    const occ_err_t e = insert(im, k, &r, retries);
+    if (e == OCC_ERR_RANGE) {
+        return; /* the camera off a small map: both maps stay as they are */
+    }
+    if (e != OCC_OK) {
+        print_case(im, k);
+    }
+    assert_int_equal(e, OCC_OK);
+    occ_code_t *codes = NULL;
+    size_t hits = 0;
+    const size_t n = projref_codes(&map_b, im, k, &codes, &hits);
+    size_t changed = 0;
+    assert_int_equal(occ_map_observe_codes(&map_b, codes, n, &changed), OCC_OK);
+    free(codes);
+    assert_int_equal(r.insert.voxels_occupied, hits);
+    assert_true(r.insert.voxels_updated <= n);
+    if (iotest_map_digest(&map_a) != iotest_map_digest(&map_b)) {
+        print_case(im, k);
+        fail_msg("the walk's map differs from the oracle's");
+    }
+    assert_int_equal(occ_map_check(&map_a), OCC_OK);
+    *updates += n;
+}
+
+static void test_random_frames_equal_oracle(void **state)
+{
+    (void)state;
+    size_t updates = 0, frames = 0, retries = 0;
+    for (unsigned c = 0; c < CASES; c++) {
+        float half_map = 0.0f;
+        const occ_map_config_t cfg = random_map(&half_map);
+        assert_int_equal(occ_map_init(&map_a, &cfg, arena_a, ARENA_BYTES), OCC_OK);
+        assert_int_equal(occ_map_init(&map_b, &cfg, arena_b, ARENA_BYTES), OCC_OK);
+        const uint32_t w = 1u + below(MAX_W), h = 1u + below(MAX_H);
+        const unsigned n = 2u + below(2u);
+        occ_proj_camera_t k = random_camera(w, h, cfg.resolution_m, half_map);
+        for (unsigned f = 0; f < n; f++) {
+            if (f > 0u && below(2u) == 0u) {
+                k = random_camera(w, h, cfg.resolution_m, half_map); /* else the same pose */
+            }
+            const occ_proj_image_t im = random_image(&k, w, h);
+            frame_equals_oracle(&im, &k, &updates, &retries);
+            frames++;
+        }
+        assert_int_equal(leak_check(&map_a), 0);
+        assert_int_equal(leak_check(&map_b), 0);
+    }
+    printf("%u cases, %zu frames (%zu needed more than the default scratch), %zu oracle "
+           "updates: equal\n", CASES, frames, retries, updates);
+    assert_true(updates > 0u);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_random_frames_equal_oracle),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
