@@ -371,7 +371,8 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * max_range_m) its length: 11 on the optical axis, 13 at a Kinect's corners, more in a very
  * wide field of view); the walk tests a node in O(1) (8 corner projections, at most 3 x 3 pyramid
  * cells or 2 x 2 windows) and descends only where its answer is mixed, down to level 2, whose
- * 64 voxels it decides at once: at most 8 D + 8 (undecided nodes) nodes, in the worst case (a
+ * 64 voxels it decides at once (a level-2 node in the frustum and within range gets no
+ * footprint: the rule at once): at most 8 D + 8 (undecided nodes) nodes, in the worst case (a
  * noisy surface filling the frustum) every voxel of the frustum within max range. Typical:
  * proportional to the surface's voxels, not pixels x ray length. Then one pass over the tree.
  * Stack: O(D), no recursion. */
