@@ -28,45 +28,30 @@
 #include <string.h>
 
 #include "occmap/occmap.h"
-#include "support/iotest.h"
-#include "support/leak_check.h"
+#include "support/depth_fixture.h"
 #include "support/projective_ref.h"
 #include "support/seeded_rng.h"
 
 #define CASES 240u
-#define ARENA_BYTES ((size_t)24 << 20)
 #define SMALL_W 48u /* most cases: images up to 48 x 40 */
 #define SMALL_H 40u
 #define MAX_W 160u  /* one case in eight: up to 160 x 120 (the pyramid's windows, deeper walks) */
 #define MAX_H 120u
-/* Enough for any frame drawn here, plus 15 bytes of misalignment: a near ray at every pixel
- * (fx, fy below 32), each of at most sqrt(3) 32 + 4 voxels (max range is at most 32 voxels),
- * twice while sorted, and the walk's output. */
+/* The fixture's scratch holds any frame drawn here, plus 15 bytes of misalignment: a near ray
+ * at every pixel (fx, fy below 32), each of at most sqrt(3) 32 + 4 voxels (max range is at
+ * most 32 voxels), twice while sorted, and the walk's output. */
 #define NEAR_SLOTS (2u * MAX_W * MAX_H * 60u)
-#define SCRATCH_BYTES (OCC_PROJ_SCRATCH_BYTES(MAX_W, MAX_H, NEAR_SLOTS + 262144u) + 16u)
+typedef char fixture_scratch_holds_any_frame
+    [OCC_PROJ_SCRATCH_BYTES(MAX_W, MAX_H, NEAR_SLOTS + 262144u) + 16u <= SCRATCH_BYTES ? 1 : -1];
 
-static uint8_t *arena_a, *arena_b, *scratch;
-static occ_map_t map_a, map_b;
 static float pix_f32[MAX_H][MAX_W * 2u]; /* room for a pixel stride of 8 bytes */
 static uint16_t pix_u16[MAX_H][MAX_W];
 
 static int setup(void **state)
 {
-    (void)state;
+    (void)init_maps; /* the fixture's: the maps here have random shapes (random_map) */
     rng_seed("test_projective_fuzz");
-    arena_a = malloc(ARENA_BYTES);
-    arena_b = malloc(ARENA_BYTES);
-    scratch = malloc(SCRATCH_BYTES);
-    return arena_a != NULL && arena_b != NULL && scratch != NULL ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    free(arena_a);
-    free(arena_b);
-    free(scratch);
-    return 0;
+    return depth_setup(state);
 }
 
 static float uniform(const float lo, const float hi)
@@ -205,13 +190,6 @@ static occ_proj_image_t random_image(const occ_proj_camera_t *k, const uint32_t 
 
 /* ---- a map that is not empty ---------------------------------------------------------------- */
 
-static int by_code(const void *a, const void *b)
-{
-    const occ_code_t x = *(const occ_code_t *)a & ~OCC_CODE_HIT_BIT;
-    const occ_code_t y = *(const occ_code_t *)b & ~OCC_CODE_HIT_BIT;
-    return x < y ? -1 : (x > y ? 1 : 0);
-}
-
 /* The same random content in both maps around the camera, before its frames: whole 8 x 8 x 8
  * blocks observed free or occupied 1 to 6 times (pruned nodes above the voxels, some at the
  * clamp) and single voxels, so that the walk's whole free nodes and bricks land on pruned
@@ -249,15 +227,7 @@ static void prepopulate(const occ_vec3_t t)
             }
             c[n++] = occ_morton_encode(k) | (below(2u) ? OCC_CODE_HIT_BIT : 0u);
         }
-        qsort(c, n, sizeof *c, by_code);
-        size_t u = 0;
-        for (size_t i = 0; i < n; i++) { /* unique codes; a hit wins */
-            if (u > 0u && by_code(&c[u - 1u], &c[i]) == 0) {
-                c[u - 1u] |= c[i] & OCC_CODE_HIT_BIT;
-            } else {
-                c[u++] = c[i];
-            }
-        }
+        const size_t u = projref_sort_unique(c, n);
         assert_int_equal(occ_map_observe_codes(&map_a, c, u, NULL), OCC_OK);
         assert_int_equal(occ_map_observe_codes(&map_b, c, u, NULL), OCC_OK);
     }
@@ -397,5 +367,5 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_random_frames_equal_oracle),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, setup, depth_teardown);
 }

@@ -263,8 +263,20 @@ size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
     }
     (void)box;
     n = ref_near(map, im, cam, &c, n, &cap);
+    const size_t u = projref_sort_unique(c, n);
+    size_t hits = 0;
+    for (size_t i = 0; i < u; i++) {
+        hits += (c[i] & OCC_CODE_HIT_BIT) != 0u ? 1u : 0u;
+    }
+    *n_hits = hits;
+    *codes = c;
+    return u;
+}
+
+size_t projref_sort_unique(occ_code_t *const c, const size_t n)
+{
     qsort(c, n, sizeof *c, by_code);
-    size_t u = 0, hits = 0;
+    size_t u = 0;
     for (size_t i = 0; i < n; i++) {
         if (u > 0u && by_code(&c[u - 1u], &c[i]) == 0) {
             c[u - 1u] |= c[i] & OCC_CODE_HIT_BIT;
@@ -272,10 +284,5 @@ size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
             c[u++] = c[i];
         }
     }
-    for (size_t i = 0; i < u; i++) {
-        hits += (c[i] & OCC_CODE_HIT_BIT) != 0u ? 1u : 0u;
-    }
-    *n_hits = hits;
-    *codes = c;
     return u;
 }

@@ -12,6 +12,10 @@
 size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
                      const occ_proj_camera_t *cam, occ_code_t **codes, size_t *n_hits);
 
+/* Sort codes by voxel (the hit bit aside) and collapse each voxel's to one (a hit wins), in
+ * place, as occ_map_observe_codes takes them. Returns the count. */
+size_t projref_sort_unique(occ_code_t *codes, size_t n);
+
 /* The end points of the frame's pixels with a reading within [min, max] range, as points in
  * the map frame (t + d r (a, b, 1): for OctoMap's insertPointCloud, not the rule's voxels) in a
  * malloc'd array. Returns the count. */
