@@ -2,8 +2,9 @@
 /* projective_near.c - the near field: within a few voxels of the camera a voxel is large against
  * the frustum's cross-section, so most voxels there have their centre outside the image though
  * the camera's rays cross them (OctoMap frees them). Exact rays (computeRayKeys) from the camera
- * along a sparse grid of pixels, each to OCC_PROJ_NEAR_VOXELS voxels of depth or the front of its
- * surface if nearer, free the voxels they cross (occ_integrate.h). */
+ * along a sparse grid of pixels, each to OCC_PROJ_NEAR_VOXELS voxels of depth, the front of its
+ * surface or max range along its ray, whichever is nearest, free the voxels they cross
+ * (occ_integrate.h). */
 #include <math.h>
 #include <string.h>
 
