@@ -218,9 +218,8 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
         /* around the camera plane: no footprint. Levels 1 and 2: the per-voxel rule decides
          * their 8 or 64 voxels at once (all free: the same whole node; none: nothing), and a
          * footprint and pyramid query first costs more than it saves: on the TUM frames 62 % of
-         * the level-2 nodes that pass the tests above came out mixed and went to the rule anyway
-         * (bench/ab_split, both halves built alike: without the query 0.951 and 0.966 of the
-         * time; same maps) */
+         * the level-2 nodes tested came out mixed and went to the rule anyway (bench/ab_split,
+         * both halves built alike: without the query 0.951 and 0.966 of the time; same maps) */
         return NODE_MIXED;
     }
     uv_t c;
