@@ -67,13 +67,7 @@ static occ_proj_camera_t camera_of(const occ_pose_t *pose, float fx, float fy, f
     k.fy = fy;
     k.cx = cx;
     k.cy = cy;
-    const occ_vec3_t axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (unsigned b = 0; b < 3u; b++) {
-        const occ_vec3_t col = occ_pose_rotate(pose, axes[b]);
-        k.r[0][b] = col.x;
-        k.r[1][b] = col.y;
-        k.r[2][b] = col.z;
-    }
+    projref_rotation_of(pose, k.r);
     k.t = pose->p;
     k.min_range_m = min_m;
     k.max_range_m = max_m;

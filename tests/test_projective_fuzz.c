@@ -66,8 +66,9 @@ static uint32_t below(const uint32_t n)
 
 /* ---- the camera ---------------------------------------------------------------------------- */
 
-/* A rotation: uniform on SO(3) (a normalised Gaussian-free quaternion by rejection), or one of
- * the 24 exact quarter-turn rotations (signed permutations with determinant +1). */
+/* A rotation: uniform on SO(3) (a point of the 4-ball, normalised to a unit quaternion by
+ * occ_quat_normalize, its columns as occ_map_insert_depth builds them), or one of the 24 exact
+ * quarter-turn rotations (signed permutations with determinant +1: exactly axis-aligned). */
 static void random_rotation(float r[3][3])
 {
     if (below(4u) == 0u) {
@@ -82,22 +83,15 @@ static void random_rotation(float r[3][3])
         }
         return;
     }
-    double q[4], n2;
+    occ_quat_t q;
+    float n2;
     do {
-        for (unsigned i = 0; i < 4u; i++) {
-            q[i] = (double)uniform(-1.0f, 1.0f);
-        }
-        n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
-    } while (n2 > 1.0 || n2 < 1e-3);
-    const double n = sqrt(n2), w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
-    const double m[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-                            {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-                            {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}};
-    for (unsigned a = 0; a < 3u; a++) {
-        for (unsigned b = 0; b < 3u; b++) {
-            r[a][b] = (float)m[a][b];
-        }
-    }
+        q = (occ_quat_t){uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)};
+        n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
+    } while (n2 > 1.0f || n2 < 1e-3f);
+    occ_pose_t pose = occ_pose_identity();
+    assert_int_equal(occ_quat_normalize(q, &pose.q), OCC_OK);
+    projref_rotation_of(&pose, r);
 }
 
 /* A coordinate near the map's centre: random, or on a voxel face (a multiple of res). */
@@ -188,6 +182,14 @@ static occ_proj_image_t random_image(const occ_proj_camera_t *k, const uint32_t 
     return im;
 }
 
+/* Key kt + off on one axis, clamped to [0, side - span] (span: the block's edge, 1 for a voxel). */
+static uint32_t key_near(const uint32_t kt, const int64_t off, const uint32_t side,
+                         const uint32_t span)
+{
+    const int64_t v = (int64_t)kt + off, hi = (int64_t)side - (int64_t)span;
+    return (uint32_t)(v < 0 ? 0 : (v > hi ? hi : v));
+}
+
 /* ---- a map that is not empty ---------------------------------------------------------------- */
 
 /* The same random content in both maps around the camera, before its frames: whole 8 x 8 x 8
@@ -209,11 +211,10 @@ static void prepopulate(const occ_vec3_t t)
         for (unsigned b = 0; b < 24u; b++) {
             const occ_code_t hit = below(3u) == 0u ? OCC_CODE_HIT_BIT : 0u;
             occ_key_t k0;
-            for (unsigned a = 0; a < 3u; a++) {
-                const int64_t v = ((int64_t)kt.k[a] + (int64_t)below(49u) - 24) & ~(int64_t)7;
-                k0.k[a] = (uint32_t)(v < 0 ? 0 : (v + 8 > (int64_t)side ? (int64_t)side - 8 : v));
+            for (unsigned a = 0; a < 3u; a++) { /* aligned to 8: maps have 3 levels or more */
+                k0.k[a] = key_near(kt.k[a], (int64_t)below(49u) - 24, side, 8u) & ~7u;
             }
-            for (uint32_t m = 0; m < 512u && side >= 8u; m++) {
+            for (uint32_t m = 0; m < 512u; m++) {
                 const occ_key_t k = {{k0.k[0] + (m & 7u), k0.k[1] + ((m >> 3) & 7u),
                                       k0.k[2] + (m >> 6)}};
                 c[n++] = occ_morton_encode(k) | hit;
@@ -222,8 +223,7 @@ static void prepopulate(const occ_vec3_t t)
         for (unsigned v = 0; v < 512u; v++) {
             occ_key_t k;
             for (unsigned a = 0; a < 3u; a++) {
-                const int64_t x = (int64_t)kt.k[a] + (int64_t)below(49u) - 24;
-                k.k[a] = (uint32_t)(x < 0 ? 0 : (x >= (int64_t)side ? (int64_t)side - 1 : x));
+                k.k[a] = key_near(kt.k[a], (int64_t)below(49u) - 24, side, 1u);
             }
             c[n++] = occ_morton_encode(k) | (below(2u) ? OCC_CODE_HIT_BIT : 0u);
         }
@@ -252,16 +252,15 @@ static occ_map_config_t random_map(float *half_map)
     return c;
 }
 
-/* The insert through the header's default scratch, OCC_PROJ_SCRATCH_BYTES(w, h,
+/* The insert (map_a's digest before it: `before`) through the header's default scratch, OCC_PROJ_SCRATCH_BYTES(w, h,
  * OCC_PROJ_OUT_DEFAULT(w, h)) at a random misalignment, and, when a frame needs more (a wide
  * field of view: a near ray at every pixel, each several voxels long), the refusal leaves the
  * map as it was and all of the test's scratch is enough. First, when drawn, a scratch short of
  * the fixed part: refused, map unchanged. */
 static occ_err_t insert(const occ_proj_image_t *im, const occ_proj_camera_t *k,
-                        occ_proj_result_t *r, size_t *retries)
+                        const uint64_t before, occ_proj_result_t *r, size_t *retries)
 {
     unsigned char *const s = scratch + below(16u);
-    const uint64_t before = iotest_map_digest(&map_a);
     if (below(4u) == 0u) {
         assert_int_equal(occ_map_insert_projective(&map_a, im, k, s, below(4096u), r),
                          OCC_ERR_SCRATCH);
@@ -295,7 +294,7 @@ static void frame_equals_oracle(const occ_proj_image_t *im, const occ_proj_camer
 {
     occ_proj_result_t r;
     const uint64_t before = iotest_map_digest(&map_a);
-    const occ_err_t e = insert(im, k, &r, retries);
+    const occ_err_t e = insert(im, k, before, &r, retries);
     if (e == OCC_ERR_RANGE || e == OCC_ERR_NOMEM) {
         /* the camera off a small map, or map_a's small pool full: map_a as it was, and the
          * oracle's map stays as it is too */

@@ -273,6 +273,17 @@ size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
     return u;
 }
 
+void projref_rotation_of(const occ_pose_t *const pose, float r[3][3])
+{
+    const occ_vec3_t axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (unsigned b = 0; b < 3u; b++) {
+        const occ_vec3_t col = occ_pose_rotate(pose, axes[b]);
+        r[0][b] = col.x;
+        r[1][b] = col.y;
+        r[2][b] = col.z;
+    }
+}
+
 size_t projref_sort_unique(occ_code_t *const c, const size_t n)
 {
     qsort(c, n, sizeof *c, by_code);

@@ -6,11 +6,16 @@
 #define OCC_PROJECTIVE_REF_H_INCLUDED
 
 #include "occmap/occmap.h"
+#include "occmap/occ_pose.h"
 
 /* The frame's voxel updates, sorted by code, unique, hit bit set for hits (hits win), in a
  * malloc'd array (*codes; the caller frees it). Returns the count. *n_hits: hit voxels. */
 size_t projref_codes(const occ_map_t *map, const occ_proj_image_t *im,
                      const occ_proj_camera_t *cam, occ_code_t **codes, size_t *n_hits);
+
+/* The camera's rotation columns from a pose, as occ_map_insert_depth builds them
+ * (occ_pose_rotate of the camera's unit axes): map = r * camera + t. */
+void projref_rotation_of(const occ_pose_t *pose, float r[3][3]);
 
 /* Sort codes by voxel (the hit bit aside) and collapse each voxel's to one (a hit wins), in
  * place, as occ_map_observe_codes takes them. Returns the count. */
