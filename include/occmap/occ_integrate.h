@@ -345,21 +345,23 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  * OCC_ERR_NOMEM when a tight pool would have sufficed); any error: the map is unchanged.
  *
  * Scratch (caller's, any alignment): a fixed part (OCC_PROJ_FIXED_BYTES: alignment, an 8 KiB
- * repeat filter for end points, the radix sort's histograms, the call's context, the walk's
+ * cache of the end points' level-2 nodes, the radix sort's histograms, the call's context, the walk's
  * per-level constants and stack and the 64-voxel rule's lane arrays (6 KiB, kept off the
  * stack)), 4 bytes per pixel (the
  * depths), 8 bytes per pyramid cell (min and max, levels 1.. of halved sides, and from level 2
  * on per cell the min and max over the 8 x 8 cells from it: at most OCC_PROJ_CELLS(w, h) =
  * 5 w h / 12 + 3 (w + h) / 2 + 40 cells), 52 bytes per image column (the pixel
  * pass's per-column tables and row buffers, OCC_PROJ_COLUMN_BYTES) and the output, in 8-byte
- * slots: the end points' codes after the repeat filter (twice while they are sorted), the near
+ * slots: the end points as records of 2 slots, a level-2 node's code and the bits of its voxels
+ * that hold one (one record per node, more when the cache dropped it between two of its end
+ * points: ~1,300 records for a pioneer frame; twice while they are sorted), the near
  * rays' voxels (twice while sorted; ~5,000 for a 640 x 480 Kinect frame), then the updates:
  * 4 per level-2 node (4 x 4 x 4 voxels) holding a free voxel or an end point (its voxels by
  * the miss and by the hit) and 1 per whole free node above level 2. OCC_PROJ_SCRATCH_BYTES(w,
  * h, n_out) sizes it for n_out slots; OCC_PROJ_OUT_DEFAULT(w, h) = w h / 2 + 16384 slots covers
  * the TUM frames in `make bench` (bench/projective.cpp prints what they used) and an 8x8 ToF
  * array at 0.05 m to 3 m (tests/test_projective.c). For 640 x 480 the whole formula is 12.1
- * bytes per pixel, of which a frame of the pioneer sequence used at most 9.0. A small image
+ * bytes per pixel, of which a frame of the pioneer sequence used at most 8.5. A small image
  * with a very wide field of view (fx or fy below 32: a near ray at every pixel) can need more
  * (tests/test_projective_fuzz.c draws such cameras). A frame that needs more slots is refused
  * with OCC_ERR_SCRATCH (map unchanged): pass more.

@@ -65,6 +65,9 @@ occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, size_t n, uint32_t 
  * the key array holding the result; its values are in v if it is k, else in tv. */
 uint64_t *occi_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_t *tv, size_t n,
                                  uint32_t *hist);
+/* The same sort of n records r[2 i] (key, bits 0..62), r[2 i + 1] (carried along), using
+ * tmp[2 n]. Returns r or tmp: where the result is. */
+occ_code_t *occi_keyset_sort_records(occ_code_t *r, occ_code_t *tmp, size_t n, uint32_t *hist);
 /* Collapse runs of equal codes (bits 0..62) of a sorted array to one entry whose hit bit is the
  * OR of the run's. Returns the new length. */
 size_t occi_keyset_unique(occ_code_t *a, size_t n);

@@ -11,13 +11,14 @@
 #define CODE_BITS ((occ_code_t)0x7FFFFFFFFFFFFFFFull)
 #define DIGIT_MASK ((occ_code_t)(OCC_KS_RADIX - 1u))
 
-/* The bits that differ between codes (the hit flag aside). */
-static occ_code_t code_diff(const occ_code_t *const a, const size_t n)
+/* The bits that differ between codes a[0], a[stride], ... (n of them; the hit flag aside). */
+static OCC_ALWAYS_INLINE occ_code_t code_diff(const occ_code_t *const a, const size_t n,
+                                              const size_t stride)
 {
     const occ_code_t first = a[0] & CODE_BITS;
     occ_code_t diff = 0;
     for (size_t i = 0; i < n; i++) {
-        diff |= (a[i] & CODE_BITS) ^ first;
+        diff |= (a[i * stride] & CODE_BITS) ^ first;
     }
     return diff;
 }
@@ -26,9 +27,10 @@ static occ_code_t code_diff(const occ_code_t *const a, const size_t n)
  * returns the bits that differ between codes. A frame's or a scan's codes often differ in
  * their low bits only (not where the keys cross 2^(D-1) on an axis): counting every pass there
  * cost as much as the sort. */
-static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t *const hist)
+static OCC_ALWAYS_INLINE occ_code_t histograms(const occ_code_t *const a, const size_t n,
+                                               const size_t stride, uint32_t *const hist)
 {
-    const occ_code_t diff = code_diff(a, n);
+    const occ_code_t diff = code_diff(a, n, stride);
     unsigned live = 0, top = 0; /* bit p: pass p sorts; passes 0 .. top - 1 hold them all */
     for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
         if (((diff >> (p * OCC_INSERT_RADIX_BITS)) & DIGIT_MASK) != 0u) {
@@ -44,7 +46,7 @@ static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t
      * 64-ray scan 2 %, where every pass below top sorts. */
     if (live + 1u == 1u << top) { /* passes 0 .. top - 1 all sort: no test per pass */
         for (size_t i = 0; i < n; i++) {
-            occ_code_t v = a[i] & CODE_BITS;
+            occ_code_t v = a[i * stride] & CODE_BITS;
             for (unsigned p = 0; p < top; p++) {
                 hist[p * OCC_KS_RADIX + (unsigned)(v & DIGIT_MASK)]++;
                 v >>= OCC_INSERT_RADIX_BITS;
@@ -53,7 +55,7 @@ static occ_code_t histograms(const occ_code_t *const a, const size_t n, uint32_t
         return diff;
     }
     for (size_t i = 0; i < n; i++) {
-        occ_code_t v = a[i] & CODE_BITS;
+        occ_code_t v = a[i * stride] & CODE_BITS;
         for (unsigned p = 0; p < top; p++) {
             if (((live >> p) & 1u) != 0u) {
                 hist[p * OCC_KS_RADIX + (unsigned)(v & DIGIT_MASK)]++;
@@ -86,7 +88,7 @@ occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uin
     if (n < 2u) {
         return a;
     }
-    const occ_code_t diff = histograms(a, n, hist);
+    const occ_code_t diff = histograms(a, n, 1u, hist);
     for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
         uint32_t *const h = pass_offsets(hist, p, diff);
         if (h == NULL) {
@@ -103,6 +105,33 @@ occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uin
         tmp = t;
     }
     return a;
+}
+
+occ_code_t *occi_keyset_sort_records(occ_code_t *r, occ_code_t *tmp, const size_t n,
+                                     uint32_t *const hist)
+{
+    if (n < 2u) {
+        return r;
+    }
+    const occ_code_t diff = histograms(r, n, 2u, hist);
+    for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
+        uint32_t *const h = pass_offsets(hist, p, diff);
+        if (h == NULL) {
+            continue;
+        }
+        const unsigned shift = p * OCC_INSERT_RADIX_BITS;
+        for (size_t i = 0; i < n; i++) {
+            const occ_code_t c = r[2u * i];
+            const unsigned b = (unsigned)(((c & CODE_BITS) >> shift) & DIGIT_MASK);
+            const size_t at = 2u * (size_t)h[b]++;
+            tmp[at] = c;
+            tmp[at + 1u] = r[2u * i + 1u];
+        }
+        occ_code_t *const t = r;
+        r = tmp;
+        tmp = t;
+    }
+    return r;
 }
 
 size_t occi_keyset_unique(occ_code_t *const a, const size_t n)
@@ -196,7 +225,7 @@ uint64_t *occi_keyset_sort_pairs(uint64_t *k, uint32_t *v, uint64_t *tk, uint32_
     if (n < 2u) {
         return k;
     }
-    const occ_code_t diff = histograms(k, n, hist);
+    const occ_code_t diff = histograms(k, n, 1u, hist);
     for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
         uint32_t *const h = pass_offsets(hist, p, diff);
         if (h == NULL) {

@@ -8,8 +8,8 @@
 #include "projective_internal.h"
 #include "../core/tree_internal.h"
 
-/* The header's fixed term names the filter's 8 KiB. */
-typedef char proj_filter_matches_header[OCC_PROJ_FILTER_N * 8u == 8192u ? 1 : -1];
+/* The header's fixed term names the brick cache's 8 KiB. */
+typedef char proj_cache_matches_header[OCC_PROJ_CACHE_N * 16u == 8192u ? 1 : -1];
 
 static bool finite_pos(const float v)
 {
@@ -63,7 +63,7 @@ typedef char occ_proj_levels_fit[sizeof(occ_proj_levels_t) <= OCC_PROJ_LEVELS_BY
 /* And the call's context (occ_proj_t) in OCC_PROJ_CTX_BYTES, a multiple of 8. */
 typedef char occ_proj_ctx_fit[sizeof(occ_proj_t) <= OCC_PROJ_CTX_BYTES && OCC_PROJ_CTX_BYTES % 8u == 0u ? 1 : -1];
 
-/* Carve the scratch: the filter and the sort's histograms (8-byte aligned), the depths and
+/* Carve the scratch: the brick cache and the sort's histograms (8-byte aligned), the depths and
  * the pyramid (floats), the pixel pass's tables (16-byte aligned), then the output (8-byte
  * codes). false when it cannot hold all that and one output slot. */
 static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
@@ -73,7 +73,7 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
     }
     const uintptr_t a = (uintptr_t)scratch;
     const size_t skip = (size_t)((16u - (a & 15u)) & 15u);
-    const size_t fixed = OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u + OCC_PROJ_LEVELS_BYTES +
+    const size_t fixed = OCC_PROJ_CACHE_N * 16u + OCC_KS_HIST_WORDS * 4u + OCC_PROJ_LEVELS_BYTES +
                          OCC_PROJ_BULK_BYTES;
     const size_t px = (size_t)x->im->width * x->im->height;
     /* level 0 plus 4 floats: the row loop writes up to 3 past a row (the next row's, later
@@ -85,9 +85,10 @@ static bool carve(occ_proj_t *x, void *scratch, const size_t bytes, float **mem)
         return false;
     }
     unsigned char *const base = (unsigned char *)scratch + skip;
-    x->filter = (occ_code_t *)(void *)base;
-    x->hist = (uint32_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u);
-    x->lv = (occ_proj_levels_t *)(void *)(base + OCC_PROJ_FILTER_N * 8u + OCC_KS_HIST_WORDS * 4u);
+    x->cache_code = (occ_code_t *)(void *)base;
+    x->cache_bits = (uint64_t *)(void *)(base + OCC_PROJ_CACHE_N * 8u);
+    x->hist = (uint32_t *)(void *)(base + OCC_PROJ_CACHE_N * 16u);
+    x->lv = (occ_proj_levels_t *)(void *)(base + OCC_PROJ_CACHE_N * 16u + OCC_KS_HIST_WORDS * 4u);
     x->bulk = (occ_proj_bulk_t *)(void *)((unsigned char *)x->lv + OCC_PROJ_LEVELS_BYTES);
     x->d0 = (float *)(void *)(base + fixed);
     *mem = x->d0 + px + 4u;
@@ -116,7 +117,7 @@ static occ_err_t apply(occ_proj_t *x)
     }
     occ_insert_result_t *const r = &x->r->insert;
     r->voxels_free = x->nv;
-    r->voxels_updated = r->voxels_free + x->nh;
+    r->voxels_updated = r->voxels_free + x->nhv;
     r->voxels_changed = fo.changed;
     r->coarse_updated = e == OCC_OK ? x->nn : 0u;
     return e;
@@ -126,7 +127,7 @@ static occ_err_t apply(occ_proj_t *x)
 static void count_output(occ_proj_t *x)
 {
     occ_insert_result_t *const r = &x->r->insert;
-    r->voxels_occupied = x->nh;
+    r->voxels_occupied = x->nhv;
     r->voxel_visits = x->r->nodes_tested;
     r->rays_clipped = x->r->pixels_beyond_max;
     r->points_integrated = x->r->pixels - x->r->pixels_no_reading - x->r->pixels_too_close -

@@ -37,8 +37,11 @@
 #define OCC_PROJ_WIN_LEVEL 2u
 #define OCC_PROJ_WIN_SHIFT 3u /* projective_pyramid.c's column steps are written out for 3 */
 #define OCC_PROJ_WIN_CELLS (1u << OCC_PROJ_WIN_SHIFT)
-/* Entries of the end points' repeat filter (direct mapped, 8 bytes each). */
-#define OCC_PROJ_FILTER_N 1024u
+/* Entries of the end points' brick cache (a level-2 node's code and its end points' bits, 16
+ * bytes each), two ways per set: on the pioneer frames 1,255 records per frame for 1,121
+ * nodes; direct mapped, two nodes of a row that share a slot evict each other on every row:
+ * 4,089 records. */
+#define OCC_PROJ_CACHE_N 512u
 /* An end point farther than this from the camera (in voxels: 2^22) is outside every map (keys
  * have at most 21 bits, and one axis differs by more than 2^22 / sqrt(3) > 2^21); below it the
  * key offsets from the camera's voxel convert to int32 without overflow. */
@@ -113,18 +116,22 @@ typedef struct {
     float tabs;             /* |t.x| + |t.y| + |t.z| */
     float wf, hf;           /* image width and height as floats (exact) */
     float peps0;            /* 1e-5 (fx + fy + |cx| + |cy| + w + h) */
-    occ_code_t *filter;     /* OCC_PROJ_FILTER_N recent end-point codes */
+    occ_code_t *cache_code; /* the brick cache: OCC_PROJ_CACHE_N level-2 nodes' codes */
+    uint64_t *cache_bits;   /* and their end points' bits (0: empty) */
     uint32_t *hist;         /* the radix sort's histograms */
-    /* The output: sorted hit codes (nh), the near field's voxels (nr), then the walk's stream
-     * (ns slots, tree_internal.h's occi_frame_t: bricks and whole nodes in code order), the
-     * brick being gathered in bcode / bmiss / bhit / bwhole until the walk moves past it. nv:
-     * free voxels decided one by one; nn: whole free nodes (the call's counters). */
+    /* The output: the end points as records of two slots (a level-2 node's code, the bits of
+     * its voxels holding one), sorted and one per node (nh slots; nhv end points), the near
+     * field's voxels (nr), then the walk's stream (ns slots, tree_internal.h's occi_frame_t:
+     * bricks and whole nodes in code order), the brick being gathered in bcode / bmiss / bhit
+     * / bwhole until the walk moves past it. nv: free voxels decided one by one; nn: whole free
+     * nodes (the call's counters). The pixel pass counts records in nh. */
     occ_code_t *out;
-    size_t cap, nh, nv, nn, ns, hwm;
+    size_t cap, nh, nhv, nv, nn, ns, hwm;
     occ_code_t bcode;
     uint64_t bmiss, bhit, bwhole;
     bool bopen;
-    size_t hit_cur;         /* the walk's cursor over the sorted hits */
+    size_t hit_cur;         /* the walk's cursor over the hit records (a slot: even) */
+    uint64_t hit_rest;      /* the bits of the record at hit_cur not yet taken */
     /* The near field's free voxels (projective_near.c): sorted codes after the hits, merged
      * into the walk's output in code order by its cursor. */
     const occ_code_t *near;
@@ -149,8 +156,9 @@ size_t occi_proj_pyramid_bytes(uint32_t w, uint32_t h);
 size_t occi_proj_pixels_bytes(uint32_t w);
 /* Lay them out from `mem` (16-byte aligned, occi_proj_pixels_bytes(w) bytes). */
 void occi_proj_pixels_carve(occ_proj_t *x, unsigned char *mem);
-/* The pixel pass: level 0 (x->d0), the counters, and the end points' codes, filtered, in
- * out[0..nh) (unsorted); false when the output cannot hold them and the sort's temporary. */
+/* The pixel pass: level 0 (x->d0), the counters, and the end points as nh records in
+ * out[0..2 nh) (unsorted, a node's in several at times); false when the output cannot hold
+ * them and the sort's temporary. */
 bool occi_proj_pixels(occ_proj_t *x);
 /* Level 0's single-pixel gaps closed for the free test (projective_fill.c), in place, with
  * occi_proj_fill_bytes(w) bytes of rows at `mem` (4-byte aligned). */
@@ -167,7 +175,8 @@ void occi_proj_build(occ_proj_t *x, float *mem);
 void occi_proj_range(const occ_proj_t *x, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1,
                      float *mn, float *mx);
 
-/* Sort and collapse the end points' codes in out[0..nh) (hit bit set). */
+/* Sort the end points' records by node and merge a node's into one: nh becomes their slots,
+ * nhv the end points. */
 void occi_proj_hits_sort(occ_proj_t *x);
 
 /* The near field (projective_near.c): rays from the camera along every step-th pixel

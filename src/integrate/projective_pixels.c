@@ -1,9 +1,11 @@
 /* SPDX-License-Identifier: BSD-3-Clause */
 /* projective_pixels.c - one pass over the image, a row at a time: each pixel's depth (level 0
  * of the pyramid), its counters, and its end point's voxel. A voxel repeated from the left or
- * the upper neighbour is dropped at once, the rest go through a small repeat filter to the
- * output as hit codes (sorted and collapsed afterwards). The row loops are branch-free so that
- * a host compiler vectorises them; the arithmetic is the header's, lane for lane. */
+ * the upper neighbour is dropped at once, the rest are bits of their level-2 node's entry in
+ * a small cache, whose entries go to the output as records (a node's code, its voxels' bits;
+ * sorted and merged afterwards: a pioneer frame's 31,000 new-voxel pixels are ~1,300 records
+ * where they were 17,700 codes to sort). The row loops are branch-free so that a host compiler
+ * vectorises them; the arithmetic is the header's, lane for lane. */
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -244,42 +246,66 @@ static void flag_new(occ_proj_t *const x)
                x->px.kp[1] - 1, x->px.kp[2] - 1, x->px.nw);
 }
 
-/* Slot of a code in the repeat filter. */
-static size_t filter_slot(const occ_code_t c)
-{
-    return (size_t)((c ^ (c >> 17) ^ (c >> 31)) & (OCC_PROJ_FILTER_N - 1u));
-}
-
-/* The hit code of column i's end point (its key is on the map: 21 bits per axis at most).
- * Inlined into both loops of emit_row (GCC called it: 0.979 and 0.981 of the frame's time
- * inlined, bench/ab_split with both halves built alike, 21 and 31 rounds). */
+/* The voxel code of column i's end point (its key is on the map: 21 bits per axis at most).
+ * Inlined into the row's loop (GCC called it: 0.979 and 0.981 of the frame's time inlined,
+ * bench/ab_split with both halves built alike, 21 and 31 rounds). */
 static OCC_ALWAYS_INLINE occ_code_t code_at(const occ_proj_t *const x, const uint32_t i)
 {
     const uint32_t k[3] = {(uint32_t)(x->kcam[0] + x->px.kc[0][i]),
                            (uint32_t)(x->kcam[1] + x->px.kc[1][i]),
                            (uint32_t)(x->kcam[2] + x->px.kc[2][i])};
     const occ_code_t c = occi_morton_spread21(k[0]) | (occi_morton_spread21(k[1]) << 1) |
-                         (occi_morton_spread21(k[2]) << 2) |
-                         OCC_CODE_HIT_BIT;
+                         (occi_morton_spread21(k[2]) << 2);
     const occ_key_t key = {{k[0], k[1], k[2]}}; /* the check's only (tests) */
-    OCC_ASSERT(c == (occ_morton_encode(key) | OCC_CODE_HIT_BIT));
+    OCC_ASSERT(c == occ_morton_encode(key));
     (void)key;
     return c;
 }
 
-/* One end point's code to the output (unless the repeat filter has it); false when the output
- * cannot hold it and the sort's temporary. */
-static bool emit(occ_proj_t *const x, const occ_code_t code, size_t *const n)
+/* Set of a level-2 node's code in the brick cache (its two ways: slots 2 s and 2 s + 1). */
+static size_t cache_set(const occ_code_t brick)
 {
-    const size_t s = filter_slot(code);
-    if (x->filter[s] == code) {
-        return true;
-    }
-    x->filter[s] = code;
-    if (2u * (*n + 1u) > x->cap) {
+    const occ_code_t c = brick >> 6;
+    return (size_t)((c ^ (c >> 8) ^ (c >> 17) ^ (c >> 31)) & (OCC_PROJ_CACHE_N / 2u - 1u));
+}
+
+/* One record (a level-2 node's code, its end points' bits) to the output; false when the
+ * output cannot hold it and the sort's temporary. */
+static bool put_record(occ_proj_t *const x, const occ_code_t brick, const uint64_t bits)
+{
+    if (4u * (x->nh + 1u) > x->cap) {
         return false;
     }
-    x->out[(*n)++] = code;
+    x->out[2u * x->nh] = brick;
+    x->out[2u * x->nh + 1u] = bits;
+    x->nh++;
+    return true;
+}
+
+/* The end point with voxel code c into the brick cache: its level-2 node's bits there (two
+ * ways per set; a new node enters the first, whose entry moves to the second, whose entry goes
+ * to the output as a record: the sort merges a node's records). */
+static bool add_hit(occ_proj_t *const x, const occ_code_t c)
+{
+    const occ_code_t brick = c & ~(occ_code_t)63u;
+    const uint64_t bit = (uint64_t)1 << (c & 63u);
+    occ_code_t *const code = x->cache_code + 2u * cache_set(brick);
+    uint64_t *const bits = x->cache_bits + (code - x->cache_code);
+    if (code[0] == brick) {
+        bits[0] |= bit;
+        return true;
+    }
+    if (code[1] == brick) {
+        bits[1] |= bit;
+        return true;
+    }
+    if (bits[1] != 0u && !put_record(x, code[1], bits[1])) {
+        return false;
+    }
+    code[1] = code[0];
+    bits[1] = bits[0];
+    code[0] = brick;
+    bits[0] = bit;
     return true;
 }
 
@@ -296,32 +322,27 @@ static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)
     return n;
 }
 
-/* The flagged pixels' codes to the output; false when it is full. When the whole row surely
- * fits, the repeat filter is branch-free: every code is written, and the count moves past the
- * new ones only. */
-static bool emit_row(occ_proj_t *const x, size_t *const n)
+/* The flagged pixels' end points into the brick cache; false when the output is full. */
+static bool emit_row(occ_proj_t *const x)
 {
     int32_t *const nw = x->px.nw;
     const uint32_t m = compact_flags(nw, (x->im->width + 3u) & ~3u);
-    if (2u * (*n + m) > x->cap) {
-        for (uint32_t j = 0; j < m; j++) { /* the exact order of the output running full */
-            if (!emit(x, code_at(x, (uint32_t)nw[j]), n)) {
-                return false;
-            }
-        }
-        return true;
-    }
-    occ_code_t *const filter = x->filter, *const out = x->out;
-    size_t k = *n;
     for (uint32_t j = 0; j < m; j++) {
-        const occ_code_t code = code_at(x, (uint32_t)nw[j]);
-        const size_t s = filter_slot(code);
-        const size_t fresh = filter[s] != code;
-        filter[s] = code;
-        out[k] = code;
-        k += fresh;
+        if (!add_hit(x, code_at(x, (uint32_t)nw[j]))) {
+            return false;
+        }
     }
-    *n = k;
+    return true;
+}
+
+/* The cache's entries to the output as records, after the last row. */
+static bool flush_cache(occ_proj_t *const x)
+{
+    for (size_t i = 0; i < OCC_PROJ_CACHE_N; i++) {
+        if (x->cache_bits[i] != 0u && !put_record(x, x->cache_code[i], x->cache_bits[i])) {
+            return false;
+        }
+    }
     return true;
 }
 
@@ -338,8 +359,9 @@ static void next_row(occ_proj_t *const x)
 bool occi_proj_pixels(occ_proj_t *const x)
 {
     const uint32_t w = x->im->width, h = x->im->height;
-    for (size_t i = 0; i < OCC_PROJ_FILTER_N; i++) {
-        x->filter[i] = 0u; /* a hit code always has bit 63: 0 is never one */
+    for (size_t i = 0; i < OCC_PROJ_CACHE_N; i++) {
+        x->cache_code[i] = ~(occ_code_t)0; /* never a level-2 node's code (low bits clear) */
+        x->cache_bits[i] = 0u;
     }
     for (unsigned a = 0; a < 3u; a++) {
         for (uint32_t i = 0; i <= w; i++) {
@@ -351,15 +373,16 @@ bool occi_proj_pixels(occ_proj_t *const x)
     }
     columns(x);
     x->raw_lanes = raw_rows(x->im);
+    x->nh = 0u;
     bool fit = true;
-    size_t n = 0;
     for (uint32_t j = 0; j < h; j++) {
         load_row(x, j);
         classify_row(x, j, x->d0 + (size_t)j * w);
         flag_new(x);
-        fit = fit && emit_row(x, &n);
+        fit = fit && emit_row(x);
         next_row(x);
     }
-    x->nh = n;
+    fit = fit && flush_cache(x);
+    x->hwm = 4u * x->nh; /* the records and the sort's temporary (so far, when not all fit) */
     return fit;
 }

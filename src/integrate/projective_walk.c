@@ -293,26 +293,51 @@ static void brick_at(occ_proj_t *x, const occ_code_t code)
     x->bmiss = x->bhit = x->bwhole = 0u;
 }
 
-/* The hits and the near field's voxels below `code` into their bricks, in code order (a near
- * voxel that is also a hit is a hit). */
+/* The next end point's code (NONE: none left): the first bit left of the record at the
+ * cursor. */
+static occ_code_t next_hit(const occ_proj_t *x)
+{
+    return x->hit_cur < x->nh ? x->out[x->hit_cur] | occ_first_slot64(x->hit_rest) : NONE;
+}
+
+/* Take `bits` (some of those left) of the record at the cursor; past it when none are left. */
+static void take_hits(occ_proj_t *x, const uint64_t bits)
+{
+    x->hit_rest &= ~bits;
+    if (x->hit_rest == 0u) {
+        x->hit_cur += 2u;
+        x->hit_rest = x->hit_cur < x->nh ? x->out[x->hit_cur + 1u] : 0u;
+    }
+}
+
+/* The hits and the near field's voxels below `code` into their bricks, a brick at a time in
+ * code order (a near voxel that is also a hit is a hit: the brick's hits below `code` are
+ * taken first). */
 static void catch_up(occ_proj_t *x, const occ_code_t code)
 {
     for (;;) {
-        const occ_code_t h = x->hit_cur < x->nh ? x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT : NONE;
+        const occ_code_t h = next_hit(x);
         const occ_code_t v = x->near_cur < x->nr ? x->near[x->near_cur] : NONE;
         const occ_code_t c = h < v ? h : v;
         if (c >= code) {
             return;
         }
-        brick_at(x, c);
-        if (c == h) {
-            x->bhit |= (uint64_t)1 << (c & 63u);
-            x->hit_cur++;
-            x->near_cur += c == v ? 1u : 0u;
-        } else {
-            x->bmiss |= (uint64_t)1 << (c & 63u);
-            x->nv++;
-            x->near_cur++;
+        const occ_code_t b = c & ~(occ_code_t)63u;
+        brick_at(x, b);
+        if (x->hit_cur < x->nh && x->out[x->hit_cur] == b) {
+            const uint64_t below = code - b >= 64u ? ~(uint64_t)0 : ((uint64_t)1 << (code - b)) - 1u;
+            const uint64_t t = x->hit_rest & below;
+            x->bhit |= t;
+            take_hits(x, t);
+        }
+        for (; x->near_cur < x->nr && x->near[x->near_cur] < code &&
+               (x->near[x->near_cur] & ~(occ_code_t)63u) == b;
+             x->near_cur++) {
+            const uint64_t bit = (uint64_t)1 << (x->near[x->near_cur] & 63u);
+            if ((x->bhit & bit) == 0u) {
+                x->bmiss |= bit;
+                x->nv++;
+            }
         }
     }
 }
@@ -322,22 +347,21 @@ static void catch_up(occ_proj_t *x, const occ_code_t code)
 static bool holds_hit(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
     catch_up(x, code);
-    const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
-    return x->hit_cur < x->nh && (x->out[x->hit_cur] & ~OCC_CODE_HIT_BIT) < end;
+    return next_hit(x) < code + ((occ_code_t)1 << (3u * l));
 }
 
-/* The end points inside the level-l node (l <= 2) at `code`, as bits of voxel offsets from
- * code (hits win over its free voxels); the cursor moves past them. */
+/* The end points inside the level-l node (l <= 2) at `code`, caught up with, as bits of voxel
+ * offsets from code (hits win over its free voxels); the cursor moves past them. */
 static uint64_t hit_bits(occ_proj_t *x, const occ_code_t code, const unsigned l)
 {
-    const occ_code_t end = code + ((occ_code_t)1 << (3u * l));
-    uint64_t bits = 0u;
-    size_t i = x->hit_cur;
-    for (; i < x->nh && (x->out[i] & ~OCC_CODE_HIT_BIT) < end; i++) {
-        bits |= (uint64_t)1 << ((x->out[i] & ~OCC_CODE_HIT_BIT) - code);
+    if (x->hit_cur >= x->nh || x->out[x->hit_cur] != (code & ~(occ_code_t)63u)) {
+        return 0u;
     }
-    x->hit_cur = i;
-    return bits;
+    const unsigned off = (unsigned)(code & 63u), n = 1u << (3u * l);
+    const uint64_t span = n == 64u ? ~(uint64_t)0 : ((uint64_t)1 << n) - 1u;
+    const uint64_t t = x->hit_rest & (span << off);
+    take_hits(x, t);
+    return t >> off;
 }
 
 /* Skip the near field's voxels inside the level-l node at `code`; returns their bits (voxel
@@ -421,6 +445,8 @@ void occi_proj_walk(occ_proj_t *const x)
     occ_proj_frame_t *const st = x->walk; /* in the scratch, not on the stack */
     foot_t f;
     planes_init(x);
+    x->hit_cur = 0u;
+    x->hit_rest = x->nh > 0u ? x->out[1] : 0u;
     if (depth == 1u) {
         const uint32_t k0[3] = {0u, 0u, 0u};
         if (test_node(x, k0, 1u, x->dmax, &f) != NODE_SKIP) {
