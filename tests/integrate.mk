@@ -21,8 +21,8 @@ TEST_STEPS += integrate-cli
 .PHONY: integrate-cli
 
 # The integration tests once more, linked against the release library (build/libocc.a: -O3,
-# the projective lane loops vectorised, their AVX2 clones where the CPU has AVX2), so that the
-# OctoMap and oracle comparisons cover the code `make bench` times, not only the ASan build's
+# the projective lane loops vectorised, their AVX-512 or AVX2 clones where the CPU has them), so
+# that the OctoMap and oracle comparisons cover the code `make bench` times, not only the ASan build's
 # (-O1, scalar loops). The tests' own objects are the ASan build's (an uninstrumented library
 # links with them).
 REL_TWINS := test_integrate test_projective test_proj_range test_projective_fuzz

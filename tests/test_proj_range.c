@@ -7,7 +7,7 @@
  * pixels near it (within twice the footprint's size). A query that reads a window too small
  * for the footprint (a wrong level), the wrong rows or a stale table fails here even where the
  * oracle test's frames happen not to notice. Random seed: printed, overridable with OCC_SEED.
- * Also linked against the release library (test_proj_range_rel: the AVX2 clones).
+ * Also linked against the release library (test_proj_range_rel: the AVX-512 or AVX2 clones).
  */
 #include <stdarg.h>
 #include <stddef.h>

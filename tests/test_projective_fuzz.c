@@ -13,8 +13,8 @@
  * pruned blocks of either state and single voxels around the camera; one map in six has a
  * small pool, and a frame it cannot hold must leave it as it was (OCC_ERR_NOMEM). A refused call (scratch short)
  * must leave the map as it was. Random seed: printed, overridable with OCC_SEED. Also linked
- * against the release library (test_projective_fuzz_rel: the vectorised lanes and their AVX2
- * clones).
+ * against the release library (test_projective_fuzz_rel: the vectorised lanes and their AVX-512 or
+ * AVX2 clones).
  */
 #include <stdarg.h>
 #include <stddef.h>

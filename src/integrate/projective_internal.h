@@ -10,14 +10,18 @@
 #include "integrate_internal.h"
 
 /* A vectorisable loop kept out of line: inlined into its caller, GCC 12 drops the loop's
- * restrict qualifiers and leaves it scalar. On x86-64 glibc hosts GCC also builds an AVX2
- * clone of it, picked once at load time by the CPU (an ifunc; libgcc's __cpu_model): eight
- * lanes instead of SSE2's four. The same IEEE operations lane for lane (AVX2 brings no FMA,
- * and C99 mode contracts none), so the same map (bench/ab_split compares digests;
- * test_projective_rel runs the oracle test on the release build). Measured 0.94x the time of
- * SSE2 alone on the TUM frames; an AVX-512 clone measured 0.99x, so there is none. */
+ * restrict qualifiers and leaves it scalar. On x86-64 glibc hosts GCC also builds an AVX-512
+ * and an AVX2 clone of it, one picked once at load time by the CPU (an ifunc; libgcc's
+ * __cpu_model): 16 or 8 lanes instead of SSE2's four. The same IEEE operations lane for lane
+ * (C99 mode contracts nothing into an FMA), so the same map (bench/ab_split compares digests;
+ * test_projective_rel runs the oracle test on the release build). The AVX2 clone measured 0.94x
+ * the time of SSE2 alone on the TUM frames. The AVX-512 clone measured 0.993x of AVX2 alone when
+ * the pixel pass was most of the lanes; with the 64-voxel rule's lanes it is 0.959x (q1 0.950,
+ * q3 0.974; 31 rounds) and 0.959x (21 rounds) on a Sapphire Rapids Xeon, same maps; an
+ * x86-64-v4 clone (AVX-512 BW, DQ, VL too) instead measured 1.007x of it. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__GLIBC__)
-#define OCC_PROJ_LANES OCC_NOINLINE __attribute__((target_clones("avx2", "default")))
+#define OCC_PROJ_LANES \
+    OCC_NOINLINE __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define OCC_PROJ_LANES OCC_NOINLINE
 #endif

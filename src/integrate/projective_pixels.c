@@ -214,7 +214,7 @@ static void classify_row(occ_proj_t *const x, const uint32_t j, float *const d0r
     c.side = x->kside;
     const uint32_t w = x->im->width, n = (w + 3u) & ~3u;
     row_counts_t s = {0u, 0u, 0u, 0u}; /* the lane loops set every field; gcc -fanalyzer cannot
-                                        * see through their AVX2 clones' load-time pick */
+                                        * see through their clones' load-time pick */
     const occ_proj_pixels_t *const p = &x->px;
     depth_lanes(n, &c, p->dr, p->asq, d0row, p->ds, &s);
     key_lanes(n, &c, p->ds, p->u[0], p->u[1], p->u[2], p->kc[0], p->kc[1], p->kc[2], &s);
