@@ -406,6 +406,15 @@ static void emit_node(occ_proj_t *x, const occ_code_t code, const unsigned l)
  * occi_proj_pixels'). Whole free nodes where every voxel below is free and holds no end point
  * (the same updates, counted as nodes): the node itself (level 2; level 1 when may_merge) or
  * its level-1 children; the other free voxels one by one. */
+/* The bytes of m whose 8 bits are all set, as 0xFF (the others 0). */
+static uint64_t full_bytes(const uint64_t m)
+{
+    uint64_t f = m & (m >> 4);
+    f &= f >> 2;
+    f &= f >> 1;
+    return (f & 0x0101010101010101ull) * 0xFFu;
+}
+
 static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code,
                        const unsigned level, const bool may_merge)
 {
@@ -426,17 +435,13 @@ static void visit_bulk(occ_proj_t *x, const uint32_t k[3], const occ_code_t code
     brick_at(x, code);
     const unsigned off = (unsigned)(code & 63u);
     x->bhit |= hits << off;
-    for (unsigned c = 0; c < n / 8u; c++) {
-        const uint64_t byte = (mask >> (8u * c)) & 0xFFu;
-        const uint64_t at = byte << (off + 8u * c);
-        if (byte == 0xFFu && (level == 2u || may_merge)) {
-            x->nn++;
-            x->bwhole |= at;
-        } else {
-            x->nv += occ_popcount64(byte);
-        }
-        x->bmiss |= at;
-    }
+    x->bmiss |= mask << off;
+    /* whole free level-1 nodes: one node each in the counters, the other free voxels one each
+     * (without a branch per byte: which bytes are full falls at random) */
+    const uint64_t whole = level == 2u || may_merge ? full_bytes(mask) : 0u;
+    x->bwhole |= whole << off;
+    x->nn += occ_popcount64(whole) / 8u;
+    x->nv += occ_popcount64(mask & ~whole);
 }
 
 void occi_proj_walk(occ_proj_t *const x)
