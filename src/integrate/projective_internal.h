@@ -69,7 +69,15 @@ typedef struct {
     occ_code_t code;
     float cap;
     uint8_t level, next;
+    uint8_t kids; /* a level-3 node: its MIXED level-2 children, by slot */
 } occ_proj_frame_t;
+
+/* The inputs of the walk's tests of a level-3 node's 8 children at once (projective_walk.c). */
+typedef struct {
+    float lo[3][8]; /* the children's lower faces, by child slot */
+    float t[3], r[3][3], pn[4][3], pc[4][3], dz[3];
+    float s, tabs, max2, max_range, peps0, cap;
+} occ_proj_kids_t;
 
 /* Lanes of the bulk rule: the voxels of a level-2 node. */
 #define OCC_PROJ_BULK 64u
@@ -81,6 +89,7 @@ typedef struct {
     uint32_t pix[OCC_PROJ_BULK];
     int32_t in[OCC_PROJ_BULK];
     uint8_t free8[OCC_PROJ_BULK];
+    occ_proj_kids_t kids;       /* the walk's tests of 8 children at once: inputs */
 } occ_proj_bulk_t;
 
 /* Per node level, the walk's constants (see occ_proj_t). */

@@ -45,13 +45,19 @@ static void to_cam(const occ_proj_camera_t *k, const float w[3], float q[3])
     }
 }
 
+/* Distance along one axis from the camera's t to the box's [lo, lo + s]. */
+static inline float axis_gap(const float lo, const float t, const float s)
+{
+    return lo - t > 0.0f ? lo - t : (t - (lo + s) > 0.0f ? t - (lo + s) : 0.0f);
+}
+
 /* Squared distance from the camera to the node's box (map frame). */
 static float box_dist2(const occ_proj_camera_t *k, const float lo[3], const float s)
 {
     const float t[3] = {k->t.x, k->t.y, k->t.z};
     float d2 = 0.0f;
     for (unsigned a = 0; a < 3u; a++) {
-        const float e = lo[a] - t[a] > 0.0f ? lo[a] - t[a] : (t[a] - (lo[a] + s) > 0.0f ? t[a] - (lo[a] + s) : 0.0f);
+        const float e = axis_gap(lo[a], t[a], s);
         d2 += e * e;
     }
     return d2;
@@ -91,16 +97,20 @@ static void planes_init(occ_proj_t *x)
     x->peps0 = 1e-5f * (k->fx + k->fy + fabsf(k->cx) + fabsf(k->cy) + wf + hf);
 }
 
+/* Side plane n's value at the box's corner q plus the positive edge parts c (in that order). */
+static inline float plane_value(const float n[3], const float c[3], const float q0,
+                                const float q1, const float q2)
+{
+    return n[0] * q0 + n[1] * q1 + n[2] * q2 + c[0] + c[1] + c[2];
+}
+
 /* Does the box (camera-frame corner q0, level l) lie wholly outside one of the side planes?
  * (The corner's plane value plus the positive edge parts, added in axis order.) */
 static bool outside_planes(const occ_proj_t *x, const float q0[3], const unsigned l,
                            const float peps)
 {
     for (unsigned p = 0; p < 4u; p++) {
-        const float *const c = x->lv->plane_pos[l][p];
-        const float m = x->pn[p][0] * q0[0] + x->pn[p][1] * q0[1] + x->pn[p][2] * q0[2] + c[0] +
-                        c[1] + c[2];
-        if (m < -peps) {
+        if (plane_value(x->pn[p], x->lv->plane_pos[l][p], q0[0], q0[1], q0[2]) < -peps) {
             return true;
         }
     }
@@ -241,6 +251,96 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
         return NODE_FREE;
     }
     return NODE_MIXED;
+}
+
+/* test_node's tests for the 8 level-2 children of a level-3 node at once (lanes: the child
+ * slots), lane for lane the same arithmetic: a level-2 node is never FREE there (the rule
+ * decides its voxels), only SKIP or MIXED. One lane loop instead of 8 calls with their
+ * early exits: bench/ab_split 0.985 and 0.983 of the time (31 and 41 rounds, same maps). */
+OCC_PROJ_LANES static void kids_lanes(const occ_proj_kids_t *restrict in, uint8_t *restrict mixed)
+{
+    const float s = in->s, cap = in->cap, max2 = in->max2, range = in->max_range;
+    for (unsigned m = 0; m < 8u; m++) {
+        const float l0 = in->lo[0][m], l1 = in->lo[1][m], l2 = in->lo[2][m];
+        const float e0 = axis_gap(l0, in->t[0], s), e1 = axis_gap(l1, in->t[1], s),
+                    e2 = axis_gap(l2, in->t[2], s);
+        const float bd2 = ((0.0f + e0 * e0) + e1 * e1) + e2 * e2;
+        const float mabs = ((in->tabs + hi_of(fabsf(l0), fabsf(l0 + s))) +
+                            hi_of(fabsf(l1), fabsf(l1 + s))) + hi_of(fabsf(l2), fabsf(l2 + s));
+        const float eps = 1e-5f * (1.0f + mabs);
+        const float w0 = l0 - in->t[0], w1 = l1 - in->t[1], w2 = l2 - in->t[2];
+        const float q0 = in->r[0][0] * w0 + in->r[1][0] * w1 + in->r[2][0] * w2;
+        const float q1 = in->r[0][1] * w0 + in->r[1][1] * w1 + in->r[2][1] * w2;
+        const float q2 = in->r[0][2] * w0 + in->r[1][2] * w1 + in->r[2][2] * w2;
+        float zmin = q2, zmax = q2;
+        for (unsigned a = 0; a < 3u; a++) {
+            zmin += in->dz[a] < 0.0f ? in->dz[a] : 0.0f;
+            zmax += in->dz[a] > 0.0f ? in->dz[a] : 0.0f;
+        }
+        const float peps = in->peps0 * (1.0f + mabs);
+        int32_t skip = (bd2 > max2 + eps * (1.0f + range)) | (zmax < -eps) |
+                       (zmin > cap + eps) | (zmin > range + eps);
+        for (unsigned p = 0; p < 4u; p++) {
+            skip |= plane_value(in->pn[p], in->pc[p], q0, q1, q2) < -peps;
+        }
+        mixed[m] = (uint8_t)(skip == 0);
+    }
+}
+
+/* The MIXED ones among the 8 level-2 children of the level-3 node at key k (parent's cap), as
+ * bits by child slot; the rest are SKIP. Checked against test_node where asserts are live. */
+static unsigned kids_mixed(occ_proj_t *x, const uint32_t k[3], const float cap)
+{
+    occ_proj_kids_t *const in = &x->bulk->kids;
+    for (unsigned a = 0; a < 3u; a++) {
+        const float lo0 = key_low(&x->g, k[a]), lo1 = key_low(&x->g, k[a] | 4u);
+        for (unsigned c = 0; c < 8u; c++) {
+            in->lo[a][c] = ((c >> a) & 1u) != 0u ? lo1 : lo0;
+        }
+        in->dz[a] = x->lv->edge[2][a][2];
+    }
+    in->cap = cap;
+    uint8_t mixed[8];
+    kids_lanes(in, mixed);
+    x->r->nodes_tested += 8u;
+    unsigned bits = 0;
+    for (unsigned c = 0; c < 8u; c++) {
+        bits |= (unsigned)mixed[c] << c;
+#if defined(OCC_TESTING)
+        const uint32_t kc[3] = {k[0] | ((c & 1u) << 2), k[1] | (((c >> 1) & 1u) << 2),
+                                k[2] | (((c >> 2) & 1u) << 2)};
+        foot_t f;
+        const int cls = test_node(x, kc, 2u, cap, &f);
+        x->r->nodes_tested--;
+        OCC_ASSERT(cls == (mixed[c] != 0u ? NODE_MIXED : NODE_SKIP));
+#endif
+    }
+    return bits;
+}
+
+/* The per-call constants of kids_lanes. */
+static void kids_init(occ_proj_t *x)
+{
+    occ_proj_kids_t *const in = &x->bulk->kids;
+    const occ_proj_camera_t *const cam = x->cam;
+    const float t[3] = {cam->t.x, cam->t.y, cam->t.z};
+    for (unsigned a = 0; a < 3u; a++) {
+        in->t[a] = t[a];
+        for (unsigned b = 0; b < 3u; b++) {
+            in->r[a][b] = cam->r[a][b];
+        }
+    }
+    for (unsigned p = 0; p < 4u; p++) {
+        for (unsigned a = 0; a < 3u; a++) {
+            in->pn[p][a] = x->pn[p][a];
+            in->pc[p][a] = x->lv->plane_pos[2][p][a];
+        }
+    }
+    in->s = x->lv->side[2];
+    in->tabs = x->tabs;
+    in->max2 = x->max2;
+    in->max_range = cam->max_range_m;
+    in->peps0 = x->peps0;
 }
 
 /* ---- the output: bricks and whole nodes in code order (tree_internal.h, occi_frame_t) -----------
@@ -450,6 +550,9 @@ void occi_proj_walk(occ_proj_t *const x)
     occ_proj_frame_t *const st = x->walk; /* in the scratch, not on the stack */
     foot_t f;
     planes_init(x);
+    if (depth >= 3u) { /* level-3 nodes exist: their children are tested at once */
+        kids_init(x);
+    }
     x->hit_cur = 0u;
     x->hit_rest = x->nh > 0u ? x->out[1] : 0u;
     if (depth == 1u) {
@@ -478,6 +581,15 @@ void occi_proj_walk(occ_proj_t *const x)
         const uint32_t k[3] = {st[t].k[0] | ((s & 1u) << l), st[t].k[1] | (((s >> 1) & 1u) << l),
                                st[t].k[2] | (((s >> 2) & 1u) << l)};
         const occ_code_t code = st[t].code | ((occ_code_t)s << (3u * l));
+        if (l == 2u) { /* the children's tests at once, then the rule on the MIXED ones */
+            if (s == 0u) {
+                st[t].kids = (uint8_t)kids_mixed(x, st[t].k, st[t].cap);
+            }
+            if ((((unsigned)st[t].kids >> s) & 1u) != 0u) {
+                visit_bulk(x, k, code, 2u, true);
+            }
+            continue;
+        }
         int cls = test_node(x, k, l, st[t].cap, &f);
         if (cls == NODE_FREE && holds_hit(x, code, l)) {
             cls = NODE_MIXED; /* hits win: not expected (a free node is in front of every end
