@@ -256,8 +256,9 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
 /* test_node's tests for the 8 level-2 children of a level-3 node at once (lanes: the child
  * slots), lane for lane the same arithmetic: a level-2 node is never FREE there (the rule
  * decides its voxels), only SKIP or MIXED. One lane loop instead of 8 calls with their
- * early exits: bench/ab_split 0.985 and 0.983 of the time (31 and 41 rounds, same maps). */
-OCC_PROJ_LANES static void kids_lanes(const occ_proj_kids_t *restrict in, uint8_t *restrict mixed)
+ * early exits: bench/ab_split 0.985 and 0.983 of the time (31 and 41 rounds, same maps). The
+ * answers as int32 lanes: with bytes GCC vectorised by two floats (0.976 and 0.977 of that). */
+OCC_PROJ_LANES static void kids_lanes(const occ_proj_kids_t *restrict in, int32_t *restrict mixed)
 {
     const float s = in->s, cap = in->cap, max2 = in->max2, range = in->max_range;
     for (unsigned m = 0; m < 8u; m++) {
@@ -283,7 +284,7 @@ OCC_PROJ_LANES static void kids_lanes(const occ_proj_kids_t *restrict in, uint8_
         for (unsigned p = 0; p < 4u; p++) {
             skip |= plane_value(in->pn[p], in->pc[p], q0, q1, q2) < -peps;
         }
-        mixed[m] = (uint8_t)(skip == 0);
+        mixed[m] = skip == 0;
     }
 }
 
@@ -300,7 +301,7 @@ static unsigned kids_mixed(occ_proj_t *x, const uint32_t k[3], const float cap)
         in->dz[a] = x->lv->edge[2][a][2];
     }
     in->cap = cap;
-    uint8_t mixed[8];
+    int32_t mixed[8];
     kids_lanes(in, mixed);
     x->r->nodes_tested += 8u;
     unsigned bits = 0;
@@ -312,7 +313,7 @@ static unsigned kids_mixed(occ_proj_t *x, const uint32_t k[3], const float cap)
         foot_t f;
         const int cls = test_node(x, kc, 2u, cap, &f);
         x->r->nodes_tested--;
-        OCC_ASSERT(cls == (mixed[c] != 0u ? NODE_MIXED : NODE_SKIP));
+        OCC_ASSERT(cls == (mixed[c] != 0 ? NODE_MIXED : NODE_SKIP));
 #endif
     }
     return bits;
