@@ -293,7 +293,8 @@ size_t occ_ray_max_keys(const occ_map_t *map, occ_vec3_t origin, occ_vec3_t end)
  *    |c|^2 not finite: no reading; |c|^2 < min_range_m^2: no reading (blind zone);
  *  - the voxel's centre C (OctoMap's float centre per axis) goes to the camera frame:
  *    w = C - t, q_k = r[0][k] w_0 + r[1][k] w_1 + r[2][k] w_2 (float, left to right), and its
- *    pixel is i = floor(fx * (q_0 / q_2) + cx + 0.5), j = floor(fy * (q_1 / q_2) + cy + 0.5);
+ *    pixel, with iz = 1 / q_2 (float), is i = floor(fx * (q_0 iz) + cx + 0.5),
+ *    j = floor(fy * (q_1 iz) + cy + 0.5);
  *  - the free test's depth of a pixel: its reading d; a pixel with no reading takes the
  *    smallest reading among its four neighbours (left, right, up, down) that have one, so that a
  *    single-pixel gap (a speckle of the sensor) is decided by the readings around it as ray

@@ -96,8 +96,9 @@ OCC_PROJ_LANES static void project_lanes(const occ_proj_t *const x, const float 
     const float wf = x->wf, hf = x->hf, max2 = x->max2;
     const uint32_t w = x->im->width;
     for (unsigned m = 0; m < OCC_PROJ_BULK; m++) {
-        const float u = fx * (qa[m] / qc[m]) + cx + 0.5f;
-        const float v = fy * (qb[m] / qc[m]) + cy + 0.5f;
+        const float iz = 1.0f / qc[m]; /* one division, not two: the lanes' limit */
+        const float u = fx * (qa[m] * iz) + cx + 0.5f;
+        const float v = fy * (qb[m] * iz) + cy + 0.5f;
         const float r2 = qa[m] * qa[m] + qb[m] * qb[m] + qc[m] * qc[m];
         const int32_t ok = (qc[m] > 0.0f) & (u >= 0.0f) & (u < wf) & (v >= 0.0f) & (v < hf) &
                            (r2 <= max2);

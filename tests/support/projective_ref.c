@@ -165,8 +165,9 @@ static bool ref_free(const occ_proj_image_t *im, const occ_proj_camera_t *k, occ
     if (!(q[2] > 0.0f)) {
         return false;
     }
-    const float u = floorf(k->fx * (q[0] / q[2]) + k->cx + 0.5f);
-    const float v = floorf(k->fy * (q[1] / q[2]) + k->cy + 0.5f);
+    const float iz = 1.0f / q[2];
+    const float u = floorf(k->fx * (q[0] * iz) + k->cx + 0.5f);
+    const float v = floorf(k->fy * (q[1] * iz) + k->cy + 0.5f);
     if (!(u >= 0.0f && u < (float)im->width && v >= 0.0f && v < (float)im->height)) {
         return false;
     }
