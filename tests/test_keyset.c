@@ -75,45 +75,43 @@ static size_t draw_n(const unsigned round)
     return round < 3u ? round : (size_t)(rng_next() % MAX_N);
 }
 
-static void test_sort_codes(void **state)
+/* 200 random arrays of n entries of `width` words sorted by the library and by ref_sort:
+ * codes with the hit flag (width 1: occi_keyset_sort) or records whose second word is any
+ * value (width 2: occi_keyset_sort_records); equal, entry for entry (stable). */
+static void check_sorts(const size_t width)
 {
-    (void)state;
-    static occ_code_t a[2u * MAX_N], ref[MAX_N];
+    static occ_code_t a[4u * MAX_N], ref[2u * MAX_N];
     static uint32_t hist[OCC_KS_HIST_WORDS];
     for (unsigned round = 0; round < 200u; round++) {
-        const size_t n = draw_n(round);
+        const size_t n = draw_n(round), words = width * n;
         const unsigned shape = round % 4u;
         const occ_code_t base = rng_next() & KEY_BITS;
         for (size_t i = 0; i < n; i++) {
-            a[i] = draw_key(shape, base) | ((rng_next() & 1u) << 63); /* the hit flag */
+            a[width * i] = draw_key(shape, base) | (width == 1u ? (rng_next() & 1u) << 63 : 0u);
+            if (width == 2u) {
+                a[2u * i + 1u] = rng_next();
+            }
         }
-        memcpy(ref, a, n * sizeof a[0]);
-        ref_sort(ref, n, 1u);
-        const occ_code_t *const got = occi_keyset_sort(a, a + MAX_N, n, hist);
-        assert_true(got == a || got == a + MAX_N);
-        assert_memory_equal(got, ref, n * sizeof a[0]); /* stable: flags in input order */
+        memcpy(ref, a, words * sizeof a[0]);
+        ref_sort(ref, n, width);
+        const occ_code_t *const got = width == 1u
+                                          ? occi_keyset_sort(a, a + words, n, hist)
+                                          : occi_keyset_sort_records(a, a + words, n, hist);
+        assert_true(got == a || got == a + words);
+        assert_memory_equal(got, ref, words * sizeof a[0]);
     }
+}
+
+static void test_sort_codes(void **state)
+{
+    (void)state;
+    check_sorts(1u);
 }
 
 static void test_sort_records(void **state)
 {
     (void)state;
-    static occ_code_t r[4u * MAX_N], ref[2u * MAX_N];
-    static uint32_t hist[OCC_KS_HIST_WORDS];
-    for (unsigned round = 0; round < 200u; round++) {
-        const size_t n = draw_n(round);
-        const unsigned shape = round % 4u;
-        const occ_code_t base = rng_next() & KEY_BITS;
-        for (size_t i = 0; i < n; i++) {
-            r[2u * i] = draw_key(shape, base);
-            r[2u * i + 1u] = rng_next(); /* any word, bit 63 included */
-        }
-        memcpy(ref, r, 2u * n * sizeof r[0]);
-        ref_sort(ref, n, 2u);
-        const occ_code_t *const got = occi_keyset_sort_records(r, r + 2u * n, n, hist);
-        assert_true(got == r || got == r + 2u * n);
-        assert_memory_equal(got, ref, 2u * n * sizeof r[0]);
-    }
+    check_sorts(2u);
 }
 
 static void test_unique(void **state)

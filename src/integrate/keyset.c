@@ -83,12 +83,15 @@ static uint32_t *pass_offsets(uint32_t *const hist, const unsigned p, const occ_
     return h;
 }
 
-occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint32_t *const hist)
+/* The sort of n entries of `width` words (1: codes; 2: records, the second word carried),
+ * keyed by the first word's bits 0..62; inlined into each caller with its width a constant. */
+static OCC_ALWAYS_INLINE occ_code_t *sort_entries(occ_code_t *a, occ_code_t *tmp, const size_t n,
+                                                  const size_t width, uint32_t *const hist)
 {
     if (n < 2u) {
         return a;
     }
-    const occ_code_t diff = histograms(a, n, 1u, hist);
+    const occ_code_t diff = histograms(a, n, width, hist);
     for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
         uint32_t *const h = pass_offsets(hist, p, diff);
         if (h == NULL) {
@@ -96,9 +99,13 @@ occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uin
         }
         const unsigned shift = p * OCC_INSERT_RADIX_BITS;
         for (size_t i = 0; i < n; i++) {
-            const occ_code_t c = a[i];
+            const occ_code_t c = a[width * i];
             const unsigned b = (unsigned)(((c & CODE_BITS) >> shift) & DIGIT_MASK);
-            tmp[h[b]++] = c;
+            const size_t at = width * (size_t)h[b]++;
+            tmp[at] = c;
+            if (width == 2u) {
+                tmp[at + 1u] = a[width * i + 1u];
+            }
         }
         occ_code_t *const t = a;
         a = tmp;
@@ -107,31 +114,15 @@ occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uin
     return a;
 }
 
+occ_code_t *occi_keyset_sort(occ_code_t *a, occ_code_t *tmp, const size_t n, uint32_t *const hist)
+{
+    return sort_entries(a, tmp, n, 1u, hist);
+}
+
 occ_code_t *occi_keyset_sort_records(occ_code_t *r, occ_code_t *tmp, const size_t n,
                                      uint32_t *const hist)
 {
-    if (n < 2u) {
-        return r;
-    }
-    const occ_code_t diff = histograms(r, n, 2u, hist);
-    for (unsigned p = 0; p < OCC_KS_PASSES; p++) {
-        uint32_t *const h = pass_offsets(hist, p, diff);
-        if (h == NULL) {
-            continue;
-        }
-        const unsigned shift = p * OCC_INSERT_RADIX_BITS;
-        for (size_t i = 0; i < n; i++) {
-            const occ_code_t c = r[2u * i];
-            const unsigned b = (unsigned)(((c & CODE_BITS) >> shift) & DIGIT_MASK);
-            const size_t at = 2u * (size_t)h[b]++;
-            tmp[at] = c;
-            tmp[at + 1u] = r[2u * i + 1u];
-        }
-        occ_code_t *const t = r;
-        r = tmp;
-        tmp = t;
-    }
-    return r;
+    return sort_entries(r, tmp, n, 2u, hist);
 }
 
 size_t occi_keyset_unique(occ_code_t *const a, const size_t n)
