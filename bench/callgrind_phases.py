@@ -112,8 +112,9 @@ def projective_rows(c, frames):
         ("tree", "tree pass (bricks and whole nodes into the tree)",
          c.get("occi_tree_apply_frame")),
     ], [
-        ("walk/node_tests", "of the walk: node tests with the footprint query",
+        ("walk/node_tests", "of the walk: node tests with the footprint query (level 3 and up)",
          c.get("test_node")),
+        ("walk/kids", "of the walk: level-2 node tests, 8 at once", c.get("kids_mixed")),
         ("walk/bulk", "of the walk: the 64-voxel rule", c.get("occi_proj_bulk")),
     ], "rest (checks, scratch layout, pool check)", frames * 1e6, "M instructions per frame",
         frames)

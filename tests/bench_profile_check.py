@@ -87,7 +87,7 @@ def test_simple():
 def test_projective():
     c = {"occ_map_insert_projective": 2000, "occi_proj_pixels": 500, "occi_proj_hits_sort": 100,
          "occi_proj_build": 100, "occi_proj_near": 50, "occi_proj_walk": 800, "test_node": 300,
-         "occi_proj_bulk": 200, "occi_tree_apply_frame": 400}
+         "kids_mixed": 80, "occi_proj_bulk": 200, "occi_tree_apply_frame": 400}
     rows = prof.projective_rows(c, 10)
     r = rows_by_key(rows, prof.PROJ_ID)
     # rest = 2000 - (500 + 100 + 100 + 50 + 800 + 400); the walk's parts are inside the walk
@@ -95,7 +95,8 @@ def test_projective():
     top = ["pixels", "sort", "pyramid", "near", "walk", "tree", "rest"]
     check(abs(sum(r[k]["occmap"] for k in top) - r["total"]["occmap"]) < 1e-9,
           "PROJECTIVE: the top-level phases add up to the call")
-    check("walk/node_tests" in r and "walk/bulk" in r, "PROJECTIVE: the walk's two parts")
+    check(all(p in r for p in ("walk/node_tests", "walk/kids", "walk/bulk")),
+          "PROJECTIVE: the walk's three parts")
     del c["test_node"]
     r2 = rows_by_key(prof.projective_rows(c, 10), prof.PROJ_ID)
     check("walk/node_tests" not in r2 and abs(r2["rest"]["occmap"] - r["rest"]["occmap"]) < 1e-12,

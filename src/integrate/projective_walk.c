@@ -289,8 +289,9 @@ OCC_PROJ_LANES static void kids_lanes(const occ_proj_kids_t *restrict in, int32_
 }
 
 /* The MIXED ones among the 8 level-2 children of the level-3 node at key k (parent's cap), as
- * bits by child slot; the rest are SKIP. Checked against test_node where asserts are live. */
-static unsigned kids_mixed(occ_proj_t *x, const uint32_t k[3], const float cap)
+ * bits by child slot; the rest are SKIP. Checked against test_node where asserts are live.
+ * Out of line: bench/callgrind_phases.py counts it (one call per level-3 node). */
+OCC_NOINLINE static unsigned kids_mixed(occ_proj_t *x, const uint32_t k[3], const float cap)
 {
     occ_proj_kids_t *const in = &x->bulk->kids;
     for (unsigned a = 0; a < 3u; a++) {
