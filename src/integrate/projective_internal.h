@@ -72,7 +72,9 @@ typedef struct {
     uint8_t kids; /* a level-3 node: its MIXED level-2 children, by slot */
 } occ_proj_frame_t;
 
-/* The inputs of the walk's tests of a level-3 node's 8 children at once (projective_walk.c). */
+/* The inputs of the walk's tests of a level-3 node's 8 children at once (projective_walk.c):
+ * the children's faces, and copies of the camera's and the walk's constants for level 2, so
+ * that the lane loop reads everything through one restrict pointer. */
 typedef struct {
     float lo[3][8]; /* the children's lower faces, by child slot */
     float t[3], r[3][3], pn[4][3], pc[4][3], dz[3];

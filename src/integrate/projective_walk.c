@@ -37,12 +37,39 @@ static float key_low(const occ_raygeo_t *g, const uint32_t k)
     return (float)(((occ_rr_t)k - g->tmv_r) * g->res);
 }
 
-/* Camera frame of a map-frame offset w (the header's arithmetic). */
+/* Camera-frame component a of a map-frame offset w (the header's arithmetic). */
+static inline float cam_axis(const float r[3][3], const unsigned a, const float w0, const float w1,
+                             const float w2)
+{
+    return r[0][a] * w0 + r[1][a] * w1 + r[2][a] * w2;
+}
+
+/* Camera frame of a map-frame offset w. */
 static void to_cam(const occ_proj_camera_t *k, const float w[3], float q[3])
 {
     for (unsigned a = 0; a < 3u; a++) {
-        q[a] = k->r[0][a] * w[0] + k->r[1][a] * w[1] + k->r[2][a] * w[2];
+        q[a] = cam_axis(k->r, a, w[0], w[1], w[2]);
     }
+}
+
+/* A node's coordinate magnitude along one axis (its face farther from 0), for the rounding
+ * slack: eps = 1e-5 (1 + |t| + the three of them). */
+static inline float axis_abs(const float lo, const float s)
+{
+    return hi_of(fabsf(lo), fabsf(lo + s));
+}
+
+/* The camera-depth range of a box from its corner's depth q2 and its edges' depths dz, added
+ * in axis order. */
+static inline void z_range(const float q2, const float dz[3], float *zmin, float *zmax)
+{
+    float lo = q2, hi = q2;
+    for (unsigned a = 0; a < 3u; a++) {
+        lo += dz[a] < 0.0f ? dz[a] : 0.0f;
+        hi += dz[a] > 0.0f ? dz[a] : 0.0f;
+    }
+    *zmin = lo;
+    *zmax = hi;
 }
 
 /* Distance along one axis from the camera's t to the box's [lo, lo + s]. */
@@ -199,7 +226,7 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
     const float bd2 = box_dist2(cam, lo, s);
     float mabs = x->tabs;
     for (unsigned a = 0; a < 3u; a++) {
-        mabs += hi_of(fabsf(lo[a]), fabsf(lo[a] + s));
+        mabs += axis_abs(lo[a], s);
     }
     const float eps = 1e-5f * (1.0f + mabs);
     if (bd2 > x->max2 + eps * (1.0f + cam->max_range_m)) {
@@ -208,12 +235,10 @@ static int test_node(occ_proj_t *x, const uint32_t k[3], const unsigned level, c
     const float w[3] = {lo[0] - cam->t.x, lo[1] - cam->t.y, lo[2] - cam->t.z};
     float q0[3];
     to_cam(cam, w, q0);
-    float zmin = q0[2], zmax = q0[2];
-    for (unsigned a = 0; a < 3u; a++) {
-        const float dz = x->lv->edge[level][a][2];
-        zmin += dz < 0.0f ? dz : 0.0f;
-        zmax += dz > 0.0f ? dz : 0.0f;
-    }
+    const float dz[3] = {x->lv->edge[level][0][2], x->lv->edge[level][1][2],
+                         x->lv->edge[level][2][2]};
+    float zmin, zmax;
+    z_range(q0[2], dz, &zmin, &zmax);
     const float peps = x->peps0 * (1.0f + mabs);
     f->cap = cap;
     if (zmax < -eps || zmin > cap + eps || zmin > cam->max_range_m + eps ||
@@ -266,18 +291,13 @@ OCC_PROJ_LANES static void kids_lanes(const occ_proj_kids_t *restrict in, int32_
         const float e0 = axis_gap(l0, in->t[0], s), e1 = axis_gap(l1, in->t[1], s),
                     e2 = axis_gap(l2, in->t[2], s);
         const float bd2 = ((0.0f + e0 * e0) + e1 * e1) + e2 * e2;
-        const float mabs = ((in->tabs + hi_of(fabsf(l0), fabsf(l0 + s))) +
-                            hi_of(fabsf(l1), fabsf(l1 + s))) + hi_of(fabsf(l2), fabsf(l2 + s));
+        const float mabs = ((in->tabs + axis_abs(l0, s)) + axis_abs(l1, s)) + axis_abs(l2, s);
         const float eps = 1e-5f * (1.0f + mabs);
         const float w0 = l0 - in->t[0], w1 = l1 - in->t[1], w2 = l2 - in->t[2];
-        const float q0 = in->r[0][0] * w0 + in->r[1][0] * w1 + in->r[2][0] * w2;
-        const float q1 = in->r[0][1] * w0 + in->r[1][1] * w1 + in->r[2][1] * w2;
-        const float q2 = in->r[0][2] * w0 + in->r[1][2] * w1 + in->r[2][2] * w2;
-        float zmin = q2, zmax = q2;
-        for (unsigned a = 0; a < 3u; a++) {
-            zmin += in->dz[a] < 0.0f ? in->dz[a] : 0.0f;
-            zmax += in->dz[a] > 0.0f ? in->dz[a] : 0.0f;
-        }
+        const float q0 = cam_axis(in->r, 0u, w0, w1, w2), q1 = cam_axis(in->r, 1u, w0, w1, w2),
+                    q2 = cam_axis(in->r, 2u, w0, w1, w2);
+        float zmin, zmax;
+        z_range(q2, in->dz, &zmin, &zmax);
         const float peps = in->peps0 * (1.0f + mabs);
         int32_t skip = (bd2 > max2 + eps * (1.0f + range)) | (zmax < -eps) |
                        (zmin > cap + eps) | (zmin > range + eps);
