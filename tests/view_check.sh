@@ -30,18 +30,33 @@ in_page=$(grep -o '"free": {"n": [0-9]*' "$page" | grep -o '[0-9]*$')
 # Root in a container: no sandbox; WebGL on SwiftShader (no GPU); no network.
 chrome=(chromium --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader
         --hide-scrollbars --window-size=960,540 --virtual-time-budget=2000
-        --host-resolver-rules="MAP * ~NOTFOUND" --user-data-dir="$(realpath -m "$work/profile")")
+        --host-resolver-rules="MAP * ~NOTFOUND")
 url="file://$(realpath "$page")"
 shot=$(realpath -m "$work/shot.png")
-rm -f "$shot"
-timeout 180 "${chrome[@]}" --screenshot="$shot" --dump-dom "$url" >"$work/dom.html" 2>"$work/chromium.log" \
-  || fail "chromium (log: $work/chromium.log)"
+# Headless Chromium with a virtual-time budget now and then never exits (a known Chromium
+# behaviour, not the page's: it draws once and has no timers). CI hit it once (killed after
+# 180 s), this machine once in 25 runs; a run takes ~8 s here. An attempt that has not finished
+# in 60 s is killed and retried with a fresh profile, at most 3 times. Each attempt's log is
+# kept; only the outputs of an attempt that exited cleanly are judged below.
+ran=0
+for attempt in 1 2 3; do
+  log=$work/chromium.$attempt.log
+  rm -rf "$shot" "$work/dom.html" "$work/profile"
+  timeout -k 5 60 "${chrome[@]}" --user-data-dir="$(realpath -m "$work/profile")" \
+    --screenshot="$shot" --dump-dom "$url" >"$work/dom.html" 2>"$log"
+  rc=$?
+  if [ $rc -eq 0 ]; then ran=1; break; fi
+  echo "test-view: chromium attempt $attempt exited $rc$([ $rc -ge 124 ] && echo ' (killed after 60 s)'); log $log:"
+  grep -v 'dbus' "$log" | tail -5 | sed 's/^/    /'
+done
+[ $ran -eq 1 ] || fail "chromium failed 3 times (logs: $work/chromium.*.log)"
+[ $attempt -eq 1 ] || echo "test-view: chromium finished on attempt $attempt"
 status=$(grep -o '<div id="status"[^>]*>' "$work/dom.html")
 err=$(sed -n 's/.*data-error="\([^"]*\)".*/\1/p' <<<"$status")
 [ -z "$err" ] || fail "the page reports: $err"
 drawn=$(sed -n 's/.*data-drawn="\([-0-9.]*\)".*/\1/p' <<<"$status")
 [ "$drawn" = "$want" ] || fail "Chromium drew $drawn occupied cubes, the map has $want occupied leaves"
 echo "PASS test-view: Chromium drew $drawn occupied cubes = occmap info's occupied_leaves ($want)"
-[ -s "$shot" ] || fail "chromium wrote no screenshot (log: $work/chromium.log)"
+[ -s "$shot" ] || fail "chromium wrote no screenshot (log: $log)"
 python3 tests/view_png.py "$shot" || fail "the screenshot $shot looks blank"
 echo "PASS test-view: screenshot $shot shows the map (offline page, $(stat -c %s "$page") bytes)"
