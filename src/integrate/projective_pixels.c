@@ -311,16 +311,49 @@ static bool add_hit(occ_proj_t *const x, const occ_code_t c)
 
 /* The flagged columns' indices to the front of nw, in order; their count. In place and
  * without branches, as the flags fall at random: index n <= i is read before it is written. */
-static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)
+static uint32_t compact_scalar(int32_t *const nw, const uint32_t from, uint32_t n, const uint32_t n4)
 {
-    uint32_t n = 0;
-    for (uint32_t i = 0; i < n4; i++) {
+    for (uint32_t i = from; i < n4; i++) {
         const int32_t f = nw[i];
         nw[n] = (int32_t)i;
         n += (uint32_t)f;
     }
     return n;
 }
+
+#if OCC_PROJ_X86
+#include <immintrin.h>
+
+/* The same with AVX-512's compress, 16 flags at a time, where the CPU has it (the scalar loop
+ * was a third of the pixel pass's own time: the frame in 0.964x and 0.968x the time,
+ * bench/ab_split, 41 and 31 rounds, same maps). Each store writes 16 cells from n <= i: cells
+ * already read. The i386 test build, without it, runs the scalar loop through the same tests. */
+__attribute__((target("avx512f"))) static uint32_t compact_avx512(int32_t *const nw,
+                                                                  const uint32_t n4)
+{
+    const __m512i step = _mm512_set1_epi32(16);
+    __m512i idx = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    uint32_t n = 0, i = 0;
+    for (; i + 16u <= n4; i += 16u) {
+        const __m512i f = _mm512_loadu_si512((const void *)(nw + i));
+        const __mmask16 k = _mm512_test_epi32_mask(f, f);
+        _mm512_storeu_si512((void *)(nw + n), _mm512_maskz_compress_epi32(k, idx));
+        n += (uint32_t)__builtin_popcount((unsigned)k);
+        idx = _mm512_add_epi32(idx, step);
+    }
+    return compact_scalar(nw, i, n, n4);
+}
+
+static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)
+{
+    return __builtin_cpu_supports("avx512f") ? compact_avx512(nw, n4) : compact_scalar(nw, 0u, 0u, n4);
+}
+#else
+static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)
+{
+    return compact_scalar(nw, 0u, 0u, n4);
+}
+#endif
 
 /* The flagged pixels' end points into the brick cache; false when the output is full. */
 static bool emit_row(occ_proj_t *const x)
