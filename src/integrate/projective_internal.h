@@ -20,7 +20,10 @@
  * q3 0.974; 31 rounds) and 0.959x (21 rounds) on a Sapphire Rapids Xeon, same maps; an
  * x86-64-v4 clone (AVX-512 BW, DQ, VL too) instead measured 1.007x of it. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__GLIBC__)
-#define OCC_PROJ_X86 1 /* and intrinsics behind a CPU check (projective_pixels.c) */
+/* Where GCC cannot vectorise a loop (a compaction; gathers, which it builds from scalar
+ * loads), projective_pixels.c and projective_bulk.c also carry AVX-512 intrinsics, taken when
+ * __builtin_cpu_supports says so; the C loops stay beside them (other CPUs, the i386 tests). */
+#define OCC_PROJ_X86 1
 #define OCC_PROJ_LANES \
     OCC_NOINLINE __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
