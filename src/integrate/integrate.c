@@ -153,6 +153,29 @@ static inline size_t filt_slot(const occ_code_t c)
     return (size_t)((c * 0x9E3779B97F4A7C15ull) >> (64u - OCC_INSERT_FILTER_BITS));
 }
 
+#if OCC_MARK_LANES
+/* The queued rays into the set, 8 at a time (occi_mwalk_batch). */
+static void flush_rays(occ_ictx_t *const x)
+{
+    x->r->voxel_visits += occi_mwalk_batch(&x->g, x->o, x->ko, x->q, x->nq, x->bs);
+    x->r->rays_cast += x->nq;
+    x->nq = 0;
+}
+
+/* One ray into the queue; a full queue is walked. */
+static void queue_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+{
+    occi_ray_end_t *const r = &x->q[x->nq++];
+    for (unsigned i = 0; i < 3u; i++) {
+        r->e[i] = e[i];
+        r->ke[i] = ke[i];
+    }
+    if (x->nq == OCC_MARK_BATCH) {
+        flush_rays(x);
+    }
+}
+#endif
+
 /* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
 static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 {
@@ -161,6 +184,12 @@ static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3]
         return;
     }
     if (x->bs != NULL) {
+#if OCC_MARK_LANES
+        if (x->lanes) {
+            queue_ray(x, e, ke);
+            return;
+        }
+#endif
         x->r->voxel_visits += occi_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
         x->r->rays_cast++;
         return;
@@ -230,23 +259,32 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3], const bool hit)
 int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
                      const bool no_hit_only)
 {
-    for (size_t i = 0; i < n; i++) {
+#if OCC_MARK_LANES
+    /* The set's bits do not depend on the rays' order: they may wait in a queue. */
+    x->lanes = x->bs != NULL && x->cbs == NULL && occi_mwalk_lanes_ok();
+    x->nq = 0;
+#endif
+    int rc = 0;
+    for (size_t i = 0; i < n && rc >= 0; i++) {
         const bool hit = occ_ictx_hit(x, i);
         if (no_hit_only && hit) {
             continue;
         }
         const float q[3] = {points[i].x, points[i].y, points[i].z};
-        const int rc = occi_ictx_point(x, q, hit);
-        if (rc < 0) {
-            return rc;
-        }
+        rc = occi_ictx_point(x, q, hit);
         if (rc == 0) {
             x->r->points_integrated++;
-        } else {
+        } else if (rc > 0) {
             x->r->points_skipped++;
         }
     }
-    return 0;
+#if OCC_MARK_LANES
+    if (x->lanes) {
+        flush_rays(x);
+        x->lanes = false;
+    }
+#endif
+    return rc < 0 ? rc : 0;
 }
 
 /* ---- DISCRETE: one ray per distinct end voxel, to its centre ------------------------------- */

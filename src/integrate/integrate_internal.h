@@ -186,6 +186,47 @@ void occi_vset_dense(const occ_vset_t *vs, const occ_code_t *hits, size_t n_hits
 size_t occi_dda_mark(const occ_raygeo_t *g, const float o[3], const float e[3],
                      const uint32_t ko[3], const uint32_t ke[3], occ_vset_t *vs);
 
+/* One ray's walk into the set (raycast.c), for the walks that step it elsewhere. */
+typedef struct {
+    occ_dda_t dd;   /* tMax, tDelta, steps (the walk keeps them in registers) */
+    occ_rr_t len;
+    occ_code_t c, ce;
+    uint32_t cc[3]; /* chunk coordinates (key >> 5) */
+    uint32_t n[3];  /* steps on each axis until the next chunk */
+} occi_mwalk_t;
+/* Set up o -> e and mark the origin's voxel; *cw: its chunk's words. False when there is
+ * nothing to walk (ko == ke; or the origin's chunk cannot be had: vs->overflow set). */
+bool occi_mwalk_start(occi_mwalk_t *w, uint64_t **cw, const occ_raygeo_t *g, const float o[3],
+                      const float e[3], const uint32_t ko[3], const uint32_t ke[3],
+                      occ_vset_t *vs);
+/* Visits of a walk from ko that ended with w's countdowns and chunk coordinates. */
+size_t occi_mwalk_visits(const occi_mwalk_t *w, const uint32_t ko[3]);
+
+/* ---- the same walk over 8 rays at once (raycast_lanes.c: x86-64 GCC with AVX-512) ---------- */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && defined(__GLIBC__) && \
+    OCC_RAY_DOUBLE
+#define OCC_MARK_LANES 1
+#else
+#define OCC_MARK_LANES 0
+#endif
+/* Rays a batch holds (occ_ictx_t's queue). */
+#define OCC_MARK_BATCH 256u
+typedef struct {
+    float e[3];
+    uint32_t ke[3];
+} occi_ray_end_t;
+#if OCC_MARK_LANES
+/* The words of the chunk the walk just entered (w->cc), or NULL: the walk ends (an overflow
+ * unless c is the end voxel's code and the chunk is off the map). */
+uint64_t *occi_mwalk_enter(const occi_mwalk_t *w, occ_vset_t *vs, occ_code_t c);
+/* Does this CPU run occi_mwalk_batch? */
+bool occi_mwalk_lanes_ok(void);
+/* occi_dda_mark(g, o, e_i, ko, ke_i, vs) for the n rays of ends: the same set, overflow and
+ * total of visits, in any order. */
+size_t occi_mwalk_batch(const occ_raygeo_t *g, const float o[3], const uint32_t ko[3],
+                        const occi_ray_end_t *ends, size_t n, occ_vset_t *vs);
+#endif
+
 /* Sorted, collapsed codes of the set merged with `hits` (sorted, unique, hit bit set): a voxel
  * in both is a hit. Writes to out (cap codes); returns the count, or SIZE_MAX when cap is too
  * small. tmp must hold n_touched codes. The touched list is reordered. */
@@ -215,6 +256,11 @@ typedef struct {
     occ_code_t win_lo, win_hi; /* sorted path: only codes in [win_lo, win_hi) are kept */
     bool chunked;          /* reserve may shrink win_hi instead of failing (bounded scratch) */
     occ_insert_result_t *r;
+#if OCC_MARK_LANES
+    bool lanes;            /* the set path's rays wait in q for occi_mwalk_batch */
+    size_t nq;
+    occi_ray_end_t q[OCC_MARK_BATCH];
+#endif
 } occ_ictx_t;
 
 /* Does point i mark its end voxel (false: its ray only clears)? */

@@ -249,13 +249,7 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
  * and the end). Same maps, 1.21x the time on scan.dat at 0.1 m: 96 instructions per slab (one
  * to three steps) against 29 per step here (make bench-profile), and a slab's three marks mostly
  * share a word, so each waits on the last one's store. */
-typedef struct {
-    occ_dda_t dd;   /* tMax, tDelta, steps (the walk keeps them in registers) */
-    occ_rr_t len;
-    occ_code_t c, ce;
-    uint32_t cc[3]; /* chunk coordinates (key >> 5) */
-    uint32_t n[3];  /* steps on each axis until the next chunk */
-} mwalk_t;
+typedef occi_mwalk_t mwalk_t;
 
 /* Steps along axis a until its key leaves its 32-voxel row. */
 static uint32_t chunk_countdown(const uint32_t k, const int step)
@@ -279,6 +273,13 @@ static OCC_ALWAYS_INLINE uint64_t *mark_enter(const mwalk_t *const w, occ_vset_t
     }
     return cw;
 }
+
+#if OCC_MARK_LANES
+uint64_t *occi_mwalk_enter(const occi_mwalk_t *const w, occ_vset_t *const vs, const occ_code_t c)
+{
+    return mark_enter(w, vs, c);
+}
+#endif
 
 /* One step on axis A (sign S, chunk countdown nA), with its rare cases: every tMax past the
  * length (stop), the next chunk (enter it, or stop). */
@@ -354,29 +355,53 @@ MARK_OCTANT(mark_npn, -1, 1, -1)
 MARK_OCTANT(mark_pnn, 1, -1, -1)
 MARK_OCTANT(mark_nnn, -1, -1, -1)
 
+bool occi_mwalk_start(occi_mwalk_t *const w, uint64_t **const cw, const occ_raygeo_t *const g,
+                      const float o[3], const float e[3], const uint32_t ko[3],
+                      const uint32_t ke[3], occ_vset_t *const vs)
+{
+    if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
+        return false;
+    }
+    for (unsigned i = 0; i < 3u; i++) {
+        w->cc[i] = ko[i] >> 5;
+    }
+    *cw = occi_vset_chunk(vs, w->cc[0], w->cc[1], w->cc[2]);
+    if (*cw == NULL) {
+        vs->overflow = true;
+        return false;
+    }
+    w->len = (occ_rr_t)dda_start(&w->dd, g, o, e, ko);
+    const occ_key_t kok = {{ko[0], ko[1], ko[2]}}, kek = {{ke[0], ke[1], ke[2]}};
+    w->c = occ_morton_encode(kok);
+    w->ce = occ_morton_encode(kek);
+    for (unsigned i = 0; i < 3u; i++) {
+        w->n[i] = chunk_countdown(ko[i], w->dd.step[i]);
+    }
+    (*cw)[(w->c >> 6) & 511u] |= bit64[w->c & 63u];
+    return true;
+}
+
+/* Visits: the origin and one per step but the last (the end, or past the length), i.e. the
+ * steps, which the chunk countdowns and chunk moves count per axis (no decode). */
+size_t occi_mwalk_visits(const occi_mwalk_t *const w, const uint32_t ko[3])
+{
+    size_t visits = 0;
+    for (unsigned i = 0; i < 3u; i++) {
+        const uint32_t c0 = ko[i] >> 5;
+        const uint32_t moves = w->dd.step[i] < 0 ? c0 - w->cc[i] : w->cc[i] - c0;
+        visits += (size_t)chunk_countdown(ko[i], w->dd.step[i]) - w->n[i] + 32u * (size_t)moves;
+    }
+    return visits;
+}
+
 size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float e[3],
                      const uint32_t ko[3], const uint32_t ke[3], occ_vset_t *const vs)
 {
     mwalk_t w;
-    if (ko[0] == ke[0] && ko[1] == ke[1] && ko[2] == ke[2]) {
+    uint64_t *cw = NULL;
+    if (!occi_mwalk_start(&w, &cw, g, o, e, ko, ke, vs)) {
         return 0;
     }
-    for (unsigned i = 0; i < 3u; i++) {
-        w.cc[i] = ko[i] >> 5;
-    }
-    uint64_t *const cw = occi_vset_chunk(vs, w.cc[0], w.cc[1], w.cc[2]);
-    if (cw == NULL) {
-        vs->overflow = true;
-        return 0;
-    }
-    w.len = (occ_rr_t)dda_start(&w.dd, g, o, e, ko);
-    const occ_key_t kok = {{ko[0], ko[1], ko[2]}}, kek = {{ke[0], ke[1], ke[2]}};
-    w.c = occ_morton_encode(kok);
-    w.ce = occ_morton_encode(kek);
-    for (unsigned i = 0; i < 3u; i++) {
-        w.n[i] = chunk_countdown(ko[i], w.dd.step[i]);
-    }
-    cw[(w.c >> 6) & 511u] |= bit64[w.c & 63u];
     switch ((w.dd.step[0] < 0 ? 1u : 0u) | (w.dd.step[1] < 0 ? 2u : 0u) |
             (w.dd.step[2] < 0 ? 4u : 0u)) {
     case 0u: mark_ppp(&w, vs, cw); break;
@@ -388,15 +413,7 @@ size_t occi_dda_mark(const occ_raygeo_t *const g, const float o[3], const float 
     case 6u: mark_pnn(&w, vs, cw); break;
     default: mark_nnn(&w, vs, cw); break;
     }
-    /* Visits: the origin and one per step but the last (the end, or past the length), i.e. the
-     * steps, which the chunk countdowns and chunk moves count per axis (no decode). */
-    size_t visits = 0;
-    for (unsigned i = 0; i < 3u; i++) {
-        const uint32_t c0 = ko[i] >> 5;
-        const uint32_t moves = w.dd.step[i] < 0 ? c0 - w.cc[i] : w.cc[i] - c0;
-        visits += (size_t)chunk_countdown(ko[i], w.dd.step[i]) - w.n[i] + 32u * (size_t)moves;
-    }
-    return visits;
+    return occi_mwalk_visits(&w, ko);
 }
 
 /* ---- public: occ_ray_keys ------------------------------------------------------------------ */
