@@ -157,7 +157,7 @@ static inline size_t filt_slot(const occ_code_t c)
 /* The queued rays into the set, 8 at a time (occi_mwalk_batch). */
 static void flush_rays(occ_ictx_t *const x)
 {
-    x->r->voxel_visits += occi_mwalk_batch(&x->g, x->o, x->ko, x->q, x->nq, x->bs);
+    x->r->voxel_visits += occi_mwalk_batch(&x->g, x->o, x->ko, x->q, x->nq, x->bs, &x->cache);
     x->r->rays_cast += x->nq;
     x->nq = 0;
 }
@@ -261,8 +261,11 @@ int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const 
 {
 #if OCC_MARK_LANES
     /* The set's bits do not depend on the rays' order: they may wait in a queue. */
-    x->lanes = x->bs != NULL && x->cbs == NULL && occi_mwalk_lanes_ok();
+    x->lanes = x->bs != NULL && x->cbs == NULL && occi_mwalk_lanes_ok(x->g.depth);
     x->nq = 0;
+    if (x->lanes) {
+        memset(&x->cache, 0, sizeof x->cache); /* the set may be new */
+    }
 #endif
     int rc = 0;
     for (size_t i = 0; i < n && rc >= 0; i++) {

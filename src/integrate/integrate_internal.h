@@ -209,22 +209,29 @@ size_t occi_mwalk_visits(const occi_mwalk_t *w, const uint32_t ko[3]);
 #else
 #define OCC_MARK_LANES 0
 #endif
-/* Rays a batch holds (occ_ictx_t's queue). */
-#define OCC_MARK_BATCH 256u
+/* Rays a batch holds (occ_ictx_t's queue), and chunks the lanes' cache holds (a power of 2). */
+#define OCC_MARK_BATCH 128u
+#define OCC_MARK_CACHE 256u
 typedef struct {
     float e[3];
     uint32_t ke[3];
 } occi_ray_end_t;
+/* Chunk code + 1 (0: empty) -> the chunk's words, direct-mapped. */
+typedef struct {
+    uint64_t key[OCC_MARK_CACHE], ptr[OCC_MARK_CACHE];
+} occi_mwalk_cache_t;
 #if OCC_MARK_LANES
 /* The words of the chunk the walk just entered (w->cc), or NULL: the walk ends (an overflow
  * unless c is the end voxel's code and the chunk is off the map). */
 uint64_t *occi_mwalk_enter(const occi_mwalk_t *w, occ_vset_t *vs, occ_code_t c);
-/* Does this CPU run occi_mwalk_batch? */
-bool occi_mwalk_lanes_ok(void);
-/* occi_dda_mark(g, o, e_i, ko, ke_i, vs) for the n rays of ends: the same set, overflow and
- * total of visits, in any order. */
+/* Does this CPU run occi_mwalk_batch, on a map of this depth (below 21: a step off the map
+ * shows in the code)? */
+bool occi_mwalk_lanes_ok(unsigned depth);
+/* occi_dda_mark(g, o, e_i, ko, ke_i, vs) for the n <= OCC_MARK_BATCH rays of ends: the same
+ * set, chunks, overflow and total of visits. cache: zeros when vs is new, then kept with it. */
 size_t occi_mwalk_batch(const occ_raygeo_t *g, const float o[3], const uint32_t ko[3],
-                        const occi_ray_end_t *ends, size_t n, occ_vset_t *vs);
+                        const occi_ray_end_t *ends, size_t n, occ_vset_t *vs,
+                        occi_mwalk_cache_t *cache);
 #endif
 
 /* Sorted, collapsed codes of the set merged with `hits` (sorted, unique, hit bit set): a voxel
@@ -260,6 +267,7 @@ typedef struct {
     bool lanes;            /* the set path's rays wait in q for occi_mwalk_batch */
     size_t nq;
     occi_ray_end_t q[OCC_MARK_BATCH];
+    occi_mwalk_cache_t cache; /* its chunks of bs */
 #endif
 } occ_ictx_t;
 
