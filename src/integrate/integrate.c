@@ -176,6 +176,18 @@ static void queue_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3
 }
 #endif
 
+void occi_ictx_set_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+{
+#if OCC_MARK_LANES
+    if (x->lanes) {
+        queue_ray(x, e, ke);
+        return;
+    }
+#endif
+    x->r->voxel_visits += occi_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
+    x->r->rays_cast++;
+}
+
 /* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
 static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 {
@@ -184,14 +196,7 @@ static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3]
         return;
     }
     if (x->bs != NULL) {
-#if OCC_MARK_LANES
-        if (x->lanes) {
-            queue_ray(x, e, ke);
-            return;
-        }
-#endif
-        x->r->voxel_visits += occi_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
-        x->r->rays_cast++;
+        occi_ictx_set_ray(x, e, ke);
         return;
     }
     occ_code_t *const base = x->a + x->n;
@@ -256,17 +261,35 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3], const bool hit)
     return 0;
 }
 
-int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
-                     const bool no_hit_only)
+void occi_ictx_lanes_begin(occ_ictx_t *const x)
 {
 #if OCC_MARK_LANES
-    /* The set's bits do not depend on the rays' order: they may wait in a queue. */
     x->lanes = x->bs != NULL && x->cbs == NULL && occi_mwalk_lanes_ok(x->g.depth);
     x->nq = 0;
     if (x->lanes) {
         memset(&x->cache, 0, sizeof x->cache); /* the set may be new */
     }
+#else
+    (void)x;
 #endif
+}
+
+void occi_ictx_lanes_end(occ_ictx_t *const x)
+{
+#if OCC_MARK_LANES
+    if (x->lanes) {
+        flush_rays(x);
+        x->lanes = false;
+    }
+#else
+    (void)x;
+#endif
+}
+
+int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const size_t n,
+                     const bool no_hit_only)
+{
+    occi_ictx_lanes_begin(x);
     int rc = 0;
     for (size_t i = 0; i < n && rc >= 0; i++) {
         const bool hit = occ_ictx_hit(x, i);
@@ -281,12 +304,7 @@ int occi_ictx_points(occ_ictx_t *const x, const occ_vec3_t *const points, const 
             x->r->points_skipped++;
         }
     }
-#if OCC_MARK_LANES
-    if (x->lanes) {
-        flush_rays(x);
-        x->lanes = false;
-    }
-#endif
+    occi_ictx_lanes_end(x);
     return rc < 0 ? rc : 0;
 }
 
@@ -338,7 +356,9 @@ static int run_discrete(occ_ictx_t *const x, const occ_code_t *const ends, const
 {
     const uint64_t bx = (uint64_t)(x->box_hi[0] - x->box_lo[0]) + 1u;
     const uint64_t by = (uint64_t)(x->box_hi[1] - x->box_lo[1]) + 1u;
-    for (size_t i = 0; i < n; i++) {
+    occi_ictx_lanes_begin(x);
+    int rc = 0;
+    for (size_t i = 0; i < n && rc >= 0; i++) {
         occ_key_t k;
         if ((ends[i] >> 63) != 0u) {
             k = occ_morton_decode(ends[i] & ~OCC_CODE_HIT_BIT);
@@ -349,12 +369,10 @@ static int run_discrete(occ_ictx_t *const x, const occ_code_t *const ends, const
         }
         const float c[3] = {occi_raygeo_center(&x->g, k.k[0]), occi_raygeo_center(&x->g, k.k[1]),
                             occi_raygeo_center(&x->g, k.k[2])};
-        const int rc = occi_ictx_point(x, c, true);
-        if (rc < 0) {
-            return rc;
-        }
+        rc = occi_ictx_point(x, c, true);
     }
-    return 0;
+    occi_ictx_lanes_end(x);
+    return rc < 0 ? rc : 0;
 }
 
 /* ---- method dispatch and the scan's box ----------------------------------------------------- */

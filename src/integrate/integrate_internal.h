@@ -284,6 +284,14 @@ static inline void occ_ictx_note(occ_ictx_t *x, size_t na, size_t nb)
     x->b_hwm = nb > x->b_hwm ? nb : x->b_hwm;
 }
 
+/* From here to occi_ictx_lanes_end, rays into the set (occi_ictx_set_ray) wait in a queue and
+ * are walked 8 at a time where the CPU can (OCC_MARK_LANES): the set's bits, its chunks and the
+ * visits do not depend on the rays' order. The end walks what waits. */
+void occi_ictx_lanes_begin(occ_ictx_t *x);
+void occi_ictx_lanes_end(occ_ictx_t *x);
+/* computeRayKeys(o, e) into the set x->bs (keys ko, ke valid), counted in x->r. */
+void occi_ictx_set_ray(occ_ictx_t *x, const float e[3], const uint32_t ke[3]);
+
 /* Make room for `need` more codes in a (sorting and collapsing what is there if needed). */
 bool occi_ictx_reserve(occ_ictx_t *x, size_t need);
 /* Emit one voxel code (free, or hit with OCC_CODE_HIT_BIT); room must have been reserved. */

@@ -41,8 +41,7 @@ static const unsigned PA[3] = {0u, 0u, 1u}, PB[3] = {1u, 2u, 2u};
 static void cast_one(occ_ictx_t *const x, const occ_vec3_t p, const uint32_t ke[3])
 {
     const float e[3] = {p.x, p.y, p.z};
-    x->r->voxel_visits += occi_dda_mark(&x->g, x->o, e, x->ko, ke, x->bs);
-    x->r->rays_cast++;
+    occi_ictx_set_ray(x, e, ke);
 }
 
 /* A ray's DDA takes its m_a-th a-crossing before its m_b-th b-crossing iff
@@ -464,10 +463,13 @@ bool occi_superray_run(occ_ictx_t *const x, const occ_vec3_t *const points, cons
     sr_ws_t ws;
     carve_scratch(x, n, &c, &ws);
     size_t m = 0;
-    if (!bin_points(x, points, n, &c, &m)) {
-        return false;
+    occi_ictx_lanes_begin(x);
+    bool ok = bin_points(x, points, n, &c, &m);
+    if (ok) {
+        const uint64_t cells = c.bx * c.by * ((uint64_t)(x->box_hi[2] - x->box_lo[2]) + 1u);
+        ok = cells <= 2u * (uint64_t)m ? run_cells_counted(x, points, &c, m, cells, k_min, &ws)
+                                       : run_cells_sorted(x, points, &c, m, k_min, &ws);
     }
-    const uint64_t cells = c.bx * c.by * ((uint64_t)(x->box_hi[2] - x->box_lo[2]) + 1u);
-    return cells <= 2u * (uint64_t)m ? run_cells_counted(x, points, &c, m, cells, k_min, &ws)
-                                     : run_cells_sorted(x, points, &c, m, k_min, &ws);
+    occi_ictx_lanes_end(x);
+    return ok;
 }
