@@ -248,7 +248,10 @@ size_t occi_dda_codes(const occ_raygeo_t *const g, const float o[3], const float
  * each major one from three compares, three marks per slab, this loop at ties, chunk crossings
  * and the end). Same maps, 1.21x the time on scan.dat at 0.1 m: 96 instructions per slab (one
  * to three steps) against 29 per step here (make bench-profile), and a slab's three marks mostly
- * share a word, so each waits on the last one's store. */
+ * share a word, so each waits on the last one's store.
+ * Where the CPU has AVX-512 (x86-64 GCC), the insert paths walk their rays 8 at once instead
+ * (raycast_lanes.c, through occi_ictx_set_ray): the steps below, the set-up and the chunk entry
+ * (occi_mwalk_*) are shared with it. */
 typedef occi_mwalk_t mwalk_t;
 
 /* Steps along axis a until its key leaves its 32-voxel row. */
