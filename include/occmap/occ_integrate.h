@@ -153,7 +153,9 @@ typedef enum {
      * the set to the tree by bricks) the gain is smaller: make bench on nine commits from
      * 29878c6 to 4f0089c (AMD EPYC, then Intel Xeon from 28c6fa7) gave 1.24x to 1.39x at 0.2 m
      * and 0.98x to 1.03x at 0.1 m; on 2af980b 1.30x [1.27, 1.33] and 1.02x [1.02, 1.05],
-     * on d80dd40 1.31x [1.31, 1.32] and 1.03x [1.02, 1.04] (README, Performance).
+     * on d80dd40 1.31x [1.31, 1.32] and 1.03x [1.02, 1.04]; with the 8-lane walk (AVX-512,
+     * raycast_lanes.c) on 539017a 1.31x [1.30, 1.32] and 1.00x [0.989, 1.00] (README,
+     * Performance).
      * When not: at 0.1 m or finer, and for laser scans (scan.dat, spherical_scan.graph at
      * 0.2 / 0.1 / 0.05 m: 0.95x to 1.11x over three runs, 1.0 to 1.8 points per traversal),
      * it buys nothing over SIMPLE. If OctoMap's discretize = true map will do, DISCRETE is
