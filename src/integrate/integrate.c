@@ -176,7 +176,8 @@ static void queue_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3
 }
 #endif
 
-void occi_ictx_set_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+/* occi_ictx_set_ray's body, inlined into ictx_ray (no call more per ray on firmware). */
+static OCC_ALWAYS_INLINE void set_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 {
 #if OCC_MARK_LANES
     if (x->lanes) {
@@ -188,6 +189,11 @@ void occi_ictx_set_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[
     x->r->rays_cast++;
 }
 
+void occi_ictx_set_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
+{
+    set_ray(x, e, ke);
+}
+
 /* Traverse o -> e (keys ko, ke already valid) and emit its free voxels through the filter. */
 static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3])
 {
@@ -196,7 +202,7 @@ static void ictx_ray(occ_ictx_t *const x, const float e[3], const uint32_t ke[3]
         return;
     }
     if (x->bs != NULL) {
-        occi_ictx_set_ray(x, e, ke);
+        set_ray(x, e, ke);
         return;
     }
     occ_code_t *const base = x->a + x->n;

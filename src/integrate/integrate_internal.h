@@ -194,11 +194,6 @@ typedef struct {
     uint32_t cc[3]; /* chunk coordinates (key >> 5) */
     uint32_t n[3];  /* steps on each axis until the next chunk */
 } occi_mwalk_t;
-/* Set up o -> e and mark the origin's voxel; *cw: its chunk's words. False when there is
- * nothing to walk (ko == ke; or the origin's chunk cannot be had: vs->overflow set). */
-bool occi_mwalk_start(occi_mwalk_t *w, uint64_t **cw, const occ_raygeo_t *g, const float o[3],
-                      const float e[3], const uint32_t ko[3], const uint32_t ke[3],
-                      occ_vset_t *vs);
 /* Visits of a walk from ko that ended with w's countdowns and chunk coordinates. */
 size_t occi_mwalk_visits(const occi_mwalk_t *w, const uint32_t ko[3]);
 
@@ -221,6 +216,11 @@ typedef struct {
     uint64_t key[OCC_MARK_CACHE], ptr[OCC_MARK_CACHE];
 } occi_mwalk_cache_t;
 #if OCC_MARK_LANES
+/* Set up o -> e and mark the origin's voxel; *cw: its chunk's words. False when there is
+ * nothing to walk (ko == ke; or the origin's chunk cannot be had: vs->overflow set). */
+bool occi_mwalk_start(occi_mwalk_t *w, uint64_t **cw, const occ_raygeo_t *g, const float o[3],
+                      const float e[3], const uint32_t ko[3], const uint32_t ke[3],
+                      occ_vset_t *vs);
 /* The words of the chunk the walk just entered (w->cc), or NULL: the walk ends (an overflow
  * unless c is the end voxel's code and the chunk is off the map). */
 uint64_t *occi_mwalk_enter(const occi_mwalk_t *w, occ_vset_t *vs, occ_code_t c);
