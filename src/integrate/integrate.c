@@ -24,11 +24,14 @@ typedef char fixed_term_matches_header[OCC_INSERT_SCRATCH_FIXED_BYTES == 7u + FI
 #ifdef OCC_TESTING
 occi_insert_probe_t occi_insert_probe;
 bool occi_insert_bricks_off;
+bool occi_insert_lanes_off;
 #define BRICKS_OFF() occi_insert_bricks_off
+#define LANES_OFF() occi_insert_lanes_off
 #define PROBE(field) (occi_insert_probe.field++)
 #define PROBE_RESET() memset(&occi_insert_probe, 0, sizeof occi_insert_probe)
 #else
 #define BRICKS_OFF() false
+#define LANES_OFF() false
 #define PROBE(field) ((void)0)
 #define PROBE_RESET() ((void)0)
 #endif
@@ -270,7 +273,8 @@ int occi_ictx_point(occ_ictx_t *const x, const float p[3], const bool hit)
 void occi_ictx_lanes_begin(occ_ictx_t *const x)
 {
 #if OCC_MARK_LANES
-    x->lanes = x->bs != NULL && x->cbs == NULL && occi_mwalk_lanes_ok(x->g.depth);
+    x->lanes = x->bs != NULL && x->cbs == NULL && !LANES_OFF() &&
+               occi_mwalk_lanes_ok(x->g.depth);
     x->nq = 0;
     if (x->lanes) {
         memset(&x->cache, 0, sizeof x->cache); /* the set may be new */

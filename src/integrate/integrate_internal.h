@@ -314,6 +314,9 @@ extern occi_insert_probe_t occi_insert_probe;
 /* Test builds only: true sends the voxel set the way of the codes (one batch or pieces), so
  * that tests reach those paths where bricks would do. */
 extern bool occi_insert_bricks_off;
+/* Test builds only: true keeps every ray on the scalar walk (occi_dda_mark), so that tests can
+ * hold the 8-lane walk against it. */
+extern bool occi_insert_lanes_off;
 #endif
 
 /* FAST_DISCRETE's ray (fastdiscrete.c): coarse marching, then fine DDA near the end. */
