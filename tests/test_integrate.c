@@ -340,7 +340,8 @@ static void test_lanes_equal_scalar(void **state)
 {
     (void)state;
 #if OCC_MARK_LANES
-    printf("  8-lane walk on this CPU: %s\n", occi_mwalk_lanes_ok(16u) ? "yes" : "no (both sides scalar)");
+    printf("  8-lane walk on this CPU: %s\n",
+           occi_mwalk_lanes_ok(16u) ? "yes" : "no (both sides scalar)");
 #else
     printf("  8-lane walk: not built here (both sides scalar)\n");
 #endif
@@ -352,27 +353,25 @@ static void test_lanes_equal_scalar(void **state)
                                           OCC_INSERT_SUPER_RAYS};
     const it_cloud_t *const clouds[2] = {&scan, &tum};
     const float res[2] = {0.05f, 0.1f};
-    for (unsigned ci = 0; ci < 2u; ci++) {
-        for (unsigned mi = 0; mi < 3u; mi++) {
-            for (unsigned ri = 0; ri < 2u; ri++) {
-                const lanes_run_t full = lanes_run(clouds[ci], res[ri], meths[mi], SCRATCH_BYTES, true);
-                assert_int_equal(full.e, OCC_OK);
-                /* so little that the set cannot hold the scan's chunks */
-                const size_t sizes[2] = {SCRATCH_BYTES, full.r.scratch_used / 2u};
-                for (unsigned si = 0; si < 2u; si++) {
-                    const lanes_run_t a = lanes_run(clouds[ci], res[ri], meths[mi], sizes[si], false);
-                    const lanes_run_t b = lanes_run(clouds[ci], res[ri], meths[mi], sizes[si], true);
-                    printf("  %s %.2f m method %d scratch %zu: %s, %zu visits, %zu rays, %zu bytes "
-                           "used, %zu nodes\n",
-                           ci == 0u ? "scan.dat" : "tum", (double)res[ri], (int)meths[mi], sizes[si],
-                           occ_err_str(a.e), a.r.voxel_visits, a.r.rays_cast, a.r.scratch_used,
-                           a.nodes);
-                    assert_int_equal(a.e, b.e);
-                    assert_memory_equal(&a.r, &b.r, sizeof a.r);
-                    assert_true(a.digest == b.digest);
-                    assert_int_equal(a.nodes, b.nodes);
-                }
-            }
+    for (unsigned k = 0; k < 12u; k++) { /* cloud, method, resolution */
+        const it_cloud_t *const c = clouds[k / 6u];
+        const occ_insert_method_t meth = meths[(k / 2u) % 3u];
+        const float r = res[k % 2u];
+        const lanes_run_t full = lanes_run(c, r, meth, SCRATCH_BYTES, true);
+        assert_int_equal(full.e, OCC_OK);
+        /* so little that the set cannot hold the scan's chunks */
+        const size_t sizes[2] = {SCRATCH_BYTES, full.r.scratch_used / 2u};
+        for (unsigned si = 0; si < 2u; si++) {
+            const lanes_run_t a = lanes_run(c, r, meth, sizes[si], false);
+            const lanes_run_t b = lanes_run(c, r, meth, sizes[si], true);
+            printf("  %s %.2f m method %d scratch %zu: %s, %zu visits, %zu rays, %zu bytes used, "
+                   "%zu nodes\n",
+                   k < 6u ? "scan.dat" : "tum", (double)r, (int)meth, sizes[si], occ_err_str(a.e),
+                   a.r.voxel_visits, a.r.rays_cast, a.r.scratch_used, a.nodes);
+            assert_int_equal(a.e, b.e);
+            assert_memory_equal(&a.r, &b.r, sizeof a.r);
+            assert_true(a.digest == b.digest);
+            assert_int_equal(a.nodes, b.nodes);
         }
     }
     free(scan.p);

@@ -161,8 +161,8 @@ __attribute__((target("avx512f"))) static __m512 centre16(const float p[3][3][4]
     const __m512 px = _mm512_castps128_ps512(_mm_loadu_ps(p[0][b]));
     const __m512 py = _mm512_castps128_ps512(_mm_loadu_ps(p[1][b]));
     const __m512 pz = _mm512_castps128_ps512(_mm_loadu_ps(p[2][b]));
-    return _mm512_add_ps(_mm512_add_ps(_mm512_permutexvar_ps(ix, px), _mm512_permutexvar_ps(iy, py)),
-                         _mm512_permutexvar_ps(iz, pz));
+    const __m512 xy = _mm512_add_ps(_mm512_permutexvar_ps(ix, px), _mm512_permutexvar_ps(iy, py));
+    return _mm512_add_ps(xy, _mm512_permutexvar_ps(iz, pz));
 }
 
 /* Lane m's offset (0..3) on the axis whose bits are bit0 and bit0 + 3 of m. */
@@ -170,7 +170,8 @@ __attribute__((target("avx512f"))) static __m512i offset16(const __m512i m, cons
 {
     const __m512i one = _mm512_set1_epi32(1);
     const __m512i lo = _mm512_and_si512(_mm512_srli_epi32(m, bit0), one);
-    const __m512i hi = _mm512_and_si512(_mm512_srli_epi32(m, bit0 + 2u), _mm512_add_epi32(one, one));
+    const __m512i two = _mm512_add_epi32(one, one);
+    const __m512i hi = _mm512_and_si512(_mm512_srli_epi32(m, bit0 + 2u), two);
     return _mm512_or_si512(lo, hi);
 }
 
@@ -193,8 +194,10 @@ __attribute__((target("avx512f"))) static uint64_t rule_avx512(const occ_proj_t 
         const __m512 qa = centre16(p, 0u, ox, oy, oz), qb = centre16(p, 1u, ox, oy, oz);
         const __m512 qc = centre16(p, 2u, ox, oy, oz);
         const __m512 iz = _mm512_div_ps(one, qc);
-        const __m512 u = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(fx, _mm512_mul_ps(qa, iz)), cx), half);
-        const __m512 v = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(fy, _mm512_mul_ps(qb, iz)), cy), half);
+        const __m512 u = /* fx (qa iz) + cx + 0.5, left to right */
+            _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(fx, _mm512_mul_ps(qa, iz)), cx), half);
+        const __m512 v =
+            _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(fy, _mm512_mul_ps(qb, iz)), cy), half);
         const __m512 r2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(qa, qa), _mm512_mul_ps(qb, qb)),
                                         _mm512_mul_ps(qc, qc));
         __mmask16 ok = _mm512_cmp_ps_mask(qc, zero, _CMP_GT_OQ);

@@ -311,7 +311,8 @@ static bool add_hit(occ_proj_t *const x, const occ_code_t c)
 
 /* The flagged columns' indices to the front of nw, in order; their count. In place and
  * without branches, as the flags fall at random: index n <= i is read before it is written. */
-static uint32_t compact_scalar(int32_t *const nw, const uint32_t from, uint32_t n, const uint32_t n4)
+static uint32_t compact_scalar(int32_t *const nw, const uint32_t from, uint32_t n,
+                               const uint32_t n4)
 {
     for (uint32_t i = from; i < n4; i++) {
         const int32_t f = nw[i];
@@ -346,7 +347,8 @@ __attribute__((target("avx512f"))) static uint32_t compact_avx512(int32_t *const
 
 static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)
 {
-    return __builtin_cpu_supports("avx512f") ? compact_avx512(nw, n4) : compact_scalar(nw, 0u, 0u, n4);
+    return __builtin_cpu_supports("avx512f") ? compact_avx512(nw, n4)
+                                             : compact_scalar(nw, 0u, 0u, n4);
 }
 #else
 static uint32_t compact_flags(int32_t *const nw, const uint32_t n4)

@@ -115,11 +115,9 @@ static size_t lane_enter(lanes_t *const s, const unsigned l, const bool end, ray
 /* The vector loop (no call in it: every vector register would be saved around one). Returns
  * when every lane is idle (0) or with the lanes that need lane_enter; *end says which of them
  * are at their end voxel. Adds the visits of the rays that ended to *visits. */
-__attribute__((target("avx512f"))) static unsigned walk_lanes(lanes_t *const s, rays_t *const r,
-                                                              const occi_mwalk_cache_t *const cache,
-                                                              const uint64_t off_map,
-                                                              unsigned *const end_out,
-                                                              size_t *const visits)
+__attribute__((target("avx512f"))) static unsigned
+walk_lanes(lanes_t *const s, rays_t *const r, const occi_mwalk_cache_t *const cache,
+           const uint64_t off_map, unsigned *const end_out, size_t *const visits)
 {
     const __m512i one = _mm512_set1_epi64(1), zero = _mm512_setzero_si512();
     const __m512i m0x = _mm512_set1_epi64((long long)DILATED_X);
@@ -158,16 +156,15 @@ __attribute__((target("avx512f"))) static unsigned walk_lanes(lanes_t *const s, 
         const unsigned past = (unsigned)(_mm512_mask_cmp_pd_mask(lv, t0, len, _CMP_GT_OQ) &
                                          _mm512_cmp_pd_mask(t1, len, _CMP_GT_OQ) &
                                          _mm512_cmp_pd_mask(t2, len, _CMP_GT_OQ));
-        const unsigned chunk = (unsigned)_mm512_mask_test_epi64_mask(
-                                   lv, _mm512_srli_epi64(_mm512_xor_si512(cn, c), 15), _mm512_set1_epi64(-1)) &
-                               ~past;
+        const __m512i moved = _mm512_srli_epi64(_mm512_xor_si512(cn, c), 15); /* chunk bits */
+        const unsigned chunk = (unsigned)_mm512_mask_test_epi64_mask(lv, moved, moved) & ~past;
         c = cn;
         end = (unsigned)_mm512_mask_cmpeq_epi64_mask(lv, c, ce) & ~past;
         if (chunk != 0u) { /* its words from the cache; a miss or off the map: lane_enter */
             const __m512i key = _mm512_srli_epi64(c, 15);
-            const __m512i slot = _mm512_and_si512(
-                _mm512_xor_si512(_mm512_xor_si512(key, _mm512_srli_epi64(key, 8)), _mm512_srli_epi64(key, 16)),
-                slots);
+            const __m512i fold = _mm512_xor_si512(key, _mm512_srli_epi64(key, 8));
+            const __m512i slot = /* cache_slot() */
+                _mm512_and_si512(_mm512_xor_si512(fold, _mm512_srli_epi64(key, 16)), slots);
             const __mmask8 on = (__mmask8)(chunk & ~(unsigned)_mm512_test_epi64_mask(c, off));
             const __m512i got = _mm512_mask_i64gather_epi64(zero, on, slot, cache->key, 8);
             const __mmask8 hit = _mm512_mask_cmpeq_epi64_mask(on, got, _mm512_add_epi64(key, one));
