@@ -17,7 +17,6 @@
 #include "occmap/host/occ_scan.h"
 #include "occmap/occ_evict.h"
 #include "integrate/coarse_internal.h"
-#include "integrate/integrate_internal.h"
 #include "support/oracle_rays.h"
 #include "support/integrate_fixture.h"
 #include "support/leak_check.h"
@@ -307,77 +306,6 @@ static void test_sorted_path(void **state)
     free(c.p);
 }
 
-/* One insert into a fresh map: its error, result and map digest. */
-typedef struct {
-    occ_err_t e;
-    occ_insert_result_t r;
-    uint64_t digest;
-    size_t nodes;
-} lanes_run_t;
-
-static lanes_run_t lanes_run(const it_cloud_t *c, const float res, const occ_insert_method_t meth,
-                             const size_t bytes, const bool lanes_off)
-{
-    occ_map_t m;
-    it_init_map(&m, arena_a, ARENA_BYTES, res);
-    occ_insert_params_t p = occ_insert_params_default();
-    p.method = meth;
-    lanes_run_t out;
-    memset(&out, 0, sizeof out);
-    occi_insert_lanes_off = lanes_off;
-    out.e = occ_map_insert_cloud(&m, &c->origin, c->p, c->n, &p, scratch, bytes, &out.r);
-    occi_insert_lanes_off = false;
-    out.digest = it_map_digest(&m, &out.nodes);
-    return out;
-}
-
-/* The 8-lane walk (raycast_lanes.c, where the CPU has AVX-512) against the scalar walk on the
- * same scans: the same error, every counter (visits, rays, scratch used: the set's chunks),
- * the same map; with all the scratch, and with so little that the voxel set runs full (its
- * overflow, then the sorted path or windows). Where the lanes cannot run, both sides are the
- * scalar walk (printed). */
-static void test_lanes_equal_scalar(void **state)
-{
-    (void)state;
-#if OCC_MARK_LANES
-    printf("  8-lane walk on this CPU: %s\n",
-           occi_mwalk_lanes_ok(16u) ? "yes" : "no (both sides scalar)");
-#else
-    printf("  8-lane walk: not built here (both sides scalar)\n");
-#endif
-    it_cloud_t scan, tum;
-    if (!it_load_scan(&scan, 7) || !it_load_tum(&tum, 4u, 3u)) {
-        skip();
-    }
-    const occ_insert_method_t meths[3] = {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE,
-                                          OCC_INSERT_SUPER_RAYS};
-    const it_cloud_t *const clouds[2] = {&scan, &tum};
-    const float res[2] = {0.05f, 0.1f};
-    for (unsigned k = 0; k < 12u; k++) { /* cloud, method, resolution */
-        const it_cloud_t *const c = clouds[k / 6u];
-        const occ_insert_method_t meth = meths[(k / 2u) % 3u];
-        const float r = res[k % 2u];
-        const lanes_run_t full = lanes_run(c, r, meth, SCRATCH_BYTES, true);
-        assert_int_equal(full.e, OCC_OK);
-        /* so little that the set cannot hold the scan's chunks */
-        const size_t sizes[2] = {SCRATCH_BYTES, full.r.scratch_used / 2u};
-        for (unsigned si = 0; si < 2u; si++) {
-            const lanes_run_t a = lanes_run(c, r, meth, sizes[si], false);
-            const lanes_run_t b = lanes_run(c, r, meth, sizes[si], true);
-            printf("  %s %.2f m method %d scratch %zu: %s, %zu visits, %zu rays, %zu bytes used, "
-                   "%zu nodes\n",
-                   k < 6u ? "scan.dat" : "tum", (double)r, (int)meth, sizes[si], occ_err_str(a.e),
-                   a.r.voxel_visits, a.r.rays_cast, a.r.scratch_used, a.nodes);
-            assert_int_equal(a.e, b.e);
-            assert_memory_equal(&a.r, &b.r, sizeof a.r);
-            assert_true(a.digest == b.digest);
-            assert_int_equal(a.nodes, b.nodes);
-        }
-    }
-    free(scan.p);
-    free(tum.p);
-}
-
 /* coarse.c against the per-voxel update it stands for. */
 static void test_coarse_apply(void **state)
 {
@@ -467,7 +395,6 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_fast_discrete, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_sorted_path, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_coarse_apply, it_timer_setup, it_timer_teardown),
-        cmocka_unit_test_setup_teardown(test_lanes_equal_scalar, it_timer_setup, it_timer_teardown),
     };
     const int rc = cmocka_run_group_tests(tests, NULL, NULL);
     free(arena_a);

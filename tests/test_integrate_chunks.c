@@ -558,6 +558,80 @@ static void check_vset(const unsigned depth)
     free(hist);
 }
 
+/* One insert into a fresh map: its error, result and map digest. */
+typedef struct {
+    occ_err_t e;
+    occ_insert_result_t r;
+    uint64_t digest;
+    size_t nodes;
+} lanes_run_t;
+
+static lanes_run_t lanes_run(const it_cloud_t *c, const float res, const occ_insert_method_t meth,
+                             const size_t bytes, const bool lanes_off)
+{
+    occ_map_t m;
+    it_init_map(&m, arena_a, ARENA_BYTES, res);
+    occ_insert_params_t p = occ_insert_params_default();
+    p.method = meth;
+    lanes_run_t out;
+    memset(&out, 0, sizeof out);
+    occi_insert_lanes_off = lanes_off;
+    out.e = occ_map_insert_cloud(&m, &c->origin, c->p, c->n, &p, scratch, bytes, &out.r);
+    occi_insert_lanes_off = false;
+    out.digest = it_map_digest(&m, &out.nodes);
+    return out;
+}
+
+/* The 8-lane walk (raycast_lanes.c, where the CPU has AVX-512) against the scalar walk on the
+ * same scans: the same error, every counter (visits, rays, scratch used: the set's chunks),
+ * the same map; with all the scratch, and with so little that the voxel set runs full (its
+ * overflow, then the sorted path or windows). Where the lanes cannot run (no AVX-512, the
+ * i386 build) there is nothing to compare: it says so and returns. */
+static void test_lanes_equal_scalar(void **state)
+{
+    (void)state;
+#if OCC_MARK_LANES
+    if (!occi_mwalk_lanes_ok(16u)) {
+        printf("  no AVX-512 on this CPU: every walk is the scalar one, nothing to compare\n");
+        return;
+    }
+#else
+    printf("  the 8-lane walk is not built here: nothing to compare\n");
+    return;
+#endif
+    it_cloud_t scan, tum;
+    if (!it_load_scan(&scan, 7) || !it_load_tum(&tum, 4u, 3u)) {
+        skip();
+    }
+    const occ_insert_method_t meths[3] = {OCC_INSERT_SIMPLE, OCC_INSERT_DISCRETE,
+                                          OCC_INSERT_SUPER_RAYS};
+    const it_cloud_t *const clouds[2] = {&scan, &tum};
+    const float res[2] = {0.05f, 0.1f};
+    for (unsigned k = 0; k < 12u; k++) { /* cloud, method, resolution */
+        const it_cloud_t *const c = clouds[k / 6u];
+        const occ_insert_method_t meth = meths[(k / 2u) % 3u];
+        const float r = res[k % 2u];
+        const lanes_run_t full = lanes_run(c, r, meth, SCRATCH_BYTES, true);
+        assert_int_equal(full.e, OCC_OK);
+        /* so little that the set cannot hold the scan's chunks */
+        const size_t sizes[2] = {SCRATCH_BYTES, full.r.scratch_used / 2u};
+        for (unsigned si = 0; si < 2u; si++) {
+            const lanes_run_t a = lanes_run(c, r, meth, sizes[si], false);
+            const lanes_run_t b = lanes_run(c, r, meth, sizes[si], true);
+            printf("  %s %.2f m method %d scratch %zu: %s, %zu visits, %zu rays, %zu bytes used, "
+                   "%zu nodes\n",
+                   k < 6u ? "scan.dat" : "tum", (double)r, (int)meth, sizes[si], occ_err_str(a.e),
+                   a.r.voxel_visits, a.r.rays_cast, a.r.scratch_used, a.nodes);
+            assert_int_equal(a.e, b.e);
+            assert_memory_equal(&a.r, &b.r, sizeof a.r);
+            assert_true(a.digest == b.digest);
+            assert_int_equal(a.nodes, b.nodes);
+        }
+    }
+    free(scan.p);
+    free(tum.p);
+}
+
 static void test_vset_dense_read_need(void **state)
 {
     (void)state;
@@ -579,6 +653,8 @@ int main(void)
                                         it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_simple_8mib, it_timer_setup, it_timer_teardown),
         cmocka_unit_test_setup_teardown(test_pool_full_unchanged, it_timer_setup,
+                                        it_timer_teardown),
+        cmocka_unit_test_setup_teardown(test_lanes_equal_scalar, it_timer_setup,
                                         it_timer_teardown),
     };
     const it_buffers_t b = {&arena_a, &arena_b, &scratch, ARENA_BYTES, SCRATCH_BYTES};
