@@ -204,6 +204,7 @@ size_t occi_mwalk_visits(const occi_mwalk_t *w, const uint32_t ko[3]);
 #else
 #define OCC_MARK_LANES 0
 #endif
+#if OCC_MARK_LANES
 /* Rays a batch holds (occ_ictx_t's queue), and chunks the lanes' cache holds (a power of 2). */
 #define OCC_MARK_BATCH 128u
 #define OCC_MARK_CACHE 256u
@@ -215,7 +216,6 @@ typedef struct {
 typedef struct {
     uint64_t key[OCC_MARK_CACHE], ptr[OCC_MARK_CACHE];
 } occi_mwalk_cache_t;
-#if OCC_MARK_LANES
 /* Set up o -> e and mark the origin's voxel; *cw: its chunk's words. False when there is
  * nothing to walk (ko == ke; or the origin's chunk cannot be had: vs->overflow set). */
 bool occi_mwalk_start(occi_mwalk_t *w, uint64_t **cw, const occ_raygeo_t *g, const float o[3],

@@ -112,130 +112,204 @@ static size_t lane_enter(lanes_t *const s, const unsigned l, const bool end, ray
     return visits;
 }
 
-/* The vector loop (no call in it: every vector register would be saved around one). Returns
- * when every lane is idle (0) or with the lanes that need lane_enter; *end says which of them
- * are at their end voxel. Adds the visits of the rays that ended to *visits. */
+/* The pieces of walk_lanes below are inlined into it (no call in its loop: every vector
+ * register would be saved around one). */
+#define LANES_FN OCC_ALWAYS_INLINE __attribute__((target("avx512f")))
+
+/* The lanes as the vector loop holds them (lanes_t's fields, one vector each). */
+typedef struct {
+    __m512d t0, t1, t2, d0, d1, d2, len;
+    __m512i c, ce, cw, a0, a1, a2, steps;
+} vec_t;
+
+LANES_FN static inline void vec_load(vec_t *const v, const lanes_t *const s)
+{
+    v->t0 = _mm512_loadu_pd(s->t[0]);
+    v->t1 = _mm512_loadu_pd(s->t[1]);
+    v->t2 = _mm512_loadu_pd(s->t[2]);
+    v->d0 = _mm512_loadu_pd(s->d[0]);
+    v->d1 = _mm512_loadu_pd(s->d[1]);
+    v->d2 = _mm512_loadu_pd(s->d[2]);
+    v->len = _mm512_loadu_pd(s->len);
+    v->c = _mm512_loadu_si512(s->c);
+    v->ce = _mm512_loadu_si512(s->ce);
+    v->cw = _mm512_loadu_si512(s->cw);
+    v->a0 = _mm512_loadu_si512(s->add[0]);
+    v->a1 = _mm512_loadu_si512(s->add[1]);
+    v->a2 = _mm512_loadu_si512(s->add[2]);
+    v->steps = _mm512_loadu_si512(s->steps);
+}
+
+LANES_FN static inline void vec_store(const vec_t *const v, lanes_t *const s)
+{
+    _mm512_storeu_pd(s->t[0], v->t0);
+    _mm512_storeu_pd(s->t[1], v->t1);
+    _mm512_storeu_pd(s->t[2], v->t2);
+    _mm512_storeu_pd(s->d[0], v->d0);
+    _mm512_storeu_pd(s->d[1], v->d1);
+    _mm512_storeu_pd(s->d[2], v->d2);
+    _mm512_storeu_pd(s->len, v->len);
+    _mm512_storeu_si512(s->c, v->c);
+    _mm512_storeu_si512(s->ce, v->ce);
+    _mm512_storeu_si512(s->cw, v->cw);
+    _mm512_storeu_si512(s->add[0], v->a0);
+    _mm512_storeu_si512(s->add[1], v->a1);
+    _mm512_storeu_si512(s->add[2], v->a2);
+    _mm512_storeu_si512(s->steps, v->steps);
+}
+
+/* The lanes of k take rays r[i ..] in lane order (expanding loads), their steps from 0. */
+LANES_FN static inline void vec_take(vec_t *const v, const __mmask8 k, const rays_t *const r,
+                                     const size_t i)
+{
+    v->t0 = _mm512_mask_expandloadu_pd(v->t0, k, &r->t[0][i]);
+    v->t1 = _mm512_mask_expandloadu_pd(v->t1, k, &r->t[1][i]);
+    v->t2 = _mm512_mask_expandloadu_pd(v->t2, k, &r->t[2][i]);
+    v->d0 = _mm512_mask_expandloadu_pd(v->d0, k, &r->d[0][i]);
+    v->d1 = _mm512_mask_expandloadu_pd(v->d1, k, &r->d[1][i]);
+    v->d2 = _mm512_mask_expandloadu_pd(v->d2, k, &r->d[2][i]);
+    v->len = _mm512_mask_expandloadu_pd(v->len, k, &r->len[i]);
+    v->c = _mm512_mask_expandloadu_epi64(v->c, k, &r->c[i]);
+    v->ce = _mm512_mask_expandloadu_epi64(v->ce, k, &r->ce[i]);
+    v->cw = _mm512_mask_expandloadu_epi64(v->cw, k, &r->cw[i]);
+    v->a0 = _mm512_mask_expandloadu_epi64(v->a0, k, &r->add[0][i]);
+    v->a1 = _mm512_mask_expandloadu_epi64(v->a1, k, &r->add[1][i]);
+    v->a2 = _mm512_mask_expandloadu_epi64(v->a2, k, &r->add[2][i]);
+    v->steps = _mm512_maskz_mov_epi64((__mmask8)~k, v->steps);
+}
+
+/* One step of every live lane: OctoMap's axis (the smallest tMax, ties to the higher), its tMax
+ * and the code's step on it (occ_code_step); returns the new codes (v->c keeps the old ones). */
+LANES_FN static inline __m512i vec_step(vec_t *const v, const __mmask8 live)
+{
+    const __m512i m0x = _mm512_set1_epi64((long long)DILATED_X);
+    const __m512i m1x = _mm512_slli_epi64(m0x, 1), m2x = _mm512_slli_epi64(m0x, 2);
+    const __mmask8 lt12 = _mm512_cmp_pd_mask(v->t1, v->t2, _CMP_LT_OQ);
+    const __mmask8 m0 = _mm512_cmp_pd_mask(v->t0, v->t1, _CMP_LT_OQ) &
+                        _mm512_cmp_pd_mask(v->t0, v->t2, _CMP_LT_OQ);
+    const __mmask8 m1 = (__mmask8)(~m0 & lt12), m2 = (__mmask8)(~m0 & ~lt12);
+    v->t0 = _mm512_mask_add_pd(v->t0, m0, v->t0, v->d0);
+    v->t1 = _mm512_mask_add_pd(v->t1, m1, v->t1, v->d1);
+    v->t2 = _mm512_mask_add_pd(v->t2, m2, v->t2, v->d2);
+    const __m512i m = _mm512_mask_blend_epi64(m2, _mm512_mask_blend_epi64(m1, m0x, m1x), m2x);
+    const __m512i add =
+        _mm512_mask_blend_epi64(m2, _mm512_mask_blend_epi64(m1, v->a0, v->a1), v->a2);
+    const __m512i x = _mm512_and_si512(v->c, m);
+    v->steps = _mm512_mask_add_epi64(v->steps, live, v->steps, _mm512_set1_epi64(1));
+    return _mm512_add_epi64(v->c,
+                            _mm512_sub_epi64(_mm512_and_si512(_mm512_add_epi64(x, add), m), x));
+}
+
+/* The lanes of `chunk` entered another chunk: their words from the cache (cache_slot's slots,
+ * by gathers). Returns the lanes it cannot serve (a miss, or a code off the map: lane_enter). */
+LANES_FN static inline unsigned vec_chunks(vec_t *const v, const unsigned chunk,
+                                           const occi_mwalk_cache_t *const cache,
+                                           const __m512i off)
+{
+    const __m512i key = _mm512_srli_epi64(v->c, 15);
+    const __m512i fold = _mm512_xor_si512(key, _mm512_srli_epi64(key, 8));
+    const __m512i slot = _mm512_and_si512(_mm512_xor_si512(fold, _mm512_srli_epi64(key, 16)),
+                                          _mm512_set1_epi64((long long)(OCC_MARK_CACHE - 1u)));
+    const __mmask8 on = (__mmask8)(chunk & ~(unsigned)_mm512_test_epi64_mask(v->c, off));
+    const __m512i none = _mm512_setzero_si512();
+    const __m512i got = _mm512_mask_i64gather_epi64(none, on, slot, cache->key, 8);
+    const __mmask8 hit =
+        _mm512_mask_cmpeq_epi64_mask(on, got, _mm512_add_epi64(key, _mm512_set1_epi64(1)));
+    v->cw = _mm512_mask_i64gather_epi64(v->cw, hit, slot, cache->ptr, 8);
+    return chunk & ~(unsigned)hit;
+}
+
+/* A step's marks, written one step later (read right after the vector stores, the words'
+ * addresses waited on them): `pend` lanes of the step before, whose addresses and bits are in
+ * the other half of the buffer. */
+typedef struct {
+    uint64_t adr[2][LANES], bit[2][LANES];
+    unsigned pend, cur;
+} marks_t;
+
+LANES_FN static inline void marks_write(marks_t *const mk)
+{
+    const unsigned h = mk->cur ^ 1u;
+    if (mk->pend == (1u << LANES) - 1u) { /* the common case, unrolled */
+        for (unsigned l = 0; l < LANES; l++) {
+            *(uint64_t *)(uintptr_t)mk->adr[h][l] |= mk->bit[h][l];
+        }
+        return;
+    }
+    for (unsigned p = mk->pend; p != 0u; p &= p - 1u) {
+        const unsigned l = (unsigned)__builtin_ctz(p);
+        *(uint64_t *)(uintptr_t)mk->adr[h][l] |= mk->bit[h][l];
+    }
+}
+
+/* The voxels of codes c in words cw, for the `lanes`: stored now, written after the next step. */
+LANES_FN static inline void marks_add(marks_t *const mk, const __m512i c, const __m512i cw,
+                                      const unsigned lanes)
+{
+    const __m512i word = _mm512_and_si512(_mm512_srli_epi64(c, 6), _mm512_set1_epi64(511));
+    _mm512_storeu_si512(mk->adr[mk->cur], _mm512_add_epi64(cw, _mm512_slli_epi64(word, 3)));
+    const __m512i low = _mm512_and_si512(c, _mm512_set1_epi64(63));
+    _mm512_storeu_si512(mk->bit[mk->cur], _mm512_sllv_epi64(_mm512_set1_epi64(1), low));
+    marks_write(mk);
+    mk->pend = lanes;
+    mk->cur ^= 1u;
+}
+
+/* The lanes of `fin` ended: their visits into *acc, the next rays into them in order (the last
+ * lanes go idle when too few are left). Returns the live lanes. */
+LANES_FN static inline unsigned vec_finish(vec_t *const v, __m512i *const acc,
+                                           const unsigned fin, unsigned live, rays_t *const r)
+{
+    *acc = _mm512_mask_add_epi64(*acc, (__mmask8)fin, *acc, v->steps);
+    unsigned take = fin;
+    const size_t left = r->n - r->next;
+    while ((size_t)__builtin_popcount(take) > left) {
+        take &= ~(1u << (31 - __builtin_clz(take)));
+    }
+    vec_take(v, (__mmask8)take, r, r->next);
+    r->next += (size_t)__builtin_popcount(take);
+    return live & ~(fin & ~take);
+}
+
+/* The vector loop. Returns when every lane is idle (0) or with the lanes that need lane_enter;
+ * *end says which of them are at their end voxel. Adds the visits of the rays that ended to
+ * *visits. */
 __attribute__((target("avx512f"))) static unsigned
 walk_lanes(lanes_t *const s, rays_t *const r, const occi_mwalk_cache_t *const cache,
            const uint64_t off_map, unsigned *const end_out, size_t *const visits)
 {
-    const __m512i one = _mm512_set1_epi64(1), zero = _mm512_setzero_si512();
-    const __m512i m0x = _mm512_set1_epi64((long long)DILATED_X);
-    const __m512i m1x = _mm512_slli_epi64(m0x, 1), m2x = _mm512_slli_epi64(m0x, 2);
-    const __m512i words = _mm512_set1_epi64(511), bits = _mm512_set1_epi64(63);
     const __m512i off = _mm512_set1_epi64((long long)off_map);
-    const __m512i slots = _mm512_set1_epi64((long long)(OCC_MARK_CACHE - 1u));
-    __m512d t0 = _mm512_loadu_pd(s->t[0]), t1 = _mm512_loadu_pd(s->t[1]);
-    __m512d t2 = _mm512_loadu_pd(s->t[2]), d0 = _mm512_loadu_pd(s->d[0]);
-    __m512d d1 = _mm512_loadu_pd(s->d[1]), d2 = _mm512_loadu_pd(s->d[2]);
-    __m512d len = _mm512_loadu_pd(s->len);
-    __m512i c = _mm512_loadu_si512(s->c), ce = _mm512_loadu_si512(s->ce);
-    __m512i cw = _mm512_loadu_si512(s->cw), a0 = _mm512_loadu_si512(s->add[0]);
-    __m512i a1 = _mm512_loadu_si512(s->add[1]), a2 = _mm512_loadu_si512(s->add[2]);
-    __m512i steps = _mm512_loadu_si512(s->steps), acc = zero;
+    vec_t v;
+    vec_load(&v, s);
+    __m512i acc = _mm512_setzero_si512();
     unsigned live = s->live, slow = 0, end = 0;
-    /* a step's marks are written one step later, from what the step stored: read right after
-     * the vector stores, the words' addresses wait on them */
-    uint64_t adr[2][LANES], bit[2][LANES];
-    unsigned pend = 0, cur = 0;
+    marks_t mk;
+    mk.pend = 0u;
+    mk.cur = 0u;
     while (live != 0u) {
-        const __mmask8 lt12 = _mm512_cmp_pd_mask(t1, t2, _CMP_LT_OQ);
-        const __mmask8 m0 = _mm512_cmp_pd_mask(t0, t1, _CMP_LT_OQ) &
-                            _mm512_cmp_pd_mask(t0, t2, _CMP_LT_OQ);
-        const __mmask8 m1 = (__mmask8)(~m0 & lt12), m2 = (__mmask8)(~m0 & ~lt12);
-        t0 = _mm512_mask_add_pd(t0, m0, t0, d0);
-        t1 = _mm512_mask_add_pd(t1, m1, t1, d1);
-        t2 = _mm512_mask_add_pd(t2, m2, t2, d2);
-        const __m512i m = _mm512_mask_blend_epi64(m2, _mm512_mask_blend_epi64(m1, m0x, m1x), m2x);
-        const __m512i add = _mm512_mask_blend_epi64(m2, _mm512_mask_blend_epi64(m1, a0, a1), a2);
-        const __m512i x = _mm512_and_si512(c, m);
-        const __m512i cn =
-            _mm512_add_epi64(c, _mm512_sub_epi64(_mm512_and_si512(_mm512_add_epi64(x, add), m), x));
         const __mmask8 lv = (__mmask8)live;
-        steps = _mm512_mask_add_epi64(steps, lv, steps, one);
-        const unsigned past = (unsigned)(_mm512_mask_cmp_pd_mask(lv, t0, len, _CMP_GT_OQ) &
-                                         _mm512_cmp_pd_mask(t1, len, _CMP_GT_OQ) &
-                                         _mm512_cmp_pd_mask(t2, len, _CMP_GT_OQ));
-        const __m512i moved = _mm512_srli_epi64(_mm512_xor_si512(cn, c), 15); /* chunk bits */
+        const __m512i cn = vec_step(&v, lv);
+        const unsigned past = (unsigned)(_mm512_mask_cmp_pd_mask(lv, v.t0, v.len, _CMP_GT_OQ) &
+                                         _mm512_cmp_pd_mask(v.t1, v.len, _CMP_GT_OQ) &
+                                         _mm512_cmp_pd_mask(v.t2, v.len, _CMP_GT_OQ));
+        const __m512i moved = _mm512_srli_epi64(_mm512_xor_si512(cn, v.c), 15); /* chunk bits */
         const unsigned chunk = (unsigned)_mm512_mask_test_epi64_mask(lv, moved, moved) & ~past;
-        c = cn;
-        end = (unsigned)_mm512_mask_cmpeq_epi64_mask(lv, c, ce) & ~past;
-        if (chunk != 0u) { /* its words from the cache; a miss or off the map: lane_enter */
-            const __m512i key = _mm512_srli_epi64(c, 15);
-            const __m512i fold = _mm512_xor_si512(key, _mm512_srli_epi64(key, 8));
-            const __m512i slot = /* cache_slot() */
-                _mm512_and_si512(_mm512_xor_si512(fold, _mm512_srli_epi64(key, 16)), slots);
-            const __mmask8 on = (__mmask8)(chunk & ~(unsigned)_mm512_test_epi64_mask(c, off));
-            const __m512i got = _mm512_mask_i64gather_epi64(zero, on, slot, cache->key, 8);
-            const __mmask8 hit = _mm512_mask_cmpeq_epi64_mask(on, got, _mm512_add_epi64(key, one));
-            cw = _mm512_mask_i64gather_epi64(cw, hit, slot, cache->ptr, 8);
-            slow = chunk & ~(unsigned)hit;
+        v.c = cn;
+        end = (unsigned)_mm512_mask_cmpeq_epi64_mask(lv, v.c, v.ce) & ~past;
+        if (chunk != 0u) {
+            slow = vec_chunks(&v, chunk, cache, off);
         }
         const unsigned fin = (past | end) & ~slow;
-        const __m512i word = _mm512_and_si512(_mm512_srli_epi64(c, 6), words);
-        _mm512_storeu_si512(adr[cur], _mm512_add_epi64(cw, _mm512_slli_epi64(word, 3)));
-        _mm512_storeu_si512(bit[cur], _mm512_sllv_epi64(one, _mm512_and_si512(c, bits)));
-        cur ^= 1u;
-        if (pend == (1u << LANES) - 1u) { /* the common case, unrolled */
-            for (unsigned l = 0; l < LANES; l++) {
-                *(uint64_t *)(uintptr_t)adr[cur][l] |= bit[cur][l];
-            }
-        } else {
-            for (unsigned mk = pend; mk != 0u; mk &= mk - 1u) {
-                const unsigned l = (unsigned)__builtin_ctz(mk);
-                *(uint64_t *)(uintptr_t)adr[cur][l] |= bit[cur][l];
-            }
-        }
-        pend = live & ~fin & ~slow;
-        if (fin != 0u) { /* their visits, then the next rays into those lanes, in order */
-            acc = _mm512_mask_add_epi64(acc, (__mmask8)fin, acc, steps);
-            unsigned take = fin;
-            const size_t left = r->n - r->next;
-            while ((size_t)__builtin_popcount(take) > left) {
-                take &= ~(1u << (31 - __builtin_clz(take))); /* the last lanes go idle */
-            }
-            live &= ~(fin & ~take);
-            const __mmask8 k = (__mmask8)take;
-            const size_t i = r->next;
-            t0 = _mm512_mask_expandloadu_pd(t0, k, &r->t[0][i]);
-            t1 = _mm512_mask_expandloadu_pd(t1, k, &r->t[1][i]);
-            t2 = _mm512_mask_expandloadu_pd(t2, k, &r->t[2][i]);
-            d0 = _mm512_mask_expandloadu_pd(d0, k, &r->d[0][i]);
-            d1 = _mm512_mask_expandloadu_pd(d1, k, &r->d[1][i]);
-            d2 = _mm512_mask_expandloadu_pd(d2, k, &r->d[2][i]);
-            len = _mm512_mask_expandloadu_pd(len, k, &r->len[i]);
-            c = _mm512_mask_expandloadu_epi64(c, k, &r->c[i]);
-            ce = _mm512_mask_expandloadu_epi64(ce, k, &r->ce[i]);
-            cw = _mm512_mask_expandloadu_epi64(cw, k, &r->cw[i]);
-            a0 = _mm512_mask_expandloadu_epi64(a0, k, &r->add[0][i]);
-            a1 = _mm512_mask_expandloadu_epi64(a1, k, &r->add[1][i]);
-            a2 = _mm512_mask_expandloadu_epi64(a2, k, &r->add[2][i]);
-            steps = _mm512_mask_mov_epi64(steps, k, zero);
-            r->next = i + (size_t)__builtin_popcount(take);
+        marks_add(&mk, v.c, v.cw, live & ~fin & ~slow);
+        if (fin != 0u) {
+            live = vec_finish(&v, &acc, fin, live, r);
         }
         if (slow != 0u) {
             break;
         }
     }
-    cur ^= 1u;
-    for (unsigned mk = pend; mk != 0u; mk &= mk - 1u) {
-        const unsigned l = (unsigned)__builtin_ctz(mk);
-        *(uint64_t *)(uintptr_t)adr[cur][l] |= bit[cur][l];
-    }
-    _mm512_storeu_pd(s->t[0], t0);
-    _mm512_storeu_pd(s->t[1], t1);
-    _mm512_storeu_pd(s->t[2], t2);
-    _mm512_storeu_pd(s->d[0], d0);
-    _mm512_storeu_pd(s->d[1], d1);
-    _mm512_storeu_pd(s->d[2], d2);
-    _mm512_storeu_pd(s->len, len);
-    _mm512_storeu_si512(s->c, c);
-    _mm512_storeu_si512(s->ce, ce);
-    _mm512_storeu_si512(s->cw, cw);
-    _mm512_storeu_si512(s->add[0], a0);
-    _mm512_storeu_si512(s->add[1], a1);
-    _mm512_storeu_si512(s->add[2], a2);
-    _mm512_storeu_si512(s->steps, steps);
+    marks_write(&mk); /* the last step's */
+    vec_store(&v, s);
     *visits += (size_t)_mm512_reduce_add_epi64(acc);
     s->live = live;
     *end_out = end;
